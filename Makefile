@@ -1,0 +1,77 @@
+# phlex: GNU make build for Debian's PETSc 3.18 / SLEPc 3.18.
+#   make            build bin/phlex
+#   make run        build (installing missing packages first) and run the default scene
+#   make check      build (installing missing packages first) and run the regression suite
+#   make deps       install the Debian packages phlex needs (only those missing)
+#   make meshes     regenerate the committed meshes from their .geo sources
+#   make print      show the compiler and flags
+
+PKGS      := slepc petsc hdf5-mpi
+SCENE     ?= options/cantilever.yaml
+MPIEXEC   ?= mpiexec
+NP        ?= 1
+RUN_ARGS  ?=
+
+# Flags are looked up lazily, so that 'make check' on a machine without PETSc can first install it.
+CC        = $(shell pkg-config --variable=ccompiler petsc 2>/dev/null || echo mpicc)
+CPPFLAGS  = -Iinclude $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+CFLAGS    ?= -O2 -g
+CFLAGS    += -std=c99 -Wall -Wextra -Wno-unused-parameter -MMD -MP
+LDLIBS    = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lm
+
+SRC       := $(sort $(wildcard src/*.c))
+OBJ       := $(patsubst src/%.c,build/%.o,$(SRC))
+BIN       := bin/phlex
+
+# The dependency probe: PETSc, SLEPc and gmsh present means nothing has to be installed.
+HAVE_DEPS = $(shell pkg-config --exists $(PKGS) 2>/dev/null && command -v gmsh >/dev/null 2>&1 && command -v $(MPIEXEC) >/dev/null 2>&1 && echo yes)
+
+.PHONY: all run check check-update deps deps-if-missing meshes format clean print bench
+
+all: $(BIN)
+
+$(BIN): $(OBJ) | bin
+	$(CC) $(CFLAGS) -o $@ $(OBJ) $(LDLIBS)
+
+build/%.o: src/%.c | build
+	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+bin build:
+	@mkdir -p $@
+
+deps:
+	@tools/install-deps.sh
+
+deps-if-missing:
+	@$(if $(HAVE_DEPS),true,tools/install-deps.sh)
+
+run: deps-if-missing
+	@$(MAKE) --no-print-directory $(BIN)
+	$(MPIEXEC) -n $(NP) $(BIN) -options_file $(SCENE) $(RUN_ARGS)
+
+check: deps-if-missing
+	@$(MAKE) --no-print-directory $(BIN)
+	python3 tests/run.py $(TEST_ARGS)
+
+check-update: $(BIN)
+	python3 tests/run.py --update $(TEST_ARGS)
+
+meshes:
+	@$(MAKE) --no-print-directory -C meshes
+
+bench: $(BIN)
+	@$(MAKE) --no-print-directory -C bench
+
+format:
+	clang-format -i src/*.c include/*.h
+
+clean:
+	rm -rf build bin
+
+print:
+	@echo "CC       = $(CC)"
+	@echo "CPPFLAGS = $(CPPFLAGS)"
+	@echo "CFLAGS   = $(CFLAGS)"
+	@echo "LDLIBS   = $(LDLIBS)"
+
+-include $(OBJ:.o=.d)

@@ -1,0 +1,70 @@
+/* phlex: flexible multibody dynamics of 3D elastic bodies in port-Hamiltonian form (PETSc/SLEPc).
+   Public handles, enums and prototypes. The structs live in phlex_impl.h. */
+#ifndef PHLEX_H
+#define PHLEX_H
+
+#include <petscts.h>
+#include <petscdmplex.h>
+#include <slepceps.h>
+
+typedef struct _p_PhlexScene   *PhlexScene;
+typedef struct _p_PhlexBody    *PhlexBody;
+typedef struct _p_PhlexPort    *PhlexPort;
+typedef struct _p_PhlexProfile *PhlexProfile;
+typedef struct _p_PhlexOutput  *PhlexOutput;
+
+typedef enum {
+  PHLEX_ANALYSIS_TRANSIENT,
+  PHLEX_ANALYSIS_MODES
+} PhlexAnalysisType;
+PETSC_EXTERN const char *const PhlexAnalysisTypes[];
+
+/* Reference scales of the non-dimensionalisation (SI). Every internal quantity is divided by its scale. */
+typedef struct {
+  PetscReal length;   /* L [m] */
+  PetscReal density;  /* rho_ref [kg/m^3] */
+  PetscReal modulus;  /* E_ref [Pa], also the stress scale */
+  PetscReal time;     /* T = L sqrt(rho_ref/E_ref) [s] */
+  PetscReal velocity; /* L/T [m/s] */
+  PetscReal mass;     /* rho_ref L^3 [kg] */
+  PetscReal force;    /* E_ref L^2 [N] */
+  PetscReal energy;   /* E_ref L^3 [J] */
+  PetscReal power;    /* energy/T [W] */
+} PhlexUnits;
+
+/* log.c */
+PETSC_EXTERN PetscClassId  PHLEX_CLASSID;
+PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist;
+PETSC_EXTERN PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes, PHLEX_StageOutput;
+PETSC_EXTERN PetscErrorCode PhlexLogRegister(void);
+
+/* error.c */
+PETSC_EXTERN PetscErrorCode PhlexErrorHandlerPush(void);
+
+/* profile.c: scalar time profiles f(t) multiplying an input */
+PETSC_EXTERN PetscErrorCode PhlexProfileCreate(MPI_Comm, const char[], const char[], PhlexProfile *);
+PETSC_EXTERN PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile);
+PETSC_EXTERN PetscErrorCode PhlexProfileEvaluate(PhlexProfile, PetscReal, PetscReal *);
+PETSC_EXTERN PetscErrorCode PhlexProfileView(PhlexProfile, PetscViewer);
+PETSC_EXTERN PetscErrorCode PhlexProfileDestroy(PhlexProfile *);
+
+/* scene.c */
+PETSC_EXTERN PetscErrorCode PhlexSceneCreate(MPI_Comm, PhlexScene *);
+PETSC_EXTERN PetscErrorCode PhlexSceneSetFromOptions(PhlexScene);
+PETSC_EXTERN PetscErrorCode PhlexSceneSetUp(PhlexScene);
+PETSC_EXTERN PetscErrorCode PhlexSceneGetAnalysis(PhlexScene, PhlexAnalysisType *);
+PETSC_EXTERN PetscErrorCode PhlexSceneView(PhlexScene, PetscViewer);
+PETSC_EXTERN PetscErrorCode PhlexSceneDestroy(PhlexScene *);
+
+/* body.c */
+PETSC_EXTERN PetscErrorCode PhlexBodyCreate(MPI_Comm, PetscInt, PhlexBody *);
+PETSC_EXTERN PetscErrorCode PhlexBodySetFromOptions(PhlexBody);
+PETSC_EXTERN PetscErrorCode PhlexBodySetUp(PhlexBody, const PhlexUnits *);
+PETSC_EXTERN PetscErrorCode PhlexBodyView(PhlexBody, PetscViewer);
+PETSC_EXTERN PetscErrorCode PhlexBodyDestroy(PhlexBody *);
+
+/* modes.c and integrate.c: the analyses */
+PETSC_EXTERN PetscErrorCode PhlexSceneSolveModes(PhlexScene);
+PETSC_EXTERN PetscErrorCode PhlexSceneSolveTransient(PhlexScene);
+
+#endif

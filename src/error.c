@@ -1,0 +1,61 @@
+/* Error reporting: input errors raised by phlex itself are printed as one clear line (which file, option, body and
+   value); any other error keeps PETSc's full traceback. */
+#include <phlex_impl.h>
+
+static PetscBool phlex_traceback = PETSC_FALSE;
+static PetscBool phlex_short     = PETSC_FALSE; /* the error being propagated was printed as one line */
+
+static PetscBool IsInputError(PetscErrorCode n)
+{
+  switch (n) {
+  case PETSC_ERR_USER_INPUT:
+  case PETSC_ERR_USER:
+  case PETSC_ERR_FILE_OPEN:
+  case PETSC_ERR_FILE_READ:
+  case PETSC_ERR_FILE_WRITE:
+  case PETSC_ERR_FILE_UNEXPECTED:
+  case PETSC_ERR_SUP:
+  case PETSC_ERR_ARG_OUTOFRANGE:
+  case PETSC_ERR_NOT_CONVERGED:
+    return PETSC_TRUE;
+  default:
+    return PETSC_FALSE;
+  }
+}
+
+static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
+{
+  PetscBool ours = (file && !strncmp(file, "src/", 4)) ? PETSC_TRUE : PETSC_FALSE;
+
+  if (p == PETSC_ERROR_INITIAL) {
+    PetscMPIInt rank = 0;
+    phlex_short      = PETSC_FALSE;
+    /* collective checks raise the same error on every rank: print it once */
+    if (comm != MPI_COMM_NULL) MPI_Comm_rank(comm, &rank);
+    if (ours && IsInputError(n) && !phlex_traceback) {
+      phlex_short = PETSC_TRUE;
+      if (rank == 0) {
+        fprintf(stderr, "phlex: error: %s\n", mess ? mess : "(no message)");
+        fflush(stderr);
+      }
+      return n;
+    }
+  } else if (phlex_short) {
+    return n; /* the one-line message was printed */
+  }
+  return PetscTraceBackErrorHandler(comm, line, fun, file, n, p, mess, ctx);
+}
+
+/*@C
+  PhlexErrorHandlerPush - installs phlex's error handler
+
+  Options Database Key:
+. -phlex_error_traceback - print PETSc's full traceback also for input errors
+@*/
+PetscErrorCode PhlexErrorHandlerPush(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-phlex_error_traceback", &phlex_traceback, NULL));
+  PetscCall(PetscPushErrorHandler(PhlexErrorHandler, NULL));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,30 @@
+/* Class id, log events and stages of phlex (CONVENTIONS section 6). */
+#include <phlex.h>
+
+PetscClassId  PHLEX_CLASSID;
+PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist;
+PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes, PHLEX_StageOutput;
+
+/*@C
+  PhlexLogRegister - registers the phlex class id, log events and stages
+
+  Not collective
+@*/
+PetscErrorCode PhlexLogRegister(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscClassIdRegister("Phlex", &PHLEX_CLASSID));
+  PetscCall(PetscLogEventRegister("PhlexBodySetUp", PHLEX_CLASSID, &PHLEX_BodySetUp));
+  PetscCall(PetscLogEventRegister("PhlexBodyAssem", PHLEX_CLASSID, &PHLEX_BodyAssemble));
+  PetscCall(PetscLogEventRegister("PhlexSysIFunc", PHLEX_CLASSID, &PHLEX_SysIFunction));
+  PetscCall(PetscLogEventRegister("PhlexSysIJac", PHLEX_CLASSID, &PHLEX_SysIJacobian));
+  PetscCall(PetscLogEventRegister("PhlexMonEnergy", PHLEX_CLASSID, &PHLEX_MonitorEnergy));
+  PetscCall(PetscLogEventRegister("PhlexModesSolve", PHLEX_CLASSID, &PHLEX_ModesSolve));
+  PetscCall(PetscLogEventRegister("PhlexOutput", PHLEX_CLASSID, &PHLEX_Output));
+  PetscCall(PetscLogEventRegister("PhlexPortDist", PHLEX_CLASSID, &PHLEX_PortDist));
+  PetscCall(PetscLogStageRegister("Phlex Setup", &PHLEX_StageSetup));
+  PetscCall(PetscLogStageRegister("Phlex Transient", &PHLEX_StageTransient));
+  PetscCall(PetscLogStageRegister("Phlex Modes", &PHLEX_StageModes));
+  PetscCall(PetscLogStageRegister("Phlex Output", &PHLEX_StageOutput));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,389 @@
+/* gmsh -> DMPlex: file checks, physical names, distribution, cell and group validation. */
+#include <phlex_impl.h>
+#include <petscsf.h>
+
+/* The physical names of a gmsh file ($PhysicalNames is ASCII text in ASCII and binary files of versions 2.2
+   and 4.1). Rank 0 reads and checks the file, then broadcasts the table, so that a bad file gives the same clear
+   error on every rank before PETSc's reader runs. */
+typedef struct {
+  PetscInt  status; /* 0 ok, >0 error code below */
+  PetscInt  ngroups;
+  PetscReal version;
+  PetscInt  binary;
+  char      detail[256];
+} PhlexMeshHeader;
+
+enum { MESH_OK, MESH_NO_FILE, MESH_NOT_GMSH, MESH_BAD_VERSION, MESH_TRUNCATED, MESH_BAD_NAMES, MESH_IS_DIR };
+
+static void ReadHeaderRank0(const char file[], PhlexMeshHeader *h, PhlexPhysicalGroup **groups)
+{
+  FILE *fp;
+  char  line[1024];
+  int   cnt = 0, ngroups = 0;
+  long  size;
+
+  h->status  = MESH_OK;
+  h->ngroups = 0;
+  *groups    = NULL;
+  fp         = fopen(file, "rb");
+  if (!fp) {
+    h->status = MESH_NO_FILE;
+    return;
+  }
+  /* a directory can be opened on Linux, but not read */
+  if (!fgets(line, sizeof(line), fp)) {
+    h->status = ferror(fp) ? MESH_IS_DIR : MESH_NOT_GMSH;
+    fclose(fp);
+    return;
+  }
+  if (strncmp(line, "$MeshFormat", 11)) {
+    h->status = MESH_NOT_GMSH;
+    fclose(fp);
+    return;
+  }
+  {
+    double v;
+    int    bin = 0, ds = 0;
+    if (!fgets(line, sizeof(line), fp) || sscanf(line, "%lf %d %d", &v, &bin, &ds) != 3) {
+      h->status = MESH_NOT_GMSH;
+      fclose(fp);
+      return;
+    }
+    h->version = v;
+    h->binary  = bin;
+    if (!((v >= 2.0 && v < 3.0) || (v >= 4.1 && v < 4.2))) {
+      h->status = MESH_BAD_VERSION;
+      snprintf(h->detail, sizeof(h->detail), "%g", v);
+      fclose(fp);
+      return;
+    }
+  }
+  /* physical names: between $PhysicalNames and $EndPhysicalNames, before the (possibly binary) data */
+  while (fgets(line, sizeof(line), fp)) {
+    if (!strncmp(line, "$PhysicalNames", 14)) {
+      if (!fgets(line, sizeof(line), fp) || sscanf(line, "%d", &ngroups) != 1 || ngroups < 0) {
+        h->status = MESH_BAD_NAMES;
+        fclose(fp);
+        return;
+      }
+      *groups = (PhlexPhysicalGroup *)calloc((size_t)(ngroups > 0 ? ngroups : 1), sizeof(PhlexPhysicalGroup));
+      for (cnt = 0; cnt < ngroups; cnt++) {
+        int   dim, tag;
+        char *q0, *q1;
+        if (!fgets(line, sizeof(line), fp) || sscanf(line, "%d %d", &dim, &tag) != 2 || !(q0 = strchr(line, '"')) || !(q1 = strchr(q0 + 1, '"'))) {
+          h->status = MESH_BAD_NAMES;
+          snprintf(h->detail, sizeof(h->detail), "%.200s", line);
+          fclose(fp);
+          return;
+        }
+        *q1 = 0;
+        snprintf((*groups)[cnt].name, PHLEX_NAME_LEN, "%s", q0 + 1);
+        (*groups)[cnt].dim = dim;
+        (*groups)[cnt].tag = tag;
+      }
+      h->ngroups = ngroups;
+      break;
+    }
+    if (!strncmp(line, "$Nodes", 6) || !strncmp(line, "$Entities", 9)) break;
+  }
+  /* a complete file has an $EndElements marker near its end */
+  fseek(fp, 0, SEEK_END);
+  size = ftell(fp);
+  {
+    long  n   = size < 65536 ? size : 65536;
+    char *buf = (char *)malloc((size_t)n + 1);
+    int   found = 0;
+    fseek(fp, size - n, SEEK_SET);
+    if (buf && fread(buf, 1, (size_t)n, fp) == (size_t)n) {
+      for (long i = 0; i + 12 <= n; i++)
+        if (!memcmp(buf + i, "$EndElements", 12)) {
+          found = 1;
+          break;
+        }
+    }
+    free(buf);
+    if (!found) h->status = MESH_TRUNCATED;
+  }
+  fclose(fp);
+}
+
+/*@C
+  PhlexMeshReadPhysicalNames - checks that a file is a complete gmsh 2.2/4.1 mesh and returns its physical groups
+
+  Collective
+
+  Input Parameters:
++ comm - communicator
+. file - gmsh file name
+- what - object named in error messages (e.g. "body cantilever (option -body0_dm_plex_filename)")
+
+  Output Parameters:
++ ngroups - number of physical groups
+- groups  - the groups (free with PetscFree())
+@*/
+PetscErrorCode PhlexMeshReadPhysicalNames(MPI_Comm comm, const char file[], const char what[], PetscInt *ngroups, PhlexPhysicalGroup **groups)
+{
+  PhlexMeshHeader     h;
+  PhlexPhysicalGroup *g0 = NULL;
+  PetscMPIInt         rank;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&h, sizeof(h)));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) ReadHeaderRank0(file, &h, &g0);
+  PetscCallMPI(MPI_Bcast(&h, (PetscMPIInt)sizeof(h), MPI_BYTE, 0, comm));
+  switch (h.status) {
+  case MESH_NO_FILE:
+    SETERRQ(comm, PETSC_ERR_FILE_OPEN, "%s: cannot open mesh file '%s' (missing or unreadable)", what, file);
+  case MESH_IS_DIR:
+    SETERRQ(comm, PETSC_ERR_FILE_READ, "%s: cannot read mesh file '%s' (is it a directory?)", what, file);
+  case MESH_NOT_GMSH:
+    SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "%s: '%s' is not a gmsh mesh file (it does not start with $MeshFormat)", what, file);
+  case MESH_BAD_VERSION:
+    SETERRQ(comm, PETSC_ERR_SUP, "%s: mesh file '%s' has gmsh format version %s; supported are 2.2 and 4.1 (gmsh -format msh41 or msh22)", what, file, h.detail);
+  case MESH_BAD_NAMES:
+    SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "%s: mesh file '%s' has a malformed $PhysicalNames section (%s)", what, file, h.detail);
+  case MESH_TRUNCATED:
+    SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "%s: mesh file '%s' is incomplete (no $EndElements section): was it truncated?", what, file);
+  default:
+    break;
+  }
+  *ngroups = h.ngroups;
+  PetscCall(PetscCalloc1(PetscMax(h.ngroups, 1), groups));
+  if (rank == 0 && h.ngroups) PetscCall(PetscArraycpy(*groups, g0, h.ngroups));
+  free(g0);
+  if (h.ngroups) PetscCallMPI(MPI_Bcast(*groups, (PetscMPIInt)(h.ngroups * sizeof(PhlexPhysicalGroup)), MPI_BYTE, 0, comm));
+  PetscFunctionReturn(0);
+}
+
+static const char *DimName(PetscInt dim)
+{
+  switch (dim) {
+  case 0:
+    return "point";
+  case 1:
+    return "curve";
+  case 2:
+    return "surface";
+  case 3:
+    return "volume";
+  default:
+    return "?";
+  }
+}
+
+/*@C
+  PhlexMeshFindGroup - finds a physical group of a body's mesh by name, checks its dimension and that it is not empty
+
+  Collective
+
+  Input Parameters:
++ body   - the body (mesh loaded)
+. name   - the physical name
+. dim    - the required dimension (2 surface, 3 volume)
+- option - the option that named the group (for messages)
+
+  Output Parameter:
+. tag - the physical tag (value of "Face Sets" or "Cell Sets")
+@*/
+PetscErrorCode PhlexMeshFindGroup(PhlexBody body, const char name[], PetscInt dim, const char option[], PetscInt *tag)
+{
+  char      avail[1024] = "";
+  PetscInt  found = -1, count = 0, gcount = 0;
+  DMLabel   label;
+  PetscBool same;
+
+  PetscFunctionBeginUser;
+  for (PetscInt g = 0; g < body->ngroups; g++) {
+    PetscCall(PetscStrcmp(body->groups[g].name, name, &same));
+    if (same && body->groups[g].dim == dim) found = g;
+    else if (same && found < 0) found = -2 - g;
+  }
+  if (found < 0) {
+    for (PetscInt g = 0; g < body->ngroups; g++) {
+      char item[128];
+      PetscCall(PetscSNPrintf(item, sizeof(item), "%s%s (%s)", g ? ", " : "", body->groups[g].name, DimName(body->groups[g].dim)));
+      PetscCall(PetscStrlcat(avail, item, sizeof(avail)));
+    }
+    PetscCheck(found != -1, body->comm, PETSC_ERR_USER_INPUT, "body %s: option %s: physical group '%s' not found in mesh file '%s' (groups in the file: %s)", body->name, option, name, body->mesh_file, body->ngroups ? avail : "none");
+    SETERRQ(body->comm, PETSC_ERR_USER_INPUT, "body %s: option %s: physical group '%s' in mesh file '%s' is a %s, but a %s is required", body->name, option, name, body->mesh_file, DimName(body->groups[-2 - found].dim), DimName(dim));
+  }
+  *tag = body->groups[found].tag;
+  PetscCall(DMGetLabel(body->dm, dim == 3 ? "Cell Sets" : "Face Sets", &label));
+  if (label) {
+    IS is;
+    PetscCall(DMLabelGetStratumIS(label, *tag, &is));
+    if (is) {
+      const PetscInt *pts;
+      PetscInt        n, depth;
+      PetscCall(ISGetLocalSize(is, &n));
+      PetscCall(ISGetIndices(is, &pts));
+      for (PetscInt i = 0; i < n; i++) {
+        PetscCall(DMPlexGetPointDepth(body->dm, pts[i], &depth));
+        if (depth == dim) count++;
+      }
+      PetscCall(ISRestoreIndices(is, &pts));
+      PetscCall(ISDestroy(&is));
+    }
+  }
+  PetscCallMPI(MPI_Allreduce(&count, &gcount, 1, MPIU_INT, MPI_SUM, body->comm));
+  PetscCheck(gcount > 0, body->comm, PETSC_ERR_USER_INPUT, "body %s: option %s: physical group '%s' (%s, tag %" PetscInt_FMT ") in mesh file '%s' has no elements", body->name, option, name, DimName(dim), *tag, body->mesh_file);
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexMeshLoad - reads the body's gmsh file into a distributed, interpolated DMPlex and checks its cells
+
+  Collective
+
+  Input Parameter:
+. body - the body (mesh_file set)
+
+  Options Database Keys (body prefix):
++ -dm_refine <n>          - uniform refinements after distribution
+. -dm_plex_check_all      - DMPlex consistency checks
+- -petscpartitioner_type  - partitioner (PTScotch in parallel on Debian)
+
+  Notes:
+  Tetrahedra only. Hexahedra are refused: with discontinuous Q_{k-1} stress the stress space does not contain the
+  strains of the Q_k velocity, so the element-wise stress elimination is not the displacement stiffness and Q1/Q0
+  has hourglass (zero-energy) modes.
+@*/
+PetscErrorCode PhlexMeshLoad(PhlexBody body)
+{
+  DM               dm, dmdist = NULL;
+  PetscPartitioner part;
+  PetscInt         dim, cStart, cEnd, bad = -1, gbad;
+  DMPolytopeType   ct, badtype = DM_POLYTOPE_UNKNOWN;
+  char             what[512];
+  PetscMPIInt      size;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(what, sizeof(what), "body %s (option -%sdm_plex_filename)", body->name, body->prefix));
+  PetscCall(PhlexMeshReadPhysicalNames(body->comm, body->mesh_file, what, &body->ngroups, &body->groups));
+  PetscCall(DMPlexCreateFromFile(body->comm, body->mesh_file, body->name, PETSC_TRUE, &dm));
+  PetscCall(PetscObjectSetName((PetscObject)dm, body->name));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCheck(dim == 3, body->comm, PETSC_ERR_SUP, "body %s: mesh file '%s' is %" PetscInt_FMT "D; phlex needs a 3D volume mesh (gmsh -3)", body->name, body->mesh_file, dim);
+
+  /* all cells must be tetrahedra (checked before distribution, on the reading rank) */
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  for (PetscInt c = cStart; c < cEnd; c++) {
+    PetscCall(DMPlexGetCellType(dm, c, &ct));
+    if (ct != DM_POLYTOPE_TETRAHEDRON) {
+      bad     = c;
+      badtype = ct;
+      break;
+    }
+  }
+  {
+    PetscInt loc[2] = {bad >= 0 ? 1 : 0, (PetscInt)badtype}, glob[2];
+    PetscCallMPI(MPI_Allreduce(loc, glob, 2, MPIU_INT, MPI_MAX, body->comm));
+    gbad = glob[0];
+    if (gbad) {
+      PetscCheck(glob[1] != DM_POLYTOPE_HEXAHEDRON, body->comm, PETSC_ERR_SUP,
+                 "body %s: mesh file '%s' has hexahedra; phlex supports tetrahedra only: with discontinuous Q_{k-1} stress the stress space does not contain the strains of Q_k velocities, so the element-wise stress elimination is not the displacement stiffness (Q1/Q0 has hourglass modes). Mesh the body with tetrahedra (no Recombine)",
+                 body->name, body->mesh_file);
+      SETERRQ(body->comm, PETSC_ERR_SUP, "body %s: mesh file '%s' has cells of type %s; phlex supports tetrahedra only", body->name, body->mesh_file, DMPolytopeTypes[glob[1]]);
+    }
+  }
+
+  PetscCallMPI(MPI_Comm_size(body->comm, &size));
+  PetscCall(DMSetOptionsPrefix(dm, body->prefix));
+  PetscCall(DMPlexGetPartitioner(dm, &part));
+  PetscCall(PetscObjectSetOptionsPrefix((PetscObject)part, body->prefix));
+  PetscCall(PetscPartitionerSetFromOptions(part));
+  if (size > 1) {
+    PetscCall(DMPlexDistribute(dm, 0, NULL, &dmdist));
+    if (dmdist) {
+      PetscCall(DMDestroy(&dm));
+      dm = dmdist;
+    }
+  }
+  PetscCall(DMSetFromOptions(dm)); /* -<prefix>dm_refine, -<prefix>dm_plex_check_all, ... */
+  PetscCall(DMViewFromOptions(dm, NULL, "-dm_view"));
+  body->dm = dm;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexMeshCheckGeometry - refuses inverted or degenerate cells and computes the bounding box
+
+  Collective
+
+  Notes:
+  PETSc reorients gmsh tetrahedra to its own convention; a cell whose Jacobian determinant is then negative was
+  inverted in the file, and one with a volume below 1e-10 of the cube of its longest edge is degenerate.
+@*/
+PetscErrorCode PhlexMeshCheckGeometry(PhlexBody body, const PhlexUnits *units)
+{
+  PetscInt     cStart, cEnd, info[2] = {-1, 0}, ginfo[2];
+  PetscReal    v0[3], J[9], invJ[9], detJ, loc[6], glob[6];
+  PetscReal    bad_centroid[3] = {0, 0, 0};
+  Vec          coords;
+  const PetscScalar *x;
+  PetscInt     n;
+  PetscMPIInt  rank;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetHeightStratum(body->dm, 0, &cStart, &cEnd));
+  for (PetscInt c = cStart; c < cEnd && info[0] < 0; c++) {
+    PetscReal          hmax = 0, xs[4][3];
+    PetscInt           nc;
+    PetscBool          isDG;
+    const PetscScalar *array;
+    PetscScalar       *cc = NULL;
+    PetscCall(DMPlexComputeCellGeometryAffineFEM(body->dm, c, v0, J, invJ, &detJ));
+    PetscCall(DMPlexGetCellCoordinates(body->dm, c, &isDG, &nc, &array, &cc));
+    for (PetscInt i = 0; i < 4; i++)
+      for (PetscInt d = 0; d < 3; d++) xs[i][d] = PetscRealPart(cc[3 * i + d]);
+    PetscCall(DMPlexRestoreCellCoordinates(body->dm, c, &isDG, &nc, &array, &cc));
+    for (PetscInt i = 0; i < 4; i++)
+      for (PetscInt j = i + 1; j < 4; j++) {
+        PetscReal e = 0;
+        for (PetscInt d = 0; d < 3; d++) e += PetscSqr(xs[i][d] - xs[j][d]);
+        hmax = PetscMax(hmax, PetscSqrtReal(e));
+      }
+    /* the reference tetrahedron has volume 4/3, so the cell volume is detJ 4/3 */
+    if (PetscAbsReal(detJ) * 4.0 / 3.0 <= 1e-10 * hmax * hmax * hmax) info[0] = 1;
+    else if (detJ < 0) info[0] = 2;
+    if (info[0] > 0) {
+      info[1] = c;
+      for (PetscInt d = 0; d < 3; d++) bad_centroid[d] = 0.25 * (xs[0][d] + xs[1][d] + xs[2][d] + xs[3][d]);
+    }
+  }
+  PetscCallMPI(MPI_Comm_rank(body->comm, &rank));
+  {
+    PetscInt in[2] = {info[0], rank}, out[2];
+    PetscCallMPI(MPI_Allreduce(in, out, 1, MPIU_2INT, MPI_MAXLOC, body->comm));
+    ginfo[0] = out[0];
+    if (ginfo[0] > 0) {
+      PetscCallMPI(MPI_Bcast(bad_centroid, 3, MPIU_REAL, (PetscMPIInt)out[1], body->comm));
+      PetscCallMPI(MPI_Bcast(&info[1], 1, MPIU_INT, (PetscMPIInt)out[1], body->comm));
+    }
+  }
+  PetscCheck(ginfo[0] != 1, body->comm, PETSC_ERR_USER_INPUT, "body %s: mesh file '%s' has a degenerate (zero-volume) tetrahedron near (%g, %g, %g)", body->name, body->mesh_file, (double)bad_centroid[0], (double)bad_centroid[1], (double)bad_centroid[2]);
+  PetscCheck(ginfo[0] != 2, body->comm, PETSC_ERR_USER_INPUT, "body %s: mesh file '%s' has an inverted tetrahedron (negative volume, node order reversed) near (%g, %g, %g)", body->name, body->mesh_file, (double)bad_centroid[0], (double)bad_centroid[1], (double)bad_centroid[2]);
+
+  /* bounding box */
+  for (PetscInt d = 0; d < 3; d++) {
+    loc[d]     = PETSC_MAX_REAL;
+    loc[3 + d] = PETSC_MAX_REAL;
+  }
+  PetscCall(DMGetCoordinatesLocal(body->dm, &coords));
+  PetscCall(VecGetLocalSize(coords, &n));
+  PetscCall(VecGetArrayRead(coords, &x));
+  for (PetscInt i = 0; i < n / 3; i++)
+    for (PetscInt d = 0; d < 3; d++) {
+      loc[d]     = PetscMin(loc[d], PetscRealPart(x[3 * i + d]));
+      loc[3 + d] = PetscMin(loc[3 + d], -PetscRealPart(x[3 * i + d]));
+    }
+  PetscCall(VecRestoreArrayRead(coords, &x));
+  PetscCallMPI(MPI_Allreduce(loc, glob, 6, MPIU_REAL, MPI_MIN, body->comm));
+  for (PetscInt d = 0; d < 3; d++) {
+    body->bbox_min[d] = glob[d];
+    body->bbox_max[d] = -glob[3 + d];
+  }
+  (void)units;
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,184 @@
+/* Modal analysis with SLEPc: the symmetric-definite pencil (K, Mv) of the velocity after exact stress elimination
+   (K = G^T Ms^{-1} G element by element), shift-and-invert, EPS options under the prefix modes_. */
+#include <phlex_impl.h>
+
+/* Lowest free-free bending frequency of a beam with the body's bounding box (non-dimensional, rad per unit time):
+   a scale for the shift of free bodies and for telling rigid modes from elastic ones. */
+static PetscReal FrequencyScale(PhlexBody b, const PhlexUnits *u)
+{
+  PetscReal L = 0, t = PETSC_MAX_REAL, c = PETSC_MAX_REAL;
+
+  for (PetscInt d = 0; d < 3; d++) {
+    L = PetscMax(L, b->bbox_max[d] - b->bbox_min[d]);
+    t = PetscMin(t, b->bbox_max[d] - b->bbox_min[d]);
+  }
+  for (PetscInt m = 0; m < b->nmaterials; m++) c = PetscMin(c, PetscSqrtReal(b->materials[m].youngs_modulus / b->materials[m].density));
+  /* (4.730)^2 t / (sqrt(12) L^2) c, in units of 1/T */
+  return 22.373 * t / (PetscSqrtReal(12.0) * L * L) * c * u->time;
+}
+
+/*@C
+  PhlexBodyComputeModes - lowest eigenpairs of K x = lambda Mv x of a body (non-dimensional lambda = omega^2)
+
+  Collective
+
+  Input Parameters:
++ b     - the body
+. units - scales
+- nev   - number of elastic modes wanted (the six rigid modes of a free body come on top)
+
+  Output Parameters:
++ nconv  - number of eigenpairs returned
+. nrigid - how many of them are rigid-body modes (|lambda| below 1e-6 of the elastic frequency scale squared)
+. lambda - eigenvalues (ascending)
+. vecs   - eigenvectors (Mv-normalised), may be NULL
+- resid  - relative residual norms ||K x - lambda Mv x|| / (|lambda| ||x||), may be NULL
+
+  Options Database Keys:
++ -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)
+. -modes_target_frequency <Hz>    - look for modes nearest this frequency (default: lowest)
+- -modes_eps_*, -modes_st_*       - any SLEPc EPS/ST option; defaults: Krylov-Schur, shift-and-invert, Cholesky (MUMPS)
+@*/
+PetscErrorCode PhlexBodyComputeModes(PhlexBody b, const PhlexUnits *units, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **resid)
+{
+  EPS       eps;
+  ST        st;
+  KSP       ksp;
+  PC        pc;
+  PetscReal omega = FrequencyScale(b, units), sigma, ftarget = -1;
+  PetscBool free_body = b->frame_patch[0] ? PETSC_FALSE : PETSC_TRUE, flg;
+  PetscInt  n, want;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
+  want  = nev + (free_body ? 6 : 0);
+  sigma = free_body ? -PetscSqr(1e-2 * omega) : 0.0;
+  PetscCall(PetscOptionsGetReal(NULL, "modes_", "-target_frequency", &ftarget, &flg));
+  if (flg) {
+    PetscCheck(ftarget >= 0, b->comm, PETSC_ERR_USER_INPUT, "-modes_target_frequency must be >= 0 Hz, got %g", (double)ftarget);
+    sigma = PetscSqr(2.0 * PETSC_PI * ftarget * units->time);
+    if (sigma == 0 && free_body) sigma = -PetscSqr(1e-2 * omega);
+  }
+  PetscCall(EPSCreate(b->comm, &eps));
+  PetscCall(EPSSetOptionsPrefix(eps, "modes_"));
+  PetscCall(EPSSetOperators(eps, b->K, b->Mv));
+  PetscCall(EPSSetProblemType(eps, EPS_GHEP));
+  PetscCall(EPSSetType(eps, EPSKRYLOVSCHUR));
+  PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+  PetscCall(EPSSetTarget(eps, sigma));
+  PetscCall(EPSSetTolerances(eps, 1e-12, PETSC_DEFAULT));
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STSetType(st, STSINVERT));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(EPSSetFromOptions(eps));
+  PetscCall(EPSSolve(eps));
+  PetscCall(EPSGetDimensions(eps, &want, NULL, NULL));
+  PetscCall(EPSGetConverged(eps, &n));
+  n = PetscMin(n, want);
+  PetscCall(PetscMalloc1(n, lambda));
+  if (resid) PetscCall(PetscMalloc1(n, resid));
+  if (vecs) PetscCall(PetscMalloc1(n, vecs));
+  *nrigid = 0;
+  for (PetscInt i = 0; i < n; i++) {
+    PetscScalar kr, ki;
+    Vec         x = NULL;
+    if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
+    x = vecs ? (*vecs)[i] : NULL;
+    PetscCall(EPSGetEigenpair(eps, i, &kr, &ki, x, NULL));
+    (*lambda)[i] = PetscRealPart(kr);
+    if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_RELATIVE, &(*resid)[i]));
+    if (PetscAbsReal((*lambda)[i]) < 1e-6 * omega * omega) (*nrigid)++;
+  }
+  *nconv = n;
+  PetscCall(EPSDestroy(&eps));
+  PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+static PetscReal Frequency(PetscReal lambda, const PhlexUnits *u)
+{
+  const PetscReal f = PetscSqrtReal(PetscAbsReal(lambda)) / (2.0 * PETSC_PI * u->time);
+  return lambda < 0 ? -f : f;
+}
+
+/*@C
+  PhlexSceneSolveModes - modal analysis of the scene's body: prints and writes frequencies, residuals, mode shapes
+
+  Collective
+
+  Options Database Keys:
++ -modes_nev <n>                        - elastic modes wanted (default 10)
+. -expect_frequencies f1,f2,...         - expected elastic frequencies [Hz] (self-check)
+. -expect_frequencies_rtol <r>          - relative tolerance of that check (default 1e-6)
+- -expect_residual_max <r>              - bound on the relative eigenpair residuals
+@*/
+PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
+{
+  PhlexBody        b = scene->bodies[0];
+  PetscInt         nev = 10, nconv, nrigid, nexp = 64;
+  PetscReal       *lambda, *resid, *freq, expected[64], rtol = 1e-6, rmax = -1, worst = 0;
+  Vec             *vecs;
+  PetscBool        has_exp;
+  PetscViewer      csv;
+  PhlexFieldWriter fw = NULL;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(scene->comm, NULL, "Modal analysis options", NULL);
+  PetscCall(PetscOptionsInt("-modes_nev", "Number of elastic modes wanted", "PhlexSceneSolveModes", nev, &nev, NULL));
+  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", expected, &nexp, &has_exp));
+  PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveModes", rtol, &rtol, NULL));
+  PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveModes", rmax, &rmax, NULL));
+  PetscOptionsEnd();
+  PetscCheck(nev >= 1, scene->comm, PETSC_ERR_USER_INPUT, "-modes_nev must be >= 1, got %" PetscInt_FMT, nev);
+  if (!has_exp) nexp = 0;
+
+  PetscCall(PetscLogStagePush(PHLEX_StageModes));
+  PetscCall(PhlexBodyComputeModes(b, &scene->units, nev, &nconv, &nrigid, &lambda, &vecs, &resid));
+  PetscCall(PetscLogStagePop());
+  PetscCall(PetscMalloc1(nconv, &freq));
+  for (PetscInt i = 0; i < nconv; i++) freq[i] = Frequency(lambda[i], &scene->units);
+
+  PetscCall(PetscPrintf(scene->comm, "Modes of body %s (%s): %" PetscInt_FMT " computed", b->name, b->frame_patch[0] ? "clamped" : "free", nconv));
+  if (!b->frame_patch[0]) PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " rigid-body modes", nrigid));
+  PetscCall(PetscPrintf(scene->comm, "\n  mode  frequency [Hz]       kind     rel. residual\n"));
+  for (PetscInt i = 0; i < nconv; i++) {
+    PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-7s  %.1e\n", i + 1, (double)(i < nrigid ? 0.0 : freq[i]), i < nrigid ? "rigid" : "elastic", (double)resid[i]));
+    worst = PetscMax(worst, resid[i]);
+  }
+  PetscCheck(b->frame_patch[0] || nrigid == 6, scene->comm, PETSC_ERR_NOT_CONVERGED, "body %s is free but %" PetscInt_FMT " rigid-body modes were found instead of 6", b->name, nrigid);
+
+  PetscCall(PhlexOutputCSVOpen(scene->output, "modes.csv", "mode,frequency_hz,eigenvalue_rad2_s2,relative_residual,rigid", &csv));
+  for (PetscInt i = 0; i < nconv; i++) {
+    const PetscReal lam = lambda[i] / PetscSqr(scene->units.time);
+    PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0));
+  }
+  PetscCall(PetscViewerDestroy(&csv));
+  if (scene->output->fields) {
+    char name[PHLEX_NAME_LEN + 8];
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_modes", b->name));
+    PetscCall(PhlexFieldWriterCreate(scene->output, b, name, &fw));
+    for (PetscInt i = 0; i < nconv; i++) {
+      PetscReal vmax;
+      PetscCall(VecNorm(vecs[i], NORM_INFINITY, &vmax));
+      PetscCall(PhlexFieldWriterBeginStep(fw, (PetscReal)(i + 1)));
+      PetscCall(PhlexFieldWriterVertexField(fw, "mode_shape", vecs[i], vmax > 0 ? 1.0 / vmax : 1.0, NULL, NULL));
+    }
+    PetscCall(PhlexFieldWriterDestroy(&fw));
+  }
+  PetscCall(PhlexOutputCommit(scene->output));
+
+  if (rmax > 0) PetscCall(PhlexExpectMax(scene->comm, "eigenpair residuals (max relative)", "-expect_residual_max", worst, rmax, PETSC_TRUE));
+  if (nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nconv - nrigid, freq + nrigid, nexp, expected, rtol));
+
+  for (PetscInt i = 0; i < nconv; i++) PetscCall(VecDestroy(&vecs[i]));
+  PetscCall(PetscFree(vecs));
+  PetscCall(PetscFree(lambda));
+  PetscCall(PetscFree(resid));
+  PetscCall(PetscFree(freq));
+  PetscFunctionReturn(0);
+}

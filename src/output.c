@@ -1,0 +1,470 @@
+/* Output of a run: one directory with CSV series and, per body, HDF5 fields plus an XDMF index for ParaView.
+   Every file is written under a temporary name and renamed when the run completes, so an error never leaves a
+   half-written result under a final name. */
+#include <phlex_impl.h>
+#include <petscviewerhdf5.h>
+#include <sys/stat.h>
+#include <errno.h>
+
+/*@C
+  PhlexOutputCreate - creates the output manager of a run
+@*/
+PetscErrorCode PhlexOutputCreate(MPI_Comm comm, PhlexOutput *out)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(out));
+  (*out)->comm     = comm;
+  (*out)->interval = 0;
+  (*out)->fields   = PETSC_TRUE;
+  PetscCall(PetscStrcpy((*out)->dir, "output"));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputSetFromOptions - reads the output options
+
+  Options Database Keys:
++ -output_dir <dir>        - directory of the run's results (created if missing)
+. -output_interval <n>     - write fields every n time steps (0: first and last step only)
+- -output_fields <bool>    - write HDF5/XDMF fields
+@*/
+PetscErrorCode PhlexOutputSetFromOptions(PhlexOutput out)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(out->comm, NULL, "Output options", NULL);
+  PetscCall(PetscOptionsString("-output_dir", "Directory of the run's results (created if missing)", "PhlexOutputSetFromOptions", out->dir, out->dir, sizeof(out->dir), NULL));
+  PetscCall(PetscOptionsInt("-output_interval", "Write fields every n time steps (0: first and last step only)", "PhlexOutputSetFromOptions", out->interval, &out->interval, NULL));
+  PetscCall(PetscOptionsBool("-output_fields", "Write HDF5/XDMF fields for ParaView", "PhlexOutputSetFromOptions", out->fields, &out->fields, NULL));
+  PetscOptionsEnd();
+  PetscCheck(out->interval >= 0, out->comm, PETSC_ERR_USER_INPUT, "-output_interval must be >= 0, got %" PetscInt_FMT, out->interval);
+  PetscCheck(out->dir[0], out->comm, PETSC_ERR_USER_INPUT, "-output_dir must not be empty");
+  PetscFunctionReturn(0);
+}
+
+/* mkdir -p on rank 0 */
+static PetscErrorCode MakeDirectory(MPI_Comm comm, const char dir[])
+{
+  PetscMPIInt rank;
+  int         err = 0;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    char path[PETSC_MAX_PATH_LEN];
+    PetscCall(PetscStrncpy(path, dir, sizeof(path)));
+    for (char *p = path + 1; *p && !err; p++)
+      if (*p == '/') {
+        *p = 0;
+        if (mkdir(path, 0775) && errno != EEXIST) err = errno;
+        *p = '/';
+      }
+    if (!err && mkdir(path, 0775) && errno != EEXIST) err = errno;
+  }
+  PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));
+  PetscCheck(!err, comm, PETSC_ERR_FILE_OPEN, "cannot create output directory '%s' (option -output_dir): %s", dir, strerror(err));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputFile - registers an output file and returns the temporary path to write it to
+
+  Collective
+
+  Input Parameters:
++ out  - output manager
+- name - file name inside the output directory
+
+  Output Parameter:
+. tmp - temporary path (renamed to the final name by PhlexOutputCommit)
+@*/
+PetscErrorCode PhlexOutputFile(PhlexOutput out, const char name[], char tmp[])
+{
+  PetscInt k = out->nfiles;
+
+  PetscFunctionBeginUser;
+  if (k == 0) PetscCall(MakeDirectory(out->comm, out->dir));
+  PetscCheck(k < 32, out->comm, PETSC_ERR_SUP, "too many output files");
+  PetscCall(PetscSNPrintf(out->final[k], PETSC_MAX_PATH_LEN, "%s/%s", out->dir, name));
+  PetscCall(PetscSNPrintf(out->tmp[k], PETSC_MAX_PATH_LEN, "%s/.%s.tmp", out->dir, name));
+  PetscCall(PetscStrcpy(tmp, out->tmp[k]));
+  out->nfiles++;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputCommit - renames every completed output file to its final name
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputCommit(PhlexOutput out)
+{
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
+  PetscCallMPI(MPI_Barrier(out->comm));
+  if (rank == 0)
+    for (PetscInt k = 0; k < out->nfiles; k++) PetscCheck(!rename(out->tmp[k], out->final[k]), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot rename '%s' to '%s': %s", out->tmp[k], out->final[k], strerror(errno));
+  out->nfiles = 0;
+  PetscCallMPI(MPI_Barrier(out->comm));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputAbort - removes the temporary files of an unfinished run (called on error)
+
+  Not collective: each rank removes nothing but rank 0's files; safe to call after an error
+@*/
+PetscErrorCode PhlexOutputAbort(PhlexOutput out)
+{
+  PetscMPIInt rank;
+
+  if (!out) return 0;
+  MPI_Comm_rank(out->comm, &rank);
+  if (rank == 0)
+    for (PetscInt k = 0; k < out->nfiles; k++) (void)remove(out->tmp[k]);
+  out->nfiles = 0;
+  return 0;
+}
+
+/*@C
+  PhlexOutputCSVOpen - opens a CSV series in the output directory and writes its header line
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputCSVOpen(PhlexOutput out, const char name[], const char header[], PetscViewer *viewer)
+{
+  char tmp[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexOutputFile(out, name, tmp));
+  PetscCall(PetscViewerASCIIOpen(out->comm, tmp, viewer));
+  PetscCall(PetscViewerPushFormat(*viewer, PETSC_VIEWER_ASCII_CSV));
+  PetscCall(PetscViewerASCIIPrintf(*viewer, "%s\n", header));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputDestroy - destroys the output manager
+@*/
+PetscErrorCode PhlexOutputDestroy(PhlexOutput *out)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(*out));
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Fields of one body: P1 vertex fields and cell fields on the body's mesh, one HDF5 file plus an XDMF index.    */
+
+struct _p_PhlexFieldWriter {
+  PhlexOutput out;
+  PhlexBody   body;
+  char        name[PHLEX_NAME_LEN];
+  char        h5tmp[PETSC_MAX_PATH_LEN], xmftmp[PETSC_MAX_PATH_LEN];
+  PetscViewer viewer;
+  DM          dm_vertex, dm_cell6, dm_cell1; /* P1 vector, P0 6-component, P0 scalar */
+  Vec         lv;                          /* local work vector of the body's velocity space */
+  PetscInt    nsteps, nvertex, ncells;
+  PetscReal  *times;
+  PetscInt    nvfields, ncfields;
+  char        vfields[8][PHLEX_NAME_LEN], cfields[8][PHLEX_NAME_LEN];
+  PetscInt    cfield_nc[8];
+  char        geometry_field[PHLEX_NAME_LEN];   /* vertex field holding time-dependent coordinates, or "" */
+};
+
+static PetscErrorCode CreateOutputDM(DM dm, PetscInt degree, PetscInt nc, const char name[], DM *odm)
+{
+  PetscFE      fe;
+  PetscSection s;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMClone(dm, odm));
+  PetscCall(PetscFECreateLagrange(PetscObjectComm((PetscObject)dm), 3, nc, PETSC_TRUE, degree, PETSC_DETERMINE, &fe));
+  PetscCall(PetscObjectSetName((PetscObject)fe, name));
+  PetscCall(DMSetField(*odm, 0, NULL, (PetscObject)fe));
+  PetscCall(DMCreateDS(*odm));
+  PetscCall(PetscFEDestroy(&fe));
+  PetscCall(DMGetLocalSection(*odm, &s));
+  PetscCall(PetscSectionSetFieldName(s, 0, name));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterCreate - opens <name>.h5 for a body's fields and writes its mesh
+
+  Collective
+@*/
+PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexBody body, const char name[], PhlexFieldWriter *writer)
+{
+  PhlexFieldWriter w;
+  char             file[PETSC_MAX_PATH_LEN];
+  PetscInt         vStart, vEnd, cStart, cEnd, loc[2], glob[2];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&w));
+  w->out  = out;
+  w->body = body;
+  PetscCall(PetscStrncpy(w->name, name, sizeof(w->name)));
+  PetscCall(PetscSNPrintf(file, sizeof(file), "%s.h5", name));
+  PetscCall(PhlexOutputFile(out, file, w->h5tmp));
+  PetscCall(PetscSNPrintf(file, sizeof(file), "%s.xmf", name));
+  PetscCall(PhlexOutputFile(out, file, w->xmftmp));
+  PetscCall(CreateOutputDM(body->dm, 1, 3, "vertex", &w->dm_vertex));
+  PetscCall(CreateOutputDM(body->dm, 0, 6, "cell", &w->dm_cell6));
+  PetscCall(CreateOutputDM(body->dm, 0, 1, "scalar", &w->dm_cell1));
+  PetscCall(DMCreateLocalVector(body->dm, &w->lv));
+  PetscCall(PetscViewerHDF5Open(out->comm, w->h5tmp, FILE_MODE_WRITE, &w->viewer));
+  PetscCall(PetscViewerPushFormat(w->viewer, PETSC_VIEWER_HDF5_VIZ));
+  PetscCall(DMView(body->dm, w->viewer));
+  PetscCall(PetscViewerPopFormat(w->viewer));
+  PetscCall(DMPlexGetDepthStratum(body->dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetHeightStratum(body->dm, 0, &cStart, &cEnd));
+  {
+    Vec v;
+    PetscCall(DMGetGlobalVector(w->dm_vertex, &v));
+    PetscCall(VecGetSize(v, &loc[0]));
+    PetscCall(DMRestoreGlobalVector(w->dm_vertex, &v));
+    PetscCall(DMGetGlobalVector(w->dm_cell1, &v));
+    PetscCall(VecGetSize(v, &loc[1]));
+    PetscCall(DMRestoreGlobalVector(w->dm_cell1, &v));
+  }
+  glob[0]    = loc[0] / 3;
+  glob[1]    = loc[1];
+  w->nvertex = glob[0];
+  w->ncells  = glob[1];
+  *writer    = w;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterBeginStep - starts output step k at time t [s] (or a mode number)
+@*/
+PetscErrorCode PhlexFieldWriterBeginStep(PhlexFieldWriter w, PetscReal t)
+{
+  PetscReal *times;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(w->nsteps + 1, &times));
+  if (w->nsteps) PetscCall(PetscArraycpy(times, w->times, w->nsteps));
+  times[w->nsteps] = t;
+  PetscCall(PetscFree(w->times));
+  w->times = times;
+  PetscCall(DMSetOutputSequenceNumber(w->dm_vertex, w->nsteps, t));
+  PetscCall(DMSetOutputSequenceNumber(w->dm_cell6, w->nsteps, t));
+  PetscCall(DMSetOutputSequenceNumber(w->dm_cell1, w->nsteps, t));
+  w->nsteps++;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode RegisterField(PhlexFieldWriter w, PetscBool vertex, const char name[], PetscInt nc)
+{
+  PetscBool same;
+
+  PetscFunctionBeginUser;
+  if (vertex) {
+    for (PetscInt i = 0; i < w->nvfields; i++) {
+      PetscCall(PetscStrcmp(w->vfields[i], name, &same));
+      if (same) PetscFunctionReturn(0);
+    }
+    PetscCheck(w->nvfields < 8, PETSC_COMM_SELF, PETSC_ERR_SUP, "too many vertex fields");
+    PetscCall(PetscStrcpy(w->vfields[w->nvfields++], name));
+  } else {
+    for (PetscInt i = 0; i < w->ncfields; i++) {
+      PetscCall(PetscStrcmp(w->cfields[i], name, &same));
+      if (same) PetscFunctionReturn(0);
+    }
+    PetscCheck(w->ncfields < 8, PETSC_COMM_SELF, PETSC_ERR_SUP, "too many cell fields");
+    w->cfield_nc[w->ncfields] = nc;
+    PetscCall(PetscStrcpy(w->cfields[w->ncfields++], name));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterVertexField - writes a field of the body's velocity space at the vertices (P1), scaled to SI
+
+  Collective
+
+  Input Parameters:
++ w      - the writer
+. name   - field name shown in ParaView
+. v      - global vector of the body's velocity space (non-dimensional), or NULL for zero
+. scale  - factor to SI
+. offset - optional per-vertex function adding x (SI) times offset_scale: NULL or the affine map (R, r): x -> r + R x
+- rowmajor R[9], r[3] used when offset != NULL
+@*/
+PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter w, const char name[], Vec v, PetscReal scale, const PetscReal *R, const PetscReal *r)
+{
+  Vec                out, lout;
+  PetscSection       s, so;
+  PetscInt           vStart, vEnd;
+  const PetscScalar *lv;
+  PetscScalar       *lo;
+  Vec                coords;
+  const PetscScalar *xc;
+  PetscSection       cs;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_Output, 0, 0, 0, 0));
+  PetscCall(VecSet(w->lv, 0.0));
+  if (v) {
+    PetscCall(DMGlobalToLocalBegin(w->body->dm, v, INSERT_VALUES, w->lv));
+    PetscCall(DMGlobalToLocalEnd(w->body->dm, v, INSERT_VALUES, w->lv));
+  }
+  PetscCall(DMGetLocalSection(w->body->dm, &s));
+  PetscCall(DMGetLocalSection(w->dm_vertex, &so));
+  PetscCall(DMGetLocalVector(w->dm_vertex, &lout));
+  PetscCall(DMPlexGetDepthStratum(w->body->dm, 0, &vStart, &vEnd));
+  PetscCall(VecGetArrayRead(w->lv, &lv));
+  PetscCall(VecGetArray(lout, &lo));
+  PetscCall(DMGetCoordinatesLocal(w->body->dm, &coords));
+  PetscCall(DMGetCoordinateSection(w->body->dm, &cs));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  for (PetscInt p = vStart; p < vEnd; p++) {
+    PetscInt off, oo, co;
+    PetscCall(PetscSectionGetOffset(s, p, &off));
+    PetscCall(PetscSectionGetOffset(so, p, &oo));
+    for (PetscInt c = 0; c < 3; c++) lo[oo + c] = scale * lv[off + c];
+    if (R) {
+      PetscReal x[3];
+      PetscCall(PetscSectionGetOffset(cs, p, &co));
+      for (PetscInt c = 0; c < 3; c++) x[c] = PetscRealPart(xc[co + c]) + PetscRealPart(lo[oo + c]);
+      for (PetscInt c = 0; c < 3; c++) lo[oo + c] = r[c] + R[3 * c] * x[0] + R[3 * c + 1] * x[1] + R[3 * c + 2] * x[2];
+    }
+  }
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(VecRestoreArrayRead(w->lv, &lv));
+  PetscCall(VecRestoreArray(lout, &lo));
+  PetscCall(DMGetGlobalVector(w->dm_vertex, &out));
+  PetscCall(DMLocalToGlobalBegin(w->dm_vertex, lout, INSERT_VALUES, out));
+  PetscCall(DMLocalToGlobalEnd(w->dm_vertex, lout, INSERT_VALUES, out));
+  PetscCall(PetscObjectSetName((PetscObject)out, name));
+  PetscCall(VecView(out, w->viewer));
+  PetscCall(DMRestoreGlobalVector(w->dm_vertex, &out));
+  PetscCall(DMRestoreLocalVector(w->dm_vertex, &lout));
+  PetscCall(RegisterField(w, PETSC_TRUE, name, 3));
+  PetscCall(PetscLogEventEnd(PHLEX_Output, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterStress - writes the cell averages of the stress [Pa] and their von Mises stress
+
+  Collective
+@*/
+PetscErrorCode PhlexFieldWriterStress(PhlexFieldWriter w, Vec stress, PetscReal scale)
+{
+  Vec                avg, vm;
+  PetscScalar       *a, *m;
+  const PetscScalar *s;
+  PetscSection       gs;
+  PetscInt           nbs = w->body->nb_s, rstart;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_Output, 0, 0, 0, 0));
+  PetscCall(DMGetGlobalVector(w->dm_cell6, &avg));
+  PetscCall(DMGetGlobalVector(w->dm_cell1, &vm));
+  PetscCall(DMGetGlobalSection(w->body->dm_s, &gs));
+  PetscCall(VecGetOwnershipRange(stress, &rstart, NULL));
+  PetscCall(VecGetArrayRead(stress, &s));
+  PetscCall(VecGetArray(avg, &a));
+  PetscCall(VecGetArray(vm, &m));
+  for (PetscInt c = w->body->cStart; c < w->body->cEnd; c++) {
+    PetscInt  off, i = c - w->body->cStart;
+    PetscReal sig[6] = {0, 0, 0, 0, 0, 0};
+    PetscCall(PetscSectionGetOffset(gs, c, &off));
+    /* node-major Lagrange P_{k-1} (P0 or P1 at the vertices): the mean of the nodal values is the cell average */
+    for (PetscInt j = 0; j < nbs; j++) sig[j % 6] += PetscRealPart(s[off - rstart + j]) * 6.0 / nbs * scale;
+    for (PetscInt k = 0; k < 6; k++) a[6 * i + k] = sig[k];
+    m[i] = PetscSqrtReal(0.5 * (PetscSqr(sig[0] - sig[1]) + PetscSqr(sig[1] - sig[2]) + PetscSqr(sig[2] - sig[0])) + 3.0 * (sig[3] * sig[3] + sig[4] * sig[4] + sig[5] * sig[5]));
+  }
+  PetscCall(VecRestoreArrayRead(stress, &s));
+  PetscCall(VecRestoreArray(avg, &a));
+  PetscCall(VecRestoreArray(vm, &m));
+  PetscCall(PetscObjectSetName((PetscObject)avg, "stress"));
+  PetscCall(PetscObjectSetName((PetscObject)vm, "von_mises"));
+  PetscCall(VecView(avg, w->viewer));
+  PetscCall(VecView(vm, w->viewer));
+  PetscCall(DMRestoreGlobalVector(w->dm_cell6, &avg));
+  PetscCall(DMRestoreGlobalVector(w->dm_cell1, &vm));
+  PetscCall(RegisterField(w, PETSC_FALSE, "stress", 6));
+  PetscCall(RegisterField(w, PETSC_FALSE, "von_mises", 1));
+  PetscCall(PetscLogEventEnd(PHLEX_Output, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterSetGeometryField - uses a vertex field (written each step) as the time-dependent coordinates
+@*/
+PetscErrorCode PhlexFieldWriterSetGeometryField(PhlexFieldWriter w, const char name[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(w->geometry_field, name, sizeof(w->geometry_field)));
+  PetscFunctionReturn(0);
+}
+
+/* XDMF 2 index: a temporal collection of uniform grids, each attribute a hyperslab of the (step, entity, comp) datasets */
+static PetscErrorCode WriteXDMF(PhlexFieldWriter w)
+{
+  FILE       *fp;
+  PetscMPIInt rank;
+  char        h5name[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(w->out->comm, &rank));
+  if (rank) PetscFunctionReturn(0);
+  PetscCall(PetscSNPrintf(h5name, sizeof(h5name), "%s.h5", w->name));
+  fp = fopen(w->xmftmp, "w");
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write '%s'", w->xmftmp);
+  fprintf(fp, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"2.0\">\n <Domain>\n");
+  fprintf(fp, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", w->name);
+  for (PetscInt k = 0; k < w->nsteps; k++) {
+    fprintf(fp, "   <Grid Name=\"%s_%d\" GridType=\"Uniform\">\n    <Time Value=\"%.12g\"/>\n", w->name, (int)k, (double)w->times[k]);
+    fprintf(fp, "    <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%d\">\n     <DataItem Dimensions=\"%d 4\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n    </Topology>\n", (int)w->ncells, (int)w->ncells, h5name);
+    if (w->geometry_field[0]) {
+      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d 3\" Type=\"HyperSlab\">\n", (int)w->nvertex);
+      fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d 3</DataItem>\n", (int)k, (int)w->nvertex);
+      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Geometry>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->geometry_field);
+    } else {
+      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n    </Geometry>\n", (int)w->nvertex, h5name);
+    }
+    for (PetscInt f = 0; f < w->nvfields; f++) {
+      fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d 3\" Type=\"HyperSlab\">\n", w->vfields[f], (int)w->nvertex);
+      fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d 3</DataItem>\n", (int)k, (int)w->nvertex);
+      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->vfields[f]);
+    }
+    for (PetscInt f = 0; f < w->ncfields; f++) {
+      const PetscInt nc = w->cfield_nc[f];
+      fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Cell\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d %d\" Type=\"HyperSlab\">\n", w->cfields[f], nc == 1 ? "Scalar" : "Matrix", (int)w->ncells, (int)nc);
+      fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d %d</DataItem>\n", (int)k, (int)w->ncells, (int)nc);
+      fprintf(fp, "      <DataItem Dimensions=\"%d %d %d\" Format=\"HDF\">%s:/cell_fields/%s_%s</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->ncells, (int)nc, h5name, w->cfields[f], nc == 1 ? "scalar" : "cell");
+    }
+    fprintf(fp, "   </Grid>\n");
+  }
+  fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");
+  PetscCheck(!fclose(fp), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write '%s'", w->xmftmp);
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterDestroy - closes the HDF5 file and writes the XDMF index (both renamed by PhlexOutputCommit)
+
+  Collective
+@*/
+PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *writer)
+{
+  PhlexFieldWriter w = *writer;
+
+  PetscFunctionBeginUser;
+  if (!w) PetscFunctionReturn(0);
+  PetscCall(PetscViewerDestroy(&w->viewer));
+  PetscCall(WriteXDMF(w));
+  PetscCall(DMDestroy(&w->dm_vertex));
+  PetscCall(DMDestroy(&w->dm_cell6));
+  PetscCall(DMDestroy(&w->dm_cell1));
+  PetscCall(VecDestroy(&w->lv));
+  PetscCall(PetscFree(w->times));
+  PetscCall(PetscFree(*writer));
+  PetscFunctionReturn(0);
+}
