@@ -126,6 +126,7 @@ struct _p_PhlexBody {
   PetscInt           ngroups;
   PhlexPhysicalGroup *groups;
   PetscInt           degree;                          /* velocity P_k, stress P_{k-1} discontinuous */
+  PetscInt           extra_refinements;               /* uniform refinements on top of -dm_refine (convergence studies) */
   char               frame_patch[PHLEX_NAME_LEN];     /* Dirichlet patch Gamma_D ("" for a free body) */
   PetscInt           frame_tag;
   PetscReal          frame_area, frame_centroid[3], frame_inertia[9]; /* SI geometry of the frame patch */
@@ -216,6 +217,7 @@ PETSC_INTERN PetscErrorCode PhlexMeshFindGroup(PhlexBody, const char[], PetscInt
 PETSC_INTERN PetscErrorCode PhlexMeshCheckGeometry(PhlexBody, const PhlexUnits *);
 
 /* body.c */
+PETSC_INTERN PetscErrorCode PhlexBodySetUpMixed(PhlexBody, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexBodyGetBasis(PhlexBody, PetscBool, PhlexElementBasis *);
 PETSC_INTERN PetscErrorCode PhlexBodyRestoreBasis(PhlexElementBasis *);
 PETSC_INTERN PetscErrorCode PhlexBodyEnergy(PhlexBody, Vec, Vec, PetscReal *, PetscReal *);

@@ -512,42 +512,82 @@ static PetscErrorCode SetUpCellGeometry(PhlexBody b, const PhlexUnits *u)
   PetscFunctionReturn(0);
 }
 
-/* Element loop assembling Mv, K, G, Ms and the body-force vectors (non-dimensional, once). */
-static PetscErrorCode AssembleOperators(PhlexBody b, const PhlexUnits *u)
+/* Element loop assembling the velocity operators Mv, K and the body-force vectors (non-dimensional, once). */
+static PetscErrorCode AssembleVelocityOperators(PhlexBody b, const PhlexUnits *u)
 {
   const PhlexElementReferenceIntegrals *R = &b->ref;
-  const PetscInt                        nv = b->nb_v, ns = b->nb_s, nn = nv / 3;
-  PetscReal                            *Me, *Ge, *Mse, *Ke, *work, fe[PHLEX_MAX_NODES], A[36];
-  PetscInt                              perm[3 * PHLEX_MAX_NODES], sidx[3 * PHLEX_MAX_NODES];
+  const PetscInt                        nv = b->nb_v, nn = nv / 3;
+  PetscReal                            *Me, *Ke, fe[PHLEX_MAX_NODES];
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BodyAssemble, 0, 0, 0, 0));
   PetscCall(CreateVelocityMatrix(b, &b->Mv));
   PetscCall(CreateVelocityMatrix(b, &b->K));
-  PetscCall(CreateCouplingMatrix(b, &b->G));
-  PetscCall(MatCreateBAIJ(b->comm, ns, b->ns_local, b->ns_local, b->ns_global, b->ns_global, 1, NULL, 0, NULL, &b->Ms));
-  PetscCall(MatSetOption(b->Ms, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   for (PetscInt c = 0; c < 3; c++) {
     PetscCall(DMCreateGlobalVector(b->dm, &b->fvol[c]));
     PetscCall(VecSet(b->fvol[c], 0.0));
   }
-  PetscCall(PetscMalloc5(nv * nv, &Me, ns * nv, &Ge, ns * ns, &Mse, nv * nv, &Ke, ns * nv, &work));
+  PetscCall(PetscMalloc2(nv * nv, &Me, nv * nv, &Ke));
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
     const PetscReal     *g   = &b->cell_geom[10 * c];
     const PhlexMaterial *mat = &b->materials[b->cell_material[c]];
     const PetscInt      *idx = &b->cell_vdofs[c * nv];
-    const PetscReal      E = mat->youngs_modulus / u->modulus, nu = mat->poissons_ratio;
-    PetscInt             rows[6 * 4], nodes[PHLEX_MAX_NODES], brow = b->cell_soff[c] / ns;
+    PetscInt             nodes[PHLEX_MAX_NODES];
 
     PhlexElementMass(R, mat->density / u->density, g[0], Me);
-    PhlexElementStiffness(R, E, nu, g[0], &g[1], Ke);
-    PhlexElementCoupling(R, g[0], &g[1], work, Ge);
-    PhlexElementCompliance(E, nu, A);
-    PhlexElementComplianceMass(R, g[0], A, Mse);
+    PhlexElementStiffness(R, mat->youngs_modulus / u->modulus, mat->poissons_ratio, g[0], &g[1], Ke);
     PhlexElementLoad(R, g[0], fe);
     CellNodeIndices(b, c, nodes);
     PetscCall(MatSetValuesBlocked(b->Mv, nn, nodes, nn, nodes, Me, ADD_VALUES));
     PetscCall(MatSetValuesBlocked(b->K, nn, nodes, nn, nodes, Ke, ADD_VALUES));
+    for (PetscInt a = 0; a < nv; a++)
+      if (idx[a] >= 0) PetscCall(VecSetValue(b->fvol[a % 3], idx[a], fe[a / 3], ADD_VALUES));
+  }
+  PetscCall(PetscFree2(Me, Ke));
+  PetscCall(MatAssemblyBegin(b->Mv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(b->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(b->Mv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(b->K, MAT_FINAL_ASSEMBLY));
+  for (PetscInt c = 0; c < 3; c++) {
+    PetscCall(VecAssemblyBegin(b->fvol[c]));
+    PetscCall(VecAssemblyEnd(b->fvol[c]));
+  }
+  PetscCall(MatSetOption(b->Mv, MAT_SPD, PETSC_TRUE));
+  PetscCall(PetscObjectSetName((PetscObject)b->Mv, "velocity mass"));
+  PetscCall(PetscObjectSetName((PetscObject)b->K, "stiffness"));
+  PetscCall(PetscLogEventEnd(PHLEX_BodyAssemble, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexBodySetUpMixed - assembles the stress operators (compliance mass Ms, coupling G) needed by the time
+  integration of the mixed system; modal analyses use the condensed velocity operators only and skip them
+
+  Collective
+@*/
+PetscErrorCode PhlexBodySetUpMixed(PhlexBody b, const PhlexUnits *u)
+{
+  const PhlexElementReferenceIntegrals *R = &b->ref;
+  const PetscInt                        nv = b->nb_v, ns = b->nb_s;
+  PetscReal                            *Ge, *Mse, *work, A[36];
+  PetscInt                              perm[3 * PHLEX_MAX_NODES], sidx[3 * PHLEX_MAX_NODES];
+
+  PetscFunctionBeginUser;
+  if (b->G) PetscFunctionReturn(0);
+  PetscCall(PetscLogEventBegin(PHLEX_BodyAssemble, 0, 0, 0, 0));
+  PetscCall(CreateCouplingMatrix(b, &b->G));
+  PetscCall(MatCreateBAIJ(b->comm, ns, b->ns_local, b->ns_local, b->ns_global, b->ns_global, 1, NULL, 0, NULL, &b->Ms));
+  PetscCall(MatSetOption(b->Ms, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(PetscMalloc3(ns * nv, &Ge, ns * ns, &Mse, ns * nv, &work));
+  for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
+    const PetscReal     *g   = &b->cell_geom[10 * c];
+    const PhlexMaterial *mat = &b->materials[b->cell_material[c]];
+    const PetscInt      *idx = &b->cell_vdofs[c * nv];
+    PetscInt             rows[6 * 4], brow = b->cell_soff[c] / ns;
+
+    PhlexElementCoupling(R, g[0], &g[1], work, Ge);
+    PhlexElementCompliance(mat->youngs_modulus / u->modulus, mat->poissons_ratio, A);
+    PhlexElementComplianceMass(R, g[0], A, Mse);
     /* G rows belong to this cell only: inserting sorted columns appends to empty rows */
     for (PetscInt a = 0; a < nv; a++) {
       perm[a] = a;
@@ -560,25 +600,12 @@ static PetscErrorCode AssembleOperators(PhlexBody b, const PhlexUnits *u)
     }
     PetscCall(MatSetValues(b->G, ns, rows, nv, sidx, work, INSERT_VALUES));
     PetscCall(MatSetValuesBlocked(b->Ms, 1, &brow, 1, &brow, Mse, INSERT_VALUES));
-    for (PetscInt a = 0; a < nv; a++)
-      if (idx[a] >= 0) PetscCall(VecSetValue(b->fvol[a % 3], idx[a], fe[a / 3], ADD_VALUES));
   }
-  PetscCall(PetscFree5(Me, Ge, Mse, Ke, work));
-  PetscCall(MatAssemblyBegin(b->Mv, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyBegin(b->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscFree3(Ge, Mse, work));
   PetscCall(MatAssemblyBegin(b->G, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyBegin(b->Ms, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(b->Mv, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(b->K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(b->G, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(b->Ms, MAT_FINAL_ASSEMBLY));
-  for (PetscInt c = 0; c < 3; c++) {
-    PetscCall(VecAssemblyBegin(b->fvol[c]));
-    PetscCall(VecAssemblyEnd(b->fvol[c]));
-  }
-  PetscCall(MatSetOption(b->Mv, MAT_SPD, PETSC_TRUE));
-  PetscCall(PetscObjectSetName((PetscObject)b->Mv, "velocity mass"));
-  PetscCall(PetscObjectSetName((PetscObject)b->K, "stiffness"));
   PetscCall(PetscObjectSetName((PetscObject)b->G, "coupling"));
   PetscCall(PetscObjectSetName((PetscObject)b->Ms, "compliance mass"));
   PetscCall(PetscLogEventEnd(PHLEX_BodyAssemble, 0, 0, 0, 0));
@@ -650,7 +677,7 @@ PetscErrorCode PhlexBodySetUp(PhlexBody b, const PhlexUnits *units)
     PetscCall(PhlexBodyRestoreBasis(&V));
     PetscCall(PhlexBodyRestoreBasis(&S));
   }
-  PetscCall(AssembleOperators(b, units));
+  PetscCall(AssembleVelocityOperators(b, units));
   PetscCall(CheckCondensation(b, units));
   for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexPortSetUp(b, &b->ports[p], units));
   PetscCall(PetscLogEventEnd(PHLEX_BodySetUp, 0, 0, 0, 0));

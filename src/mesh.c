@@ -301,6 +301,13 @@ PetscErrorCode PhlexMeshLoad(PhlexBody body)
     }
   }
   PetscCall(DMSetFromOptions(dm)); /* -<prefix>dm_refine, -<prefix>dm_plex_check_all, ... */
+  /* extra uniform refinements requested by a convergence study */
+  for (PetscInt r = 0; r < body->extra_refinements; r++) {
+    DM rdm;
+    PetscCall(DMRefine(dm, body->comm, &rdm));
+    PetscCall(DMDestroy(&dm));
+    dm = rdm;
+  }
   PetscCall(DMViewFromOptions(dm, NULL, "-dm_view"));
   body->dm = dm;
   PetscFunctionReturn(0);

@@ -106,6 +106,63 @@ static PetscReal Frequency(PetscReal lambda, const PhlexUnits *u)
   return lambda < 0 ? -f : f;
 }
 
+/* -modes_convergence_refinements n: the elastic frequencies of the scene's body on n further uniform refinements
+   of its mesh, the observed order of the eigenvalues p = log2((l0 - l1)/(l1 - l2)) over the last three levels
+   (expected 2k for P_k) and the Richardson-extrapolated frequencies. */
+static PetscErrorCode ConvergenceStudy(PhlexScene scene, PetscInt nlevels, PetscInt nmodes, const PetscReal *lambda0, PetscInt nrigid0)
+{
+  PhlexBody  b = scene->bodies[0];
+  PetscReal *lam, order_expect = -1, order_tol = 0.25, worst = 0;
+  PetscInt   worst_mode = -1;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(scene->comm, NULL, "Convergence study options", NULL);
+  PetscCall(PetscOptionsReal("-expect_convergence_order", "Self-check: expected observed order of the eigenvalues", "PhlexSceneSolveModes", order_expect, &order_expect, NULL));
+  PetscCall(PetscOptionsReal("-expect_convergence_order_tol", "Tolerance of that check (absolute, on the order)", "PhlexSceneSolveModes", order_tol, &order_tol, NULL));
+  PetscOptionsEnd();
+  PetscCall(PetscCalloc1((nlevels + 1) * nmodes, &lam));
+  for (PetscInt m = 0; m < nmodes; m++) lam[m] = lambda0[nrigid0 + m];
+  for (PetscInt l = 1; l <= nlevels; l++) {
+    PhlexBody  r;
+    PetscInt   nconv, nrigid;
+    PetscReal *lr;
+    PetscCall(PhlexBodyCreate(scene->comm, b->index, &r));
+    PetscCall(PhlexBodySetFromOptions(r));
+    r->extra_refinements = l;
+    PetscCall(PhlexBodySetUp(r, &scene->units));
+    PetscCall(PhlexBodyComputeModes(r, &scene->units, nmodes, &nconv, &nrigid, &lr, NULL, NULL));
+    PetscCheck(nconv - nrigid >= nmodes, scene->comm, PETSC_ERR_NOT_CONVERGED, "convergence study: only %" PetscInt_FMT " modes on refinement level %" PetscInt_FMT, nconv - nrigid, l);
+    for (PetscInt m = 0; m < nmodes; m++) lam[l * nmodes + m] = lr[nrigid + m];
+    PetscCall(PetscFree(lr));
+    PetscCall(PhlexBodyDestroy(&r));
+  }
+  PetscCall(PetscPrintf(scene->comm, "Convergence under uniform refinement (P%" PetscInt_FMT " velocity; eigenvalue order expected %" PetscInt_FMT "):\n  mode", b->degree, 2 * b->degree));
+  for (PetscInt l = 0; l <= nlevels; l++) PetscCall(PetscPrintf(scene->comm, "   level %" PetscInt_FMT " [Hz]", l));
+  PetscCall(PetscPrintf(scene->comm, "   order   extrapolated [Hz]\n"));
+  for (PetscInt m = 0; m < nmodes; m++) {
+    PetscReal order = 0, ext;
+    PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT, m + 1));
+    for (PetscInt l = 0; l <= nlevels; l++) PetscCall(PetscPrintf(scene->comm, "  %13.8g", (double)Frequency(lam[l * nmodes + m], &scene->units)));
+    if (nlevels >= 2) {
+      const PetscReal l0 = lam[(nlevels - 2) * nmodes + m], l1 = lam[(nlevels - 1) * nmodes + m], l2 = lam[nlevels * nmodes + m];
+      order = PetscLog2Real((l0 - l1) / (l1 - l2));
+      ext   = l2 - (l1 - l2) / (PetscPowReal(2.0, order) - 1.0);
+      PetscCall(PetscPrintf(scene->comm, "  %6.2f  %13.8g\n", (double)order, (double)Frequency(ext, &scene->units)));
+      if (PetscAbsReal(order - order_expect) > worst) {
+        worst      = PetscAbsReal(order - order_expect);
+        worst_mode = m;
+      }
+    } else PetscCall(PetscPrintf(scene->comm, "\n"));
+  }
+  if (order_expect > 0) {
+    PetscCheck(nlevels >= 2, scene->comm, PETSC_ERR_USER_INPUT, "-expect_convergence_order needs -modes_convergence_refinements >= 2");
+    PetscCheck(worst <= order_tol, scene->comm, PETSC_ERR_USER, "convergence order: FAIL: mode %" PetscInt_FMT " has observed order differing from %g by %.3g > %g (-expect_convergence_order_tol)", worst_mode + 1, (double)order_expect, (double)worst, (double)order_tol);
+    PetscCall(PetscPrintf(scene->comm, "convergence order: PASS (%" PetscInt_FMT " modes within %g of %g)\n", nmodes, (double)order_tol, (double)order_expect));
+  }
+  PetscCall(PetscFree(lam));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSceneSolveModes - modal analysis of the scene's body: prints and writes frequencies, residuals, mode shapes
 
@@ -113,6 +170,8 @@ static PetscReal Frequency(PetscReal lambda, const PhlexUnits *u)
 
   Options Database Keys:
 + -modes_nev <n>                        - elastic modes wanted (default 10)
+. -modes_convergence_refinements <n>    - also solve on n uniform refinements and report the observed order
+. -expect_convergence_order <p>         - self-check of that order (with -expect_convergence_order_tol)
 . -expect_frequencies f1,f2,...         - expected elastic frequencies [Hz] (self-check)
 . -expect_frequencies_rtol <r>          - relative tolerance of that check (default 1e-6)
 - -expect_residual_max <r>              - bound on the relative eigenpair residuals
@@ -120,7 +179,7 @@ static PetscReal Frequency(PetscReal lambda, const PhlexUnits *u)
 PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
 {
   PhlexBody        b = scene->bodies[0];
-  PetscInt         nev = 10, nconv, nrigid, nexp = 64;
+  PetscInt         nev = 10, nconv, nrigid, nexp = 64, nrefine = 0;
   PetscReal       *lambda, *resid, *freq, expected[64], rtol = 1e-6, rmax = -1, worst = 0;
   Vec             *vecs;
   PetscBool        has_exp;
@@ -133,6 +192,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", expected, &nexp, &has_exp));
   PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveModes", rtol, &rtol, NULL));
   PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveModes", rmax, &rmax, NULL));
+  PetscCall(PetscOptionsInt("-modes_convergence_refinements", "Also solve on this many uniform refinements and report the observed order", "PhlexSceneSolveModes", nrefine, &nrefine, NULL));
   PetscOptionsEnd();
   PetscCheck(nev >= 1, scene->comm, PETSC_ERR_USER_INPUT, "-modes_nev must be >= 1, got %" PetscInt_FMT, nev);
   if (!has_exp) nexp = 0;
@@ -172,6 +232,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   }
   PetscCall(PhlexOutputCommit(scene->output));
 
+  if (nrefine > 0) PetscCall(ConvergenceStudy(scene, nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid));
   if (rmax > 0) PetscCall(PhlexExpectMax(scene->comm, "eigenpair residuals (max relative)", "-expect_residual_max", worst, rmax, PETSC_TRUE));
   if (nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nconv - nrigid, freq + nrigid, nexp, expected, rtol));
 

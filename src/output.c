@@ -212,6 +212,12 @@ PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexBody body, const cha
   PetscCall(PhlexOutputFile(out, file, w->xmftmp));
   PetscCall(CreateOutputDM(body->dm, 1, 3, "vertex", &w->dm_vertex));
   PetscCall(CreateOutputDM(body->dm, 0, 6, "cell", &w->dm_cell6));
+  {
+    PetscSection     cs;
+    const char *const names[] = {"xx", "yy", "zz", "xy", "yz", "xz"};
+    PetscCall(DMGetLocalSection(w->dm_cell6, &cs));
+    for (PetscInt c = 0; c < 6; c++) PetscCall(PetscSectionSetComponentName(cs, 0, c, names[c]));
+  }
   PetscCall(CreateOutputDM(body->dm, 0, 1, "scalar", &w->dm_cell1));
   PetscCall(DMCreateLocalVector(body->dm, &w->lv));
   PetscCall(PetscViewerHDF5Open(out->comm, w->h5tmp, FILE_MODE_WRITE, &w->viewer));
@@ -376,7 +382,13 @@ PetscErrorCode PhlexFieldWriterStress(PhlexFieldWriter w, Vec stress, PetscReal 
     PetscCall(PetscSectionGetOffset(gs, c, &off));
     /* node-major Lagrange P_{k-1} (P0 or P1 at the vertices): the mean of the nodal values is the cell average */
     for (PetscInt j = 0; j < nbs; j++) sig[j % 6] += PetscRealPart(s[off - rstart + j]) * 6.0 / nbs * scale;
-    for (PetscInt k = 0; k < 6; k++) a[6 * i + k] = sig[k];
+    /* stored in ParaView's order of 6-component arrays, XX YY ZZ XY YZ XZ */
+    a[6 * i + 0] = sig[PHLEX_S_XX];
+    a[6 * i + 1] = sig[PHLEX_S_YY];
+    a[6 * i + 2] = sig[PHLEX_S_ZZ];
+    a[6 * i + 3] = sig[PHLEX_S_XY];
+    a[6 * i + 4] = sig[PHLEX_S_YZ];
+    a[6 * i + 5] = sig[PHLEX_S_XZ];
     m[i] = PetscSqrtReal(0.5 * (PetscSqr(sig[0] - sig[1]) + PetscSqr(sig[1] - sig[2]) + PetscSqr(sig[2] - sig[0])) + 3.0 * (sig[3] * sig[3] + sig[4] * sig[4] + sig[5] * sig[5]));
   }
   PetscCall(VecRestoreArrayRead(stress, &s));
@@ -404,7 +416,8 @@ PetscErrorCode PhlexFieldWriterSetGeometryField(PhlexFieldWriter w, const char n
   PetscFunctionReturn(0);
 }
 
-/* XDMF 2 index: a temporal collection of uniform grids, each attribute a hyperslab of the (step, entity, comp) datasets */
+/* XDMF 2 index: a temporal collection of uniform grids, each attribute a hyperslab of the (step, entity, comp) datasets.
+   Read by ParaView's "XDMF Reader" (the Xdmf3 readers drop hyperslab attributes). Precision 8: XDMF defaults to float32. */
 static PetscErrorCode WriteXDMF(PhlexFieldWriter w)
 {
   FILE       *fp;
@@ -425,20 +438,26 @@ static PetscErrorCode WriteXDMF(PhlexFieldWriter w)
     if (w->geometry_field[0]) {
       fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d 3\" Type=\"HyperSlab\">\n", (int)w->nvertex);
       fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d 3</DataItem>\n", (int)k, (int)w->nvertex);
-      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Geometry>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->geometry_field);
+      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Geometry>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->geometry_field);
     } else {
-      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n    </Geometry>\n", (int)w->nvertex, h5name);
+      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n    </Geometry>\n", (int)w->nvertex, h5name);
     }
     for (PetscInt f = 0; f < w->nvfields; f++) {
       fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d 3\" Type=\"HyperSlab\">\n", w->vfields[f], (int)w->nvertex);
       fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d 3</DataItem>\n", (int)k, (int)w->nvertex);
-      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->vfields[f]);
+      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->vfields[f]);
     }
     for (PetscInt f = 0; f < w->ncfields; f++) {
       const PetscInt nc = w->cfield_nc[f];
-      fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Cell\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d %d\" Type=\"HyperSlab\">\n", w->cfields[f], nc == 1 ? "Scalar" : "Matrix", (int)w->ncells, (int)nc);
-      fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d %d</DataItem>\n", (int)k, (int)w->ncells, (int)nc);
-      fprintf(fp, "      <DataItem Dimensions=\"%d %d %d\" Format=\"HDF\">%s:/cell_fields/%s_%s</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->ncells, (int)nc, h5name, w->cfields[f], nc == 1 ? "scalar" : "cell");
+      if (nc == 1) { /* PETSc stores one-component cell fields as (step, cell) */
+        fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d\" Type=\"HyperSlab\">\n", w->cfields[f], (int)w->ncells);
+        fprintf(fp, "      <DataItem Dimensions=\"3 2\" Format=\"XML\">%d 0 1 1 1 %d</DataItem>\n", (int)k, (int)w->ncells);
+        fprintf(fp, "      <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s_scalar</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->ncells, h5name, w->cfields[f]);
+      } else {
+        fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"Matrix\" Center=\"Cell\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d %d\" Type=\"HyperSlab\">\n", w->cfields[f], (int)w->ncells, (int)nc);
+        fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d %d</DataItem>\n", (int)k, (int)w->ncells, (int)nc);
+        fprintf(fp, "      <DataItem Dimensions=\"%d %d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s_cell</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->ncells, (int)nc, h5name, w->cfields[f]);
+      }
     }
     fprintf(fp, "   </Grid>\n");
   }
