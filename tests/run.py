@@ -623,10 +623,13 @@ def run_process(cmd: List[str], env: Dict[str, str], timeout: float,
 
 
 def test_env() -> Dict[str, str]:
-    """The environment for test processes: ours plus OpenMPI settings."""
+    """The environment for test processes: ours plus OpenMPI settings.
+
+    OMPI_MCA_ess_singleton_isolated: a process started without mpiexec does not spawn an
+    orted (which costs seconds on some machines, e.g. a fresh chroot)."""
     env = dict(os.environ)
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1")
+               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_ess_singleton_isolated="1")
     return env
 
 
