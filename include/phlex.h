@@ -46,6 +46,7 @@ PETSC_EXTERN PetscErrorCode PhlexProfileCreate(MPI_Comm, const char[], const cha
 PETSC_EXTERN PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile);
 PETSC_EXTERN PetscErrorCode PhlexProfileEvaluate(PhlexProfile, PetscReal, PetscReal *);
 PETSC_EXTERN PetscErrorCode PhlexProfileView(PhlexProfile, PetscViewer);
+PETSC_EXTERN PetscErrorCode PhlexProfileDescribe(PhlexProfile, char[], size_t);
 PETSC_EXTERN PetscErrorCode PhlexProfileDestroy(PhlexProfile *);
 
 /* scene.c */

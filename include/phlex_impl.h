@@ -6,6 +6,7 @@
 
 #define PHLEX_NAME_LEN 64
 #define PHLEX_MAX_PORTS 16
+#define PHLEX_MAX_BORDER 32 /* PC phlexbordered: largest border and basis */
 #define PHLEX_MAX_MATERIALS 16
 
 /* Stress components (Voigt order) of the 6-component stress field; shear components hold the tensor entry. */
@@ -16,6 +17,7 @@ typedef enum {
   PHLEX_FIELD_DISPLACEMENT,
   PHLEX_FIELD_STRESS,
   PHLEX_FIELD_VELOCITY,
+  PHLEX_FIELD_RIGID, /* floating bodies only: r, R, v_P, w_P */
   PHLEX_NUM_FIELDS
 } PhlexField;
 PETSC_EXTERN const char *const PhlexFieldNames[];
@@ -97,6 +99,20 @@ struct _p_PhlexPort {
   PhlexProfile profile;
 };
 
+/* Inertia invariants of a floating body about its frame origin P (non-dimensional). */
+typedef struct {
+  PetscReal m, s0[3], E0[9]; /* int rho, int rho x, int rho x x^T */
+  PetscReal vol, svol[3];    /* int 1, int x */
+} PhlexInertia;
+
+/* A floating body evaluated at a state and its rates (floating.c); all non-dimensional, body frame. */
+typedef struct {
+  PetscReal r[3], R[9], vP[3], w[3], rd[3], Rd[9], vPd[3], wd[3];
+  PetscReal m, s[3], sd[3], sgrav[3], Vf[3], Vfd[3], E[9], Ed[9], J[9], Jd[9], L[3], Ld[3];
+  PetscReal pt[3], pr[3], ptd[3], prd[3], gbody[3], Fext[3], Mext[3];
+  Vec       Mu, Mvv, Mud, Mvd, bext; /* Mv u, Mv v, Mv u', Mv v', elastic load */
+} PhlexFloatingState;
+
 /* Initial condition of a field. */
 typedef enum {
   PHLEX_IC_ZERO,
@@ -138,6 +154,20 @@ struct _p_PhlexBody {
   PhlexProfile       body_force_profile;
   PetscBool          has_body_force;
   PhlexIC            ic_velocity, ic_displacement, ic_stress;
+
+  /* floating frame (issue: floating body) */
+  PetscBool          floating;                        /* rigid motion of the frame is an unknown */
+  PetscBool          frozen_inertia;                  /* inertia terms at u_f = 0 */
+  PetscReal          origin[3];                       /* frame origin P (SI mesh coordinates): frame-patch centroid */
+  PetscReal          position0[3], rotation0[9];      /* initial r_P [m] and R */
+  PetscBool          position_given;
+  PetscReal          velocity0[3], omega0[3];         /* initial v_P [m/s], w_P [rad/s] (body frame) */
+  PetscReal          frame_force[3], frame_moment[3]; /* wrench at P [N, N m] (body frame) */
+  PhlexProfile       frame_profile;
+  PetscBool          frame_loaded;
+  PetscReal          gravity[3];                      /* non-dimensional, inertial frame */
+  PhlexInertia       inertia;
+  Vec                tnode, wnode, vnode;             /* per node: int rho phi, int rho x phi, int phi (triples) */
 
   /* discretisation */
   DM       dm;       /* DMPlex with the velocity field (P_k vector, essential BC on the frame patch) */
@@ -184,31 +214,72 @@ struct _p_PhlexScene {
   PhlexBody        *bodies;
   PhlexUnits        units;
   PetscReal         scale_length, scale_density, scale_modulus; /* user overrides (0: automatic) */
+  PetscReal         gravity[3];                                 /* m/s^2, inertial frame */
   PhlexOutput       output;
   PetscBool         setup;
 };
 
 /* The discrete system of a scene for time integration (system.c): unknowns [displacement | stress | velocity]
-   (non-dimensional), residual F(t, X, X') and Jacobian dF/dX + shift dF/dX' as a MATNEST of the body operators. */
+   (+ [rigid] for a floating body), non-dimensional, residual F(t, X, X') and Jacobian dF/dX + shift dF/dX' as a
+   MATNEST of the body operators. */
 typedef struct {
-  PhlexScene  scene;
-  PhlexBody   body;
-  DM          dm;                      /* layout DMShell */
-  IS          is[PHLEX_NUM_FIELDS];    /* field index sets */
-  Mat         J;                       /* MATNEST Jacobian (Amat and Pmat) */
-  Mat         Jaij;                    /* the same assembled as AIJ (-phlex_jacobian_aij) */
-  PetscBool   use_aij;
-  Mat         Juu, Juv, Jss, Jsv, Jvs, Jvv, Gt;
-  Mat         Mv, K;                   /* the body's velocity mass and stiffness as AIJ (the nest and the assembled splits need rows) */
-  Mat         Sv;                      /* shift Mv + K/shift: exactly condensed velocity operator */
-  Mat         Ssv;                     /* [[-shift Ms, G], [G^T, shift Mv]] assembled */
-  PetscReal   shift;                   /* non-dimensional shift of the assembled operators (0: none yet) */
-  Vec         load;                    /* work: load vector in the velocity space */
+  PhlexScene         scene;
+  PhlexBody          body;
+  DM                 dm;                      /* layout DMShell */
+  PetscInt           nfields;                 /* 3 (fixed body) or 4 (floating) */
+  PetscInt           qlocal;                  /* rigid unknowns on this rank: 18 on rank 0 of a floating body */
+  PetscBool          floating;
+  IS                 is[PHLEX_NUM_FIELDS];    /* field index sets */
+  Mat                J;                       /* MATNEST Jacobian (Amat and Pmat) */
+  Mat                Jaij;                    /* the same assembled as AIJ (-phlex_jacobian_aij) */
+  PetscBool          use_aij;
+  Mat                Juu, Juv, Jss, Jsv, Jvs, Jvv, Jvu, Gt;
+  Mat                Mv, K;                   /* the body's velocity mass and stiffness as AIJ */
+  Mat                Sv;                      /* shift Mv + K/shift: condensed velocity operator */
+  Mat                Ssv;                     /* [[-shift Ms, G], [G^T, shift Mv]] assembled (fixed body) */
+  Mat                Bc, Cu, Cv, Cpre, Arr;   /* floating: dense borders and rigid block */
+  Mat                CuT, CvT, CpreT;         /* their virtual transposes (rigid rows) */
+  Mat                Pvq;                     /* floating: preconditioner of the {velocity, rigid} split */
+  Mat                W;                       /* floating: basis of the state-independent borders (n x 12) */
+  PetscReal          Bvv[9], Bvu[9];          /* floating: node-wise blocks applied after Mv */
+  PhlexFloatingState fs;                      /* floating: last evaluated state */
+  Vec                ud, vd;                  /* work: non-dimensional rates */
+  PetscReal          shift;                   /* non-dimensional shift of the assembled operators (0: none yet) */
+  Vec                load;                    /* work: load vector in the velocity space */
 } PhlexSystem;
 PETSC_INTERN PetscErrorCode PhlexSystemCreate(PhlexScene, PhlexSystem **);
 PETSC_INTERN PetscErrorCode PhlexSystemIFunction(TS, PetscReal, Vec, Vec, Vec, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemIJacobian(TS, PetscReal, Vec, Vec, PetscReal, Mat, Mat, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemDestroy(PhlexSystem **);
+PETSC_INTERN PetscErrorCode PhlexSystemGetRigid(PhlexSystem *, Vec, PetscReal[18]);
+PETSC_INTERN PetscErrorCode PhlexSystemEvaluateFloating(PhlexSystem *, PetscReal, Vec, Vec);
+
+/* pcbordered.c */
+PETSC_INTERN PetscErrorCode PhlexPCRegister(void);
+
+/* rigid.c */
+PETSC_INTERN void      PhlexCross(const PetscReal[3], const PetscReal[3], PetscReal[3]);
+PETSC_INTERN PetscReal PhlexDot3(const PetscReal[3], const PetscReal[3]);
+PETSC_INTERN void      PhlexSkew(const PetscReal[3], PetscReal[9]);
+PETSC_INTERN void      PhlexMatVec3(const PetscReal[9], const PetscReal[3], PetscReal[3]);
+PETSC_INTERN void      PhlexMatTVec3(const PetscReal[9], const PetscReal[3], PetscReal[3]);
+PETSC_INTERN void      PhlexMatMat3(const PetscReal[9], const PetscReal[9], PetscReal[9]);
+PETSC_INTERN PetscReal PhlexOrthogonalityError(const PetscReal[9]);
+PETSC_INTERN void      PhlexOrthonormalize(PetscReal[9]);
+PETSC_INTERN void      PhlexRotationToQuaternion(const PetscReal[9], PetscReal[4]);
+PETSC_INTERN void      PhlexQuaternionToRotation(const PetscReal[4], PetscReal[9]);
+PETSC_INTERN void      PhlexAxisAngleToRotation(const PetscReal[3], PetscReal, PetscReal[9]);
+
+/* floating.c */
+PETSC_INTERN PetscErrorCode PhlexBodySetUpFloating(PhlexBody, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexFloatingEvaluate(PhlexBody, const PhlexUnits *, PetscReal, Vec, Vec, Vec, Vec, const PetscReal[18], const PetscReal[18], PhlexFloatingState *);
+PETSC_INTERN PetscErrorCode PhlexFloatingInputs(PhlexBody, const PhlexUnits *, PetscReal, Vec, PhlexFloatingState *);
+PETSC_INTERN PetscErrorCode PhlexFloatingResidual(PhlexBody, PhlexFloatingState *, Vec, Vec, Vec, Vec, PetscReal[18]);
+PETSC_INTERN PetscErrorCode PhlexFloatingJacobian(PhlexBody, PhlexFloatingState *, PetscReal, Vec, Vec, PetscScalar *, PetscScalar *, PetscScalar *, PetscInt, PetscReal[9], PetscReal[9], PetscReal[324]);
+PETSC_INTERN PetscErrorCode PhlexFloatingPortOutputs(PhlexBody, const PhlexUnits *, const PetscReal[3], const PetscReal[3], Vec, Vec, Vec, PetscReal[][6]);
+PETSC_INTERN PetscErrorCode PhlexFloatingEnergy(PhlexBody, PhlexFloatingState *, Vec, PetscReal *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFloatingMomenta(PhlexFloatingState *, PetscReal[3], PetscReal[3]);
+PETSC_INTERN PetscErrorCode PhlexFloatingStateDestroy(PhlexFloatingState *);
 
 /* mesh.c */
 PETSC_INTERN PetscErrorCode PhlexMeshReadPhysicalNames(MPI_Comm, const char[], const char[], PetscInt *, PhlexPhysicalGroup **);
@@ -246,13 +317,14 @@ PETSC_INTERN PetscErrorCode PhlexOutputAbort(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputDestroy(PhlexOutput *);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterCreate(PhlexOutput, PhlexBody, const char[], PhlexFieldWriter *);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterBeginStep(PhlexFieldWriter, PetscReal);
-PETSC_INTERN PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter, const char[], Vec, PetscReal, const PetscReal *, const PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter, const char[], Vec, PetscReal, const PetscReal *, const PetscReal *, PetscBool);
+PETSC_INTERN PetscErrorCode PhlexFieldWriterVertexMax(PhlexFieldWriter, Vec, PetscReal, const PetscReal *, const PetscReal *, PetscBool, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterStress(PhlexFieldWriter, Vec, PetscReal);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterSetGeometryField(PhlexFieldWriter, const char[]);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *);
 
 /* modes.c */
-PETSC_INTERN PetscErrorCode PhlexBodyComputeModes(PhlexBody, const PhlexUnits *, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **);
+PETSC_INTERN PetscErrorCode PhlexBodyComputeModes(PhlexBody, const PhlexUnits *, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
 
 /* expect.c: self-verification */
 PETSC_INTERN PetscErrorCode PhlexExpectMax(MPI_Comm, const char[], const char[], PetscReal, PetscReal, PetscBool);

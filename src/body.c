@@ -3,6 +3,8 @@
 #include <phlex_impl.h>
 
 const char *const PhlexICTypes[] = {"zero", "uniform", "rigid", "beam", "mode", "PhlexICType", "PHLEX_IC_", NULL};
+static const char *const PhlexMotionTypes[]  = {"fixed", "floating", "PhlexMotion", "PHLEX_MOTION_", NULL};
+static const char *const PhlexInertiaTypes[] = {"full", "frozen", "PhlexInertia", "PHLEX_INERTIA_", NULL};
 
 /*@C
   PhlexBodyCreate - creates body number index (options prefix "body<index>_")
@@ -25,6 +27,7 @@ PetscErrorCode PhlexBodyCreate(MPI_Comm comm, PetscInt index, PhlexBody *body)
   b->ic_displacement.amplitude = 1.0;
   b->ic_stress.amplitude       = 1.0;
   b->ic_velocity.mode = b->ic_displacement.mode = b->ic_stress.mode = 1;
+  b->rotation0[0] = b->rotation0[4] = b->rotation0[8] = 1.0;
   *body                        = b;
   PetscFunctionReturn(0);
 }
@@ -122,7 +125,61 @@ PetscErrorCode PhlexBodySetFromOptions(PhlexBody b)
   n = 3;
   PetscCall(PetscOptionsRealArray("-body_force", "Uniform body force density (body frame) [N/m^3]", "PhlexBodySetFromOptions", b->body_force, &n, &b->has_body_force));
   PetscCheck(!b->has_body_force || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sbody_force needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+  {
+    PetscInt  motion = b->floating ? 1 : 0, inertia = b->frozen_inertia ? 1 : 0;
+    PetscReal quat[4] = {1, 0, 0, 0}, aa[4] = {1, 0, 0, 0};
+    PetscBool fq = PETSC_FALSE, fa = PETSC_FALSE, fp = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE, fv = PETSC_FALSE, fw = PETSC_FALSE;
+    PetscCall(PetscOptionsEList("-motion", "Rigid motion of the body frame: fixed (clamped patch held) or floating (the frame moves)", "PhlexBodySetFromOptions", PhlexMotionTypes, 2, PhlexMotionTypes[motion], &motion, NULL));
+    PetscCall(PetscOptionsEList("-inertia", "Floating body: inertia with x + u_f (full) or at u_f = 0 (frozen, quadratic Hamiltonian)", "PhlexBodySetFromOptions", PhlexInertiaTypes, 2, PhlexInertiaTypes[inertia], &inertia, NULL));
+    b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
+    b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
+    n                 = 3;
+    PetscCall(PetscOptionsRealArray("-position", "Floating body: initial position r_P of the frame origin (default: the frame-patch centroid, i.e. the mesh as drawn) [m]", "PhlexBodySetFromOptions", b->position0, &n, &fp));
+    PetscCheck(!fp || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sposition needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    b->position_given = fp;
+    n                 = 4;
+    PetscCall(PetscOptionsRealArray("-orientation_quaternion", "Floating body: initial orientation R as a quaternion w,x,y,z [-]", "PhlexBodySetFromOptions", quat, &n, &fq));
+    PetscCheck(!fq || n == 4, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sorientation_quaternion needs 4 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    n = 4;
+    PetscCall(PetscOptionsRealArray("-orientation_axis_angle", "Floating body: initial orientation R as axis x,y,z and angle [deg]", "PhlexBodySetFromOptions", aa, &n, &fa));
+    PetscCheck(!fa || n == 4, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sorientation_axis_angle needs 4 numbers (axis, angle in degrees), got %" PetscInt_FMT, b->name, b->prefix, n);
+    PetscCheck(!(fq && fa), b->comm, PETSC_ERR_USER_INPUT, "body %s: give -%sorientation_quaternion or -%sorientation_axis_angle, not both", b->name, b->prefix, b->prefix);
+    if (fq) {
+      PetscCheck(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3] > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sorientation_quaternion must not be zero", b->name, b->prefix);
+      PhlexQuaternionToRotation(quat, b->rotation0);
+    }
+    if (fa) {
+      PetscCheck(aa[0] * aa[0] + aa[1] * aa[1] + aa[2] * aa[2] > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: the axis of -%sorientation_axis_angle must not be zero", b->name, b->prefix);
+      PhlexAxisAngleToRotation(aa, aa[3] * PETSC_PI / 180.0, b->rotation0);
+    }
+    n = 3;
+    PetscCall(PetscOptionsRealArray("-velocity", "Floating body: initial velocity v_P of the frame origin (body frame) [m/s]", "PhlexBodySetFromOptions", b->velocity0, &n, &fv));
+    PetscCheck(!fv || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%svelocity needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    n = 3;
+    PetscCall(PetscOptionsRealArray("-angular_velocity", "Floating body: initial angular velocity w_P (body frame) [rad/s]", "PhlexBodySetFromOptions", b->omega0, &n, &fw));
+    PetscCheck(!fw || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sangular_velocity needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    n = 3;
+    PetscCall(PetscOptionsRealArray("-frame_force", "Floating body: force on the frame origin (body frame) [N]", "PhlexBodySetFromOptions", b->frame_force, &n, &ff));
+    PetscCheck(!ff || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sframe_force needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    n = 3;
+    PetscCall(PetscOptionsRealArray("-frame_moment", "Floating body: moment about the frame origin (body frame) [N m]", "PhlexBodySetFromOptions", b->frame_moment, &n, &fm));
+    PetscCheck(!fm || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sframe_moment needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    b->frame_loaded = (ff || fm) ? PETSC_TRUE : PETSC_FALSE;
+    /* a fixed body has no rigid state: its rigid options would be silently ignored */
+    if (!b->floating) {
+      const char *given = fp ? "position" : fq ? "orientation_quaternion" : fa ? "orientation_axis_angle" : fv ? "velocity" : fw ? "angular_velocity" : ff ? "frame_force" : fm ? "frame_moment" : NULL;
+      PetscCheck(!given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%s%s describes the rigid motion of a floating frame; the body is fixed (-%smotion fixed): add -%smotion floating or remove the option", b->name, b->prefix, given, b->prefix, b->prefix);
+    }
+  }
   PetscOptionsEnd();
+  if (b->floating) PetscCheck(b->frame_patch[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: a floating body needs a frame patch (-%sframe_patch <surface>): it fixes the body frame and its centroid is the frame origin", b->name, b->prefix);
+  if (b->frame_loaded) {
+    char prefix[256], what[256];
+    PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sframe_", b->prefix));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s, frame wrench", b->name));
+    PetscCall(PhlexProfileCreate(b->comm, prefix, what, &b->frame_profile));
+    PetscCall(PhlexProfileSetFromOptions(b->frame_profile));
+  }
 
   PetscCheck(flg_mesh && b->mesh_file[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: no mesh: set -%sdm_plex_filename <file.msh>", b->name, b->prefix);
   PetscCheck(b->degree == 1 || b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%spetscspace_degree must be 1 or 2, got %" PetscInt_FMT, b->name, b->prefix, b->degree);
@@ -679,6 +736,13 @@ PetscErrorCode PhlexBodySetUp(PhlexBody b, const PhlexUnits *units)
   }
   PetscCall(AssembleVelocityOperators(b, units));
   PetscCall(CheckCondensation(b, units));
+  if (b->floating) {
+    for (PetscInt d = 0; d < 3; d++) {
+      b->origin[d] = b->frame_centroid[d];
+      if (!b->position_given) b->position0[d] = b->origin[d];
+    }
+    PetscCall(PhlexBodySetUpFloating(b, units));
+  }
   for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexPortSetUp(b, &b->ports[p], units));
   PetscCall(PetscLogEventEnd(PHLEX_BodySetUp, 0, 0, 0, 0));
   PetscFunctionReturn(0);
@@ -764,7 +828,17 @@ PetscErrorCode PhlexBodyView(PhlexBody b, PetscViewer viewer)
   PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: mesh %s, %" PetscInt_FMT " tetrahedra, velocity P%" PetscInt_FMT " (%" PetscInt_FMT " dofs), stress P%" PetscInt_FMT " discontinuous (%" PetscInt_FMT " dofs)\n", b->name, b->mesh_file, gcells, b->degree, b->nv_global, b->degree - 1, b->ns_global));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PetscViewerASCIIPrintf(viewer, "volume %.6g m^3, mass %.6g kg, centre of mass (%.6g, %.6g, %.6g) m\n", (double)b->volume, (double)b->mass, (double)b->center_of_mass[0], (double)b->center_of_mass[1], (double)b->center_of_mass[2]));
-  if (b->frame_patch[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "clamped patch (frame patch): %s\n", b->frame_patch));
+  if (b->floating) {
+    PetscReal q[4];
+    PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on patch %s (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", b->frame_patch, (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
+    PhlexRotationToQuaternion(b->rotation0, q);
+    PetscCall(PetscViewerASCIIPrintf(viewer, "initial r_P (%.6g, %.6g, %.6g) m, orientation quaternion (%.6g, %.6g, %.6g, %.6g), v_P (%.6g, %.6g, %.6g) m/s, w_P (%.6g, %.6g, %.6g) rad/s (body frame)\n", (double)b->position0[0], (double)b->position0[1], (double)b->position0[2], (double)q[0], (double)q[1], (double)q[2], (double)q[3], (double)b->velocity0[0], (double)b->velocity0[1], (double)b->velocity0[2], (double)b->omega0[0], (double)b->omega0[1], (double)b->omega0[2]));
+    if (b->frame_loaded) {
+      char prof[256];
+      PetscCall(PhlexProfileDescribe(b->frame_profile, prof, sizeof(prof)));
+      PetscCall(PetscViewerASCIIPrintf(viewer, "frame wrench at P: force (%g, %g, %g) N, moment (%g, %g, %g) N m (body frame), profile %s\n", (double)b->frame_force[0], (double)b->frame_force[1], (double)b->frame_force[2], (double)b->frame_moment[0], (double)b->frame_moment[1], (double)b->frame_moment[2], prof));
+    }
+  } else if (b->frame_patch[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "clamped patch (frame patch): %s\n", b->frame_patch));
   else PetscCall(PetscViewerASCIIPrintf(viewer, "no clamped patch: free body\n"));
   for (PetscInt m = 0; m < b->nmaterials; m++) {
     const PhlexMaterial *mat = &b->materials[m];
@@ -772,14 +846,13 @@ PetscErrorCode PhlexBodyView(PhlexBody b, PetscViewer viewer)
   }
   for (PetscInt p = 0; p < b->nports; p++) {
     const PhlexPort port = &b->ports[p];
-    PetscCall(PetscViewerASCIIPrintf(viewer, "port %s: area %.6g m^2, centroid (%.6g, %.6g, %.6g) m", port->name, (double)port->area, (double)port->centroid[0], (double)port->centroid[1], (double)port->centroid[2]));
+    char            load[512] = "";
     if (port->loaded) {
-      PetscCall(PetscViewerASCIIPrintf(viewer, ", force (%g, %g, %g) N, moment (%g, %g, %g) N m, profile ", (double)port->force[0], (double)port->force[1], (double)port->force[2], (double)port->moment[0], (double)port->moment[1], (double)port->moment[2]));
-      PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_FALSE));
-      PetscCall(PhlexProfileView(port->profile, viewer));
-      PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_TRUE));
+      char prof[256];
+      PetscCall(PhlexProfileDescribe(port->profile, prof, sizeof(prof)));
+      PetscCall(PetscSNPrintf(load, sizeof(load), ", force (%g, %g, %g) N, moment (%g, %g, %g) N m, profile %s", (double)port->force[0], (double)port->force[1], (double)port->force[2], (double)port->moment[0], (double)port->moment[1], (double)port->moment[2], prof));
     }
-    PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "port %s: area %.6g m^2, centroid (%.6g, %.6g, %.6g) m%s\n", port->name, (double)port->area, (double)port->centroid[0], (double)port->centroid[1], (double)port->centroid[2], load));
   }
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscFunctionReturn(0);
@@ -796,6 +869,10 @@ PetscErrorCode PhlexBodyDestroy(PhlexBody *body)
   if (!b) PetscFunctionReturn(0);
   for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexPortDestroy(&b->ports[p]));
   PetscCall(PhlexProfileDestroy(&b->body_force_profile));
+  PetscCall(PhlexProfileDestroy(&b->frame_profile));
+  PetscCall(VecDestroy(&b->tnode));
+  PetscCall(VecDestroy(&b->wnode));
+  PetscCall(VecDestroy(&b->vnode));
   PetscCall(MatDestroy(&b->Mv));
   PetscCall(MatDestroy(&b->K));
   PetscCall(MatDestroy(&b->G));

@@ -1,5 +1,5 @@
-/* Error reporting: input errors raised by phlex itself are printed as one clear line (which file, option, body and
-   value); any other error keeps PETSc's full traceback. */
+/* Error reporting: input errors raised by phlex itself, and PETSc's errors of kind "user input" (option values),
+   are printed as one clear line (which file, option, body and value); any other error keeps PETSc's full traceback. */
 #include <phlex_impl.h>
 
 static PetscBool phlex_traceback = PETSC_FALSE;
@@ -32,7 +32,9 @@ static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun
     phlex_short      = PETSC_FALSE;
     /* collective checks raise the same error on every rank: print it once */
     if (comm != MPI_COMM_NULL) MPI_Comm_rank(comm, &rank);
-    if (ours && IsInputError(n) && !phlex_traceback) {
+    /* PETSc's own option parsing (an unknown value of a list option, a malformed number) is input too */
+    const PetscBool options = (file && (strstr(file, "sys/objects/options.c") || strstr(file, "sys/objects/aoptions.c"))) ? PETSC_TRUE : PETSC_FALSE;
+    if ((ours || options) && IsInputError(n) && !phlex_traceback) {
       phlex_short = PETSC_TRUE;
       if (rank == 0) {
         fprintf(stderr, "phlex: error: %s\n", mess ? mess : "(no message)");

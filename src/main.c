@@ -38,10 +38,13 @@ int main(int argc, char **argv)
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(PhlexErrorHandlerPush());
   PetscCall(PhlexLogRegister());
+  PetscCall(PhlexPCRegister());
   ierr = Run(&scene);
   if (ierr) {
     /* no half-written result: remove the run's temporary files; an input error was printed by the handler */
     if (scene) (void)PhlexOutputAbort(scene->output);
+    /* the options a failed run did not reach are not misspelt: no -options_left report */
+    (void)PetscOptionsSetValue(NULL, "-options_left", "0");
     MPI_Comm_size(PETSC_COMM_WORLD, &size);
     if (size > 1) MPI_Abort(PETSC_COMM_WORLD, (int)ierr);
     (void)PhlexSceneDestroy(&scene);

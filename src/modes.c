@@ -17,6 +17,91 @@ static PetscReal FrequencyScale(PhlexBody b, const PhlexUnits *u)
   return 22.373 * t / (PetscSqrtReal(12.0) * L * L) * c * u->time;
 }
 
+/* The pencil of a floating body linearised at rest (paper: the mass operator of eq. momenta at u_f = 0, w = 0):
+   unknowns [v | v_P, w_P] (the six rigid ones on rank 0),
+     A = [[K, 0], [0, 0]],   B = [[Mv, Bm], [Bm^T, M6]],   M6 = [[m I, -[s0]x], [[s0]x, J0]],
+   Bm = [t e_c | e_a x w] (nodal t = int rho phi, w = int rho x phi): the kinetic energy of v_P + w x x + v. The
+   rigid unknowns make six zero eigenvalues; the others are the free-free modes with the frame patch moving
+   rigidly. Assembled as AIJ (six dense rows and columns) so that any shift and factorisation apply. */
+static PetscErrorCode FloatingPencil(PhlexBody b, Mat *A, Mat *B, IS is[2])
+{
+  MPI_Comm           comm = b->comm;
+  PetscMPIInt        rank;
+  PetscInt           n = b->nv_local, q, ld;
+  Mat                blocks[4], Kaij, Maij, Bm, BmT, M6, Z6, N;
+  const PetscScalar *ta, *wa;
+  PetscScalar       *ba;
+  const PhlexInertia *in = &b->inertia;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  q = rank == 0 ? 6 : 0;
+  PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &Kaij));
+  PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &Maij));
+  PetscCall(MatCreateDense(comm, n, q, PETSC_DETERMINE, 6, NULL, &Bm));
+  PetscCall(MatDenseGetLDA(Bm, &ld));
+  PetscCall(MatDenseGetArrayWrite(Bm, &ba));
+  PetscCall(VecGetArrayRead(b->tnode, &ta));
+  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  for (PetscInt l = 0; l < n / 3; l++) {
+    const PetscReal *w = (const PetscReal *)&wa[3 * l]; /* real build */
+    for (PetscInt c = 0; c < 3; c++) {
+      for (PetscInt j = 0; j < 3; j++) ba[j * ld + 3 * l + c] = c == j ? ta[3 * l + c] : 0.0;
+      /* (e_a x w)_c */
+      ba[3 * ld + 3 * l + c] = c == 0 ? 0.0 : (c == 1 ? -w[2] : w[1]);
+      ba[4 * ld + 3 * l + c] = c == 0 ? w[2] : (c == 1 ? 0.0 : -w[0]);
+      ba[5 * ld + 3 * l + c] = c == 0 ? -w[1] : (c == 1 ? w[0] : 0.0);
+    }
+  }
+  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(MatDenseRestoreArrayWrite(Bm, &ba));
+  PetscCall(MatAssemblyBegin(Bm, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Bm, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatTranspose(Bm, MAT_INITIAL_MATRIX, &BmT));
+  PetscCall(MatCreateAIJ(comm, q, q, 6, 6, 6, NULL, 0, NULL, &M6));
+  PetscCall(MatCreateAIJ(comm, q, q, 6, 6, 0, NULL, 0, NULL, &Z6));
+  if (rank == 0) {
+    PetscReal m6[36], S[9], J[9];
+    PetscInt  idx[6] = {0, 1, 2, 3, 4, 5};
+    const PetscReal tr = in->E0[0] + in->E0[4] + in->E0[8];
+    PhlexSkew(in->s0, S);
+    for (PetscInt k = 0; k < 9; k++) J[k] = (k % 4 == 0 ? tr : 0.0) - in->E0[k];
+    for (PetscInt i = 0; i < 3; i++)
+      for (PetscInt j = 0; j < 3; j++) {
+        m6[6 * i + j]           = i == j ? in->m : 0.0;
+        m6[6 * i + 3 + j]       = -S[3 * i + j];
+        m6[6 * (3 + i) + j]     = S[3 * i + j];
+        m6[6 * (3 + i) + 3 + j] = J[3 * i + j];
+      }
+    PetscCall(MatSetValues(M6, 6, idx, 6, idx, m6, INSERT_VALUES));
+  }
+  PetscCall(MatAssemblyBegin(M6, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(M6, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(Z6, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Z6, MAT_FINAL_ASSEMBLY));
+  blocks[0] = Kaij, blocks[1] = NULL, blocks[2] = NULL, blocks[3] = Z6;
+  PetscCall(MatCreateNest(comm, 2, NULL, 2, NULL, blocks, &N));
+  PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, A));
+  PetscCall(MatNestGetISs(N, is, NULL));
+  PetscCall(PetscObjectReference((PetscObject)is[0]));
+  PetscCall(PetscObjectReference((PetscObject)is[1]));
+  PetscCall(MatDestroy(&N));
+  blocks[0] = Maij, blocks[1] = Bm, blocks[2] = BmT, blocks[3] = M6;
+  PetscCall(MatCreateNest(comm, 2, NULL, 2, NULL, blocks, &N));
+  PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, B));
+  PetscCall(MatDestroy(&N));
+  PetscCall(MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(*B, MAT_SPD, PETSC_TRUE));
+  PetscCall(MatDestroy(&Kaij));
+  PetscCall(MatDestroy(&Maij));
+  PetscCall(MatDestroy(&Bm));
+  PetscCall(MatDestroy(&BmT));
+  PetscCall(MatDestroy(&M6));
+  PetscCall(MatDestroy(&Z6));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexBodyComputeModes - lowest eigenpairs of K x = lambda Mv x of a body (non-dimensional lambda = omega^2)
 
@@ -31,23 +116,32 @@ static PetscReal FrequencyScale(PhlexBody b, const PhlexUnits *u)
 + nconv  - number of eigenpairs returned
 . nrigid - how many of them are rigid-body modes (|lambda| below 1e-6 of the elastic frequency scale squared)
 . lambda - eigenvalues (ascending)
-. vecs   - eigenvectors (Mv-normalised), may be NULL
-- resid  - relative residual norms ||K x - lambda Mv x|| / (|lambda| ||x||), may be NULL
+. vecs   - eigenvectors (Mv-normalised; the elastic part of a floating body's), may be NULL
+. rigid  - floating body: the rigid part (v_P, w_P) of each eigenvector, 6 per mode, on every rank; may be NULL
+- resid  - relative residual norms ||K x - lambda Mv x|| / (|lambda| ||x||) (rigid modes: the backward error
+           ||K x - lambda Mv x|| / ((||K|| + |lambda| ||Mv||) ||x||)), may be NULL
+
+  Notes:
+  A floating body is solved on the pencil of its linearisation at rest (FloatingPencil): six rigid modes, then the
+  free-free modes.
 
   Options Database Keys:
 + -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)
 . -modes_target_frequency <Hz>    - look for modes nearest this frequency (default: lowest)
 - -modes_eps_*, -modes_st_*       - any SLEPc EPS/ST option; defaults: Krylov-Schur, shift-and-invert, Cholesky (MUMPS)
 @*/
-PetscErrorCode PhlexBodyComputeModes(PhlexBody b, const PhlexUnits *units, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **resid)
+PetscErrorCode PhlexBodyComputeModes(PhlexBody b, const PhlexUnits *units, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
 {
   EPS       eps;
   ST        st;
   KSP       ksp;
   PC        pc;
   PetscReal omega = FrequencyScale(b, units), sigma, ftarget = -1;
-  PetscBool free_body = b->frame_patch[0] ? PETSC_FALSE : PETSC_TRUE, flg;
+  PetscBool free_body = (!b->frame_patch[0] || b->floating) ? PETSC_TRUE : PETSC_FALSE, flg;
   PetscInt  n, want;
+  Mat       A = b->K, B = b->Mv;
+  IS        is[2] = {NULL, NULL};
+  Vec       x = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
@@ -61,7 +155,8 @@ PetscErrorCode PhlexBodyComputeModes(PhlexBody b, const PhlexUnits *units, Petsc
   }
   PetscCall(EPSCreate(b->comm, &eps));
   PetscCall(EPSSetOptionsPrefix(eps, "modes_"));
-  PetscCall(EPSSetOperators(eps, b->K, b->Mv));
+  if (b->floating) PetscCall(FloatingPencil(b, &A, &B, is));
+  PetscCall(EPSSetOperators(eps, A, B));
   PetscCall(EPSSetProblemType(eps, EPS_GHEP));
   PetscCall(EPSSetType(eps, EPSKRYLOVSCHUR));
   PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
@@ -83,16 +178,45 @@ PetscErrorCode PhlexBodyComputeModes(PhlexBody b, const PhlexUnits *units, Petsc
   PetscCall(PetscMalloc1(n, lambda));
   if (resid) PetscCall(PetscMalloc1(n, resid));
   if (vecs) PetscCall(PetscMalloc1(n, vecs));
+  if (rigid) PetscCall(PetscCalloc1(6 * n, rigid));
+  PetscCall(MatCreateVecs(A, &x, NULL));
   *nrigid = 0;
   for (PetscInt i = 0; i < n; i++) {
     PetscScalar kr, ki;
-    Vec         x = NULL;
-    if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
-    x = vecs ? (*vecs)[i] : NULL;
     PetscCall(EPSGetEigenpair(eps, i, &kr, &ki, x, NULL));
     (*lambda)[i] = PetscRealPart(kr);
-    if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_RELATIVE, &(*resid)[i]));
-    if (PetscAbsReal((*lambda)[i]) < 1e-6 * omega * omega) (*nrigid)++;
+    if (PetscAbsReal((*lambda)[i]) < 1e-6 * omega * omega) {
+      (*nrigid)++;
+      /* lambda ~ 0: the relative residual divides by |lambda|; report the backward error instead */
+      if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_BACKWARD, &(*resid)[i]));
+    } else if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_RELATIVE, &(*resid)[i]));
+    if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
+    if (!b->floating) {
+      if (vecs) PetscCall(VecCopy(x, (*vecs)[i]));
+    } else {
+      Vec                xv, xq;
+      const PetscScalar *qa;
+      PetscReal          q6[6] = {0, 0, 0, 0, 0, 0};
+      PetscInt           nq;
+      PetscCall(VecGetSubVector(x, is[0], &xv));
+      if (vecs) PetscCall(VecCopy(xv, (*vecs)[i]));
+      PetscCall(VecRestoreSubVector(x, is[0], &xv));
+      PetscCall(VecGetSubVector(x, is[1], &xq));
+      PetscCall(VecGetLocalSize(xq, &nq));
+      PetscCall(VecGetArrayRead(xq, &qa));
+      for (PetscInt k = 0; k < nq; k++) q6[k] = PetscRealPart(qa[k]);
+      PetscCall(VecRestoreArrayRead(xq, &qa));
+      PetscCall(VecRestoreSubVector(x, is[1], &xq));
+      PetscCallMPI(MPI_Bcast(q6, 6, MPIU_REAL, 0, b->comm));
+      if (rigid) PetscCall(PetscArraycpy(&(*rigid)[6 * i], q6, 6));
+    }
+  }
+  PetscCall(VecDestroy(&x));
+  if (b->floating) {
+    PetscCall(MatDestroy(&A));
+    PetscCall(MatDestroy(&B));
+    PetscCall(ISDestroy(&is[0]));
+    PetscCall(ISDestroy(&is[1]));
   }
   *nconv = n;
   PetscCall(EPSDestroy(&eps));
@@ -130,7 +254,7 @@ static PetscErrorCode ConvergenceStudy(PhlexScene scene, PetscInt nlevels, Petsc
     PetscCall(PhlexBodySetFromOptions(r));
     r->extra_refinements = l;
     PetscCall(PhlexBodySetUp(r, &scene->units));
-    PetscCall(PhlexBodyComputeModes(r, &scene->units, nmodes, &nconv, &nrigid, &lr, NULL, NULL));
+    PetscCall(PhlexBodyComputeModes(r, &scene->units, nmodes, &nconv, &nrigid, &lr, NULL, NULL, NULL));
     PetscCheck(nconv - nrigid >= nmodes, scene->comm, PETSC_ERR_NOT_CONVERGED, "convergence study: only %" PetscInt_FMT " modes on refinement level %" PetscInt_FMT, nconv - nrigid, l);
     for (PetscInt m = 0; m < nmodes; m++) lam[l * nmodes + m] = lr[nrigid + m];
     PetscCall(PetscFree(lr));
@@ -180,7 +304,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
 {
   PhlexBody        b = scene->bodies[0];
   PetscInt         nev = 10, nconv, nrigid, nexp = 64, nrefine = 0;
-  PetscReal       *lambda, *resid, *freq, expected[64], rtol = 1e-6, rmax = -1, worst = 0;
+  PetscReal       *lambda, *resid, *freq, *rigid, expected[64], rtol = 1e-6, rmax = -1, worst = 0;
   Vec             *vecs;
   PetscBool        has_exp;
   PetscViewer      csv;
@@ -198,19 +322,19 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   if (!has_exp) nexp = 0;
 
   PetscCall(PetscLogStagePush(PHLEX_StageModes));
-  PetscCall(PhlexBodyComputeModes(b, &scene->units, nev, &nconv, &nrigid, &lambda, &vecs, &resid));
+  PetscCall(PhlexBodyComputeModes(b, &scene->units, nev, &nconv, &nrigid, &lambda, &vecs, &rigid, &resid));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscMalloc1(nconv, &freq));
   for (PetscInt i = 0; i < nconv; i++) freq[i] = Frequency(lambda[i], &scene->units);
 
-  PetscCall(PetscPrintf(scene->comm, "Modes of body %s (%s): %" PetscInt_FMT " computed", b->name, b->frame_patch[0] ? "clamped" : "free", nconv));
-  if (!b->frame_patch[0]) PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " rigid-body modes", nrigid));
+  PetscCall(PetscPrintf(scene->comm, "Modes of body %s (%s): %" PetscInt_FMT " computed", b->name, b->floating ? "floating" : (b->frame_patch[0] ? "clamped" : "free"), nconv));
+  if (!b->frame_patch[0] || b->floating) PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " rigid-body modes", nrigid));
   PetscCall(PetscPrintf(scene->comm, "\n  mode  frequency [Hz]       kind     rel. residual\n"));
   for (PetscInt i = 0; i < nconv; i++) {
     PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-7s  %.1e\n", i + 1, (double)(i < nrigid ? 0.0 : freq[i]), i < nrigid ? "rigid" : "elastic", (double)resid[i]));
-    worst = PetscMax(worst, resid[i]);
+    if (i >= nrigid) worst = PetscMax(worst, resid[i]); /* rigid modes: backward error, not checked */
   }
-  PetscCheck(b->frame_patch[0] || nrigid == 6, scene->comm, PETSC_ERR_NOT_CONVERGED, "body %s is free but %" PetscInt_FMT " rigid-body modes were found instead of 6", b->name, nrigid);
+  PetscCheck((b->frame_patch[0] && !b->floating) || nrigid == 6, scene->comm, PETSC_ERR_NOT_CONVERGED, "body %s is free but %" PetscInt_FMT " rigid-body modes were found instead of 6", b->name, nrigid);
 
   PetscCall(PhlexOutputCSVOpen(scene->output, "modes.csv", "mode,frequency_hz,eigenvalue_rad2_s2,relative_residual,rigid", &csv));
   for (PetscInt i = 0; i < nconv; i++) {
@@ -223,10 +347,24 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     PetscCall(PetscSNPrintf(name, sizeof(name), "%s_modes", b->name));
     PetscCall(PhlexFieldWriterCreate(scene->output, b, name, &fw));
     for (PetscInt i = 0; i < nconv; i++) {
-      PetscReal vmax;
-      PetscCall(VecNorm(vecs[i], NORM_INFINITY, &vmax));
+      PetscReal vmax, A[9] = {0}, r[3] = {0}, *Ap = NULL, *rp = NULL;
+      if (b->floating) {
+        /* the whole velocity field v_P + w x (x - P) + v: the frame patch moves rigidly */
+        const PetscReal *q = &rigid[6 * i];
+        PetscReal        wP[3];
+        PhlexSkew(&q[3], A);
+        for (PetscInt k = 0; k < 9; k++) A[k] /= scene->units.length;
+        PhlexMatVec3(A, b->origin, wP);
+        for (PetscInt k = 0; k < 3; k++) r[k] = q[k] - wP[k];
+        Ap = A, rp = r;
+      }
+      PetscCall(PhlexFieldWriterVertexMax(fw, vecs[i], 1.0, Ap, rp, PETSC_FALSE, &vmax));
+      if (vmax > 0) {
+        for (PetscInt k = 0; k < 9; k++) A[k] /= vmax;
+        for (PetscInt k = 0; k < 3; k++) r[k] /= vmax;
+      }
       PetscCall(PhlexFieldWriterBeginStep(fw, (PetscReal)(i + 1)));
-      PetscCall(PhlexFieldWriterVertexField(fw, "mode_shape", vecs[i], vmax > 0 ? 1.0 / vmax : 1.0, NULL, NULL));
+      PetscCall(PhlexFieldWriterVertexField(fw, "mode_shape", vecs[i], vmax > 0 ? 1.0 / vmax : 1.0, Ap, rp, PETSC_FALSE));
     }
     PetscCall(PhlexFieldWriterDestroy(&fw));
   }
@@ -238,6 +376,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
 
   for (PetscInt i = 0; i < nconv; i++) PetscCall(VecDestroy(&vecs[i]));
   PetscCall(PetscFree(vecs));
+  PetscCall(PetscFree(rigid));
   PetscCall(PetscFree(lambda));
   PetscCall(PetscFree(resid));
   PetscCall(PetscFree(freq));

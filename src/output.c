@@ -287,32 +287,16 @@ static PetscErrorCode RegisterField(PhlexFieldWriter w, PetscBool vertex, const 
   PetscFunctionReturn(0);
 }
 
-/*@C
-  PhlexFieldWriterVertexField - writes a field of the body's velocity space at the vertices (P1), scaled to SI
-
-  Collective
-
-  Input Parameters:
-+ w      - the writer
-. name   - field name shown in ParaView
-. v      - global vector of the body's velocity space (non-dimensional), or NULL for zero
-. scale  - factor to SI
-. offset - optional per-vertex function adding x (SI) times offset_scale: NULL or the affine map (R, r): x -> r + R x
-- rowmajor R[9], r[3] used when offset != NULL
-@*/
-PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter w, const char name[], Vec v, PetscReal scale, const PetscReal *R, const PetscReal *r)
+/* the vertex values r + A x + Q (scale v) (see PhlexFieldWriterVertexField) in a local vector of dm_vertex */
+static PetscErrorCode VertexValues(PhlexFieldWriter w, Vec v, PetscReal scale, const PetscReal *A, const PetscReal *r, PetscBool rotate, Vec lout)
 {
-  Vec                out, lout;
-  PetscSection       s, so;
+  PetscSection       s, so, cs;
   PetscInt           vStart, vEnd;
-  const PetscScalar *lv;
+  const PetscScalar *lv, *xc;
   PetscScalar       *lo;
   Vec                coords;
-  const PetscScalar *xc;
-  PetscSection       cs;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscLogEventBegin(PHLEX_Output, 0, 0, 0, 0));
   PetscCall(VecSet(w->lv, 0.0));
   if (v) {
     PetscCall(DMGlobalToLocalBegin(w->body->dm, v, INSERT_VALUES, w->lv));
@@ -320,7 +304,6 @@ PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter w, const char name[]
   }
   PetscCall(DMGetLocalSection(w->body->dm, &s));
   PetscCall(DMGetLocalSection(w->dm_vertex, &so));
-  PetscCall(DMGetLocalVector(w->dm_vertex, &lout));
   PetscCall(DMPlexGetDepthStratum(w->body->dm, 0, &vStart, &vEnd));
   PetscCall(VecGetArrayRead(w->lv, &lv));
   PetscCall(VecGetArray(lout, &lo));
@@ -332,16 +315,44 @@ PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter w, const char name[]
     PetscCall(PetscSectionGetOffset(s, p, &off));
     PetscCall(PetscSectionGetOffset(so, p, &oo));
     for (PetscInt c = 0; c < 3; c++) lo[oo + c] = scale * lv[off + c];
-    if (R) {
-      PetscReal x[3];
+    if (A) {
+      PetscReal x[3], f[3];
       PetscCall(PetscSectionGetOffset(cs, p, &co));
-      for (PetscInt c = 0; c < 3; c++) x[c] = PetscRealPart(xc[co + c]) + PetscRealPart(lo[oo + c]);
-      for (PetscInt c = 0; c < 3; c++) lo[oo + c] = r[c] + R[3 * c] * x[0] + R[3 * c + 1] * x[1] + R[3 * c + 2] * x[2];
+      for (PetscInt c = 0; c < 3; c++) {
+        f[c] = PetscRealPart(lo[oo + c]);
+        x[c] = PetscRealPart(xc[co + c]) + (rotate ? f[c] : 0.0);
+      }
+      for (PetscInt c = 0; c < 3; c++) lo[oo + c] = r[c] + A[3 * c] * x[0] + A[3 * c + 1] * x[1] + A[3 * c + 2] * x[2] + (rotate ? 0.0 : f[c]);
     }
   }
   PetscCall(VecRestoreArrayRead(coords, &xc));
   PetscCall(VecRestoreArrayRead(w->lv, &lv));
   PetscCall(VecRestoreArray(lout, &lo));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterVertexField - writes a field of the body's velocity space at the vertices (P1), scaled to SI
+
+  Collective
+
+  Input Parameters:
++ w      - the writer
+. name   - field name shown in ParaView
+. v      - global vector of the body's velocity space (non-dimensional), or NULL for zero
+. scale  - factor to SI
+. A, r   - optional affine part (SI, A row-major): the field written is r + A x + Q (scale v) with x the vertex
+           coordinates; NULL for none
+- rotate - Q = A (a placement x -> r + A (x + u)) if true, else Q = I (a rigid velocity field r + A x plus v)
+@*/
+PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter w, const char name[], Vec v, PetscReal scale, const PetscReal *A, const PetscReal *r, PetscBool rotate)
+{
+  Vec out, lout;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_Output, 0, 0, 0, 0));
+  PetscCall(DMGetLocalVector(w->dm_vertex, &lout));
+  PetscCall(VertexValues(w, v, scale, A, r, rotate, lout));
   PetscCall(DMGetGlobalVector(w->dm_vertex, &out));
   PetscCall(DMLocalToGlobalBegin(w->dm_vertex, lout, INSERT_VALUES, out));
   PetscCall(DMLocalToGlobalEnd(w->dm_vertex, lout, INSERT_VALUES, out));
@@ -351,6 +362,30 @@ PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter w, const char name[]
   PetscCall(DMRestoreLocalVector(w->dm_vertex, &lout));
   PetscCall(RegisterField(w, PETSC_TRUE, name, 3));
   PetscCall(PetscLogEventEnd(PHLEX_Output, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterVertexMax - the largest vertex magnitude of a field as PhlexFieldWriterVertexField would write it
+
+  Collective
+@*/
+PetscErrorCode PhlexFieldWriterVertexMax(PhlexFieldWriter w, Vec v, PetscReal scale, const PetscReal *A, const PetscReal *r, PetscBool rotate, PetscReal *vmax)
+{
+  Vec                lout;
+  const PetscScalar *lo;
+  PetscInt           n;
+  PetscReal          loc = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalVector(w->dm_vertex, &lout));
+  PetscCall(VertexValues(w, v, scale, A, r, rotate, lout));
+  PetscCall(VecGetLocalSize(lout, &n));
+  PetscCall(VecGetArrayRead(lout, &lo));
+  for (PetscInt i = 0; i < n / 3; i++) loc = PetscMax(loc, PetscSqrtReal(PetscSqr(PetscRealPart(lo[3 * i])) + PetscSqr(PetscRealPart(lo[3 * i + 1])) + PetscSqr(PetscRealPart(lo[3 * i + 2]))));
+  PetscCall(VecRestoreArrayRead(lout, &lo));
+  PetscCall(DMRestoreLocalVector(w->dm_vertex, &lout));
+  PetscCall(MPIU_Allreduce(&loc, vmax, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)w->dm_vertex)));
   PetscFunctionReturn(0);
 }
 

@@ -197,26 +197,43 @@ PetscErrorCode PhlexProfileEvaluate(PhlexProfile p, PetscReal t, PetscReal *f)
 }
 
 /*@C
-  PhlexProfileView - prints a one-line description of the profile
+  PhlexProfileDescribe - a one-line description of the profile, e.g. "sine 120 Hz, phase 0 rad, from t = 0 s"
 @*/
-PetscErrorCode PhlexProfileView(PhlexProfile p, PetscViewer viewer)
+PetscErrorCode PhlexProfileDescribe(PhlexProfile p, char buf[], size_t len)
 {
   PetscFunctionBeginUser;
   switch (p->type) {
   case PHLEX_PROFILE_CONSTANT:
-    PetscCall(PetscViewerASCIIPrintf(viewer, "constant from t = %g s", (double)p->start_time));
+    PetscCall(PetscSNPrintf(buf, len, "constant from t = %g s", (double)p->start_time));
     break;
   case PHLEX_PROFILE_RAMP:
-    PetscCall(PetscViewerASCIIPrintf(viewer, "ramp from t = %g s over %g s", (double)p->start_time, (double)p->ramp_time));
+    PetscCall(PetscSNPrintf(buf, len, "ramp from t = %g s over %g s", (double)p->start_time, (double)p->ramp_time));
     break;
   case PHLEX_PROFILE_SINE:
-    PetscCall(PetscViewerASCIIPrintf(viewer, "sine %g Hz, phase %g rad, from t = %g s", (double)p->frequency, (double)p->phase, (double)p->start_time));
+    PetscCall(PetscSNPrintf(buf, len, "sine %g Hz, phase %g rad, from t = %g s", (double)p->frequency, (double)p->phase, (double)p->start_time));
     break;
   case PHLEX_PROFILE_TABLE:
-    PetscCall(PetscViewerASCIIPrintf(viewer, "table of %" PetscInt_FMT " points on [%g, %g] s", p->ntable, (double)p->table_t[0], (double)p->table_t[p->ntable - 1]));
+    PetscCall(PetscSNPrintf(buf, len, "table of %" PetscInt_FMT " points on [%g, %g] s", p->ntable, (double)p->table_t[0], (double)p->table_t[p->ntable - 1]));
     break;
   }
-  if (p->scale != 1.0) PetscCall(PetscViewerASCIIPrintf(viewer, ", scaled by %g", (double)p->scale));
+  if (p->scale != 1.0) {
+    char s[64];
+    PetscCall(PetscSNPrintf(s, sizeof(s), ", scaled by %g", (double)p->scale));
+    PetscCall(PetscStrlcat(buf, s, len));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProfileView - prints the one-line description of the profile
+@*/
+PetscErrorCode PhlexProfileView(PhlexProfile p, PetscViewer viewer)
+{
+  char buf[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexProfileDescribe(p, buf, sizeof(buf)));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "%s", buf));
   PetscFunctionReturn(0);
 }
 

@@ -43,6 +43,10 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
   PetscCall(PetscOptionsReal("-scale_length", "Reference length of the non-dimensionalisation [m] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_length, &s->scale_length, NULL));
   PetscCall(PetscOptionsReal("-scale_density", "Reference density [kg/m^3] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_density, &s->scale_density, NULL));
   PetscCall(PetscOptionsReal("-scale_modulus", "Reference modulus [Pa] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_modulus, &s->scale_modulus, NULL));
+  {
+    PetscInt n = 3;
+    PetscCall(PetscOptionsRealArray("-gravity", "Gravitational acceleration (inertial frame) acting on floating bodies [m/s^2]", "PhlexSceneSetFromOptions", s->gravity, &n, NULL));
+  }
   PetscOptionsEnd();
   PetscCheck(s->nbodies == 1, s->comm, PETSC_ERR_SUP, "-num_bodies %" PetscInt_FMT ": this version simulates one body per scene", s->nbodies);
   PetscCheck(s->scale_length >= 0 && s->scale_density >= 0 && s->scale_modulus >= 0, s->comm, PETSC_ERR_USER_INPUT, "-scale_length, -scale_density and -scale_modulus must be positive (or 0 for automatic)");
@@ -96,7 +100,12 @@ PetscErrorCode PhlexSceneSetUp(PhlexScene s)
     PetscCall(PhlexMeshCheckGeometry(s->bodies[k], NULL));
   }
   PetscCall(SceneSetUnits(s));
-  for (PetscInt k = 0; k < s->nbodies; k++) PetscCall(PhlexBodySetUp(s->bodies[k], &s->units));
+  for (PetscInt k = 0; k < s->nbodies; k++) {
+    PhlexBody b = s->bodies[k];
+    for (PetscInt d = 0; d < 3; d++) b->gravity[d] = s->gravity[d] * s->units.time * s->units.time / s->units.length;
+    PetscCheck(b->floating || (s->gravity[0] == 0 && s->gravity[1] == 0 && s->gravity[2] == 0), s->comm, PETSC_ERR_USER_INPUT, "-gravity acts on floating bodies; body %s is fixed (use -%sbody_force for its weight)", b->name, b->prefix);
+    PetscCall(PhlexBodySetUp(b, &s->units));
+  }
   s->setup = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
@@ -116,6 +125,7 @@ PetscErrorCode PhlexSceneView(PhlexScene s, PetscViewer viewer)
   PetscFunctionBeginUser;
   PetscCall(PetscViewerASCIIPrintf(viewer, "phlex scene: %s analysis, %" PetscInt_FMT " body\n", PhlexAnalysisTypes[s->analysis], s->nbodies));
   PetscCall(PetscViewerASCIIPushTab(viewer));
+  if (s->gravity[0] != 0 || s->gravity[1] != 0 || s->gravity[2] != 0) PetscCall(PetscViewerASCIIPrintf(viewer, "gravity (%g, %g, %g) m/s^2 (inertial frame)\n", (double)s->gravity[0], (double)s->gravity[1], (double)s->gravity[2]));
   for (PetscInt k = 0; k < s->nbodies; k++) PetscCall(PhlexBodyView(s->bodies[k], viewer));
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscFunctionReturn(0);

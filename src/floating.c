@@ -1,0 +1,773 @@
+/* A flexible body in large rigid motion (paper Sections 2-4): the rigid-elastic coupling of the floating frame.
+
+   State (non-dimensional, body frame): the elastic fields u, v (free velocity dofs, one x,y,z triple per node),
+   Sigma, and q = [r (3) | R (9, row-wise) | v_P (3) | w (3)]. With y = x + u the position of a material point
+   relative to the frame origin P (the centroid of the frame patch), the velocity field is V = v_P + w x y + v and
+   the kinetic energy T = 1/2 int rho |V|^2 (paper eq. H). Every integral below is exact for the discrete fields:
+     t(l)  = int rho phi_l,   w(l) = int rho x phi_l,   z(l) = w(l) + (Mv u)(l) = int rho y phi_l
+     s = int rho y = s0 + sum_l t(l) u(l),  E = int rho y y^T,  J = tr(E) I - E,  L = int rho y x v
+   The momenta (paper eq. momenta) p_t = m v_P + w x s + int rho v, p_r = s x v_P + J w + L, p_f = Mv v + t v_P +
+   int rho phi (w x y), and the equations are the discrete Hamel equations of T, equivalent to the pH form of eqs.
+   ph_mfd_all / MFD_pHDAE (p~_t, p~_r and the coefficient 2 of I_pf appear when the derivative of the mass operator
+   is moved to the right-hand side):
+     p_t' + w x p_t             = F_ext + R^T m g
+     p_r' + w x p_r + v_P x p_t = M_ext + s x R^T g
+     p_f' - dT/du + G^T Sigma   = b_ext + t R^T g          (dT/du = int rho phi (V x w))
+     u' = v,  Ms Sigma' = G v,  r' = R v_P,  R' = R [w]x
+   With -body0_inertia frozen every inertia term is evaluated at u = 0 (s = s0, E = E0, z = w, dT/du = 0): the
+   Hamiltonian of T0 = 1/2 int rho |v_P + w x x + v|^2 is quadratic and its Hamel J skew, so the implicit midpoint
+   rule conserves it to solver tolerance (the elastic field then feels no centrifugal or Coriolis load). */
+#include <phlex_impl.h>
+
+/* ---------------------------------------------------------------------------------------------------------- */
+/* Inertia invariants                                                                                          */
+
+/*@C
+  PhlexBodySetUpFloating - inertia invariants of a floating body about the frame origin P (non-dimensional):
+  m, s0 = int rho x, E0 = int rho x x^T, the volume, int x dV, and the nodal vectors t, w of the elastic space
+
+  Collective
+@*/
+PetscErrorCode PhlexBodySetUpFloating(PhlexBody b, const PhlexUnits *u)
+{
+  PhlexElementBasis V;
+  PetscQuadrature   q;
+  const PetscReal  *qpoints;
+  PetscInt          nq, nn = b->nb_v / 3;
+  PetscReal         loc[1 + 3 + 9 + 1 + 3] = {0}, glob[17];
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexBodyGetBasis(b, PETSC_FALSE, &V));
+  PetscCall(PetscFEGetQuadrature(b->fe_v, &q));
+  PetscCall(PetscQuadratureGetData(q, NULL, NULL, &nq, &qpoints, NULL));
+  PetscCall(DMCreateGlobalVector(b->dm, &b->tnode));
+  PetscCall(VecDuplicate(b->tnode, &b->wnode));
+  PetscCall(VecDuplicate(b->tnode, &b->vnode));
+  PetscCall(VecSet(b->tnode, 0.0));
+  PetscCall(VecSet(b->wnode, 0.0));
+  PetscCall(VecSet(b->vnode, 0.0));
+  /* closure indices of the frame-patch dofs are negative (constrained): drop them */
+  PetscCall(VecSetOption(b->tnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
+  PetscCall(VecSetOption(b->wnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
+  PetscCall(VecSetOption(b->vnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
+  for (PetscInt c = b->cStart; c < b->cEnd; c++) {
+    const PetscInt      ci  = c - b->cStart;
+    const PhlexMaterial *mat = &b->materials[b->cell_material[ci]];
+    const PetscReal      rho = mat->density / u->density;
+    const PetscInt      *idx = &b->cell_vdofs[ci * b->nb_v];
+    PetscReal            v0[3], J[9], invJ[9], detJ, dV;
+    PetscScalar          te[3 * PHLEX_MAX_NODES], we[3 * PHLEX_MAX_NODES], ve[3 * PHLEX_MAX_NODES];
+
+    PetscCall(DMPlexComputeCellGeometryAffineFEM(b->dm, c, v0, J, invJ, &detJ));
+    for (PetscInt i = 0; i < 3 * nn; i++) te[i] = we[i] = ve[i] = 0.0;
+    for (PetscInt qq = 0; qq < nq; qq++) {
+      PetscReal x[3];
+      /* x relative to P, non-dimensional: x = v0 + J (xi + 1) */
+      for (PetscInt d = 0; d < 3; d++) x[d] = (v0[d] + J[3 * d] * (qpoints[3 * qq] + 1) + J[3 * d + 1] * (qpoints[3 * qq + 1] + 1) + J[3 * d + 2] * (qpoints[3 * qq + 2] + 1) - b->origin[d]) / u->length;
+      dV = V.weights[qq] * detJ / (u->length * u->length * u->length);
+      loc[0] += rho * dV;
+      for (PetscInt d = 0; d < 3; d++) {
+        loc[1 + d] += rho * dV * x[d];
+        loc[14 + d] += dV * x[d];
+        for (PetscInt e = 0; e < 3; e++) loc[4 + 3 * d + e] += rho * dV * x[d] * x[e];
+      }
+      loc[13] += dV;
+      for (PetscInt a = 0; a < nn; a++) {
+        const PetscReal phi = V.node_phi[qq * V.nnodes + a];
+        for (PetscInt d = 0; d < 3; d++) {
+          te[3 * a + d] += rho * dV * phi;
+          we[3 * a + d] += rho * dV * phi * x[d];
+          ve[3 * a + d] += dV * phi;
+        }
+      }
+    }
+    PetscCall(VecSetValues(b->tnode, 3 * nn, idx, te, ADD_VALUES));
+    PetscCall(VecSetValues(b->wnode, 3 * nn, idx, we, ADD_VALUES));
+    PetscCall(VecSetValues(b->vnode, 3 * nn, idx, ve, ADD_VALUES));
+  }
+  PetscCall(PhlexBodyRestoreBasis(&V));
+  PetscCall(VecAssemblyBegin(b->tnode));
+  PetscCall(VecAssemblyEnd(b->tnode));
+  PetscCall(VecAssemblyBegin(b->wnode));
+  PetscCall(VecAssemblyEnd(b->wnode));
+  PetscCall(VecAssemblyBegin(b->vnode));
+  PetscCall(VecAssemblyEnd(b->vnode));
+  PetscCall(MPIU_Allreduce(loc, glob, 17, MPIU_REAL, MPI_SUM, b->comm));
+  b->inertia.m = glob[0];
+  for (PetscInt d = 0; d < 3; d++) {
+    b->inertia.s0[d]   = glob[1 + d];
+    b->inertia.svol[d] = glob[14 + d];
+  }
+  for (PetscInt k = 0; k < 9; k++) b->inertia.E0[k] = glob[4 + k];
+  b->inertia.vol = glob[13];
+  PetscFunctionReturn(0);
+}
+
+/* ---------------------------------------------------------------------------------------------------------- */
+/* Node-wise reductions over the elastic space (local triples, then one reduction)                             */
+
+/* out_c = sum_l t(l) x(l)_c  (= int rho x_c for x in the elastic space) */
+static void LocalTdot(PetscInt nloc, const PetscScalar *t, const PetscScalar *x, PetscReal out[3])
+{
+  for (PetscInt l = 0; l < nloc; l++)
+    for (PetscInt c = 0; c < 3; c++) out[c] += PetscRealPart(t[3 * l] * x[3 * l + c]);
+}
+
+/* out[b][c] = sum_l a(l)_b m(l)_c */
+static void LocalOuter(PetscInt nloc, const PetscScalar *a, const PetscScalar *m, PetscReal out[9])
+{
+  for (PetscInt l = 0; l < nloc; l++)
+    for (PetscInt bb = 0; bb < 3; bb++)
+      for (PetscInt c = 0; c < 3; c++) out[3 * bb + c] += PetscRealPart(a[3 * l + bb] * m[3 * l + c]);
+}
+
+static inline void Eps(const PetscReal K[9], PetscReal out[3])
+{
+  /* out_a = eps_abc K[b][c] */
+  out[0] = K[5] - K[7];
+  out[1] = K[6] - K[2];
+  out[2] = K[1] - K[3];
+}
+
+static inline void InertiaFromE(const PetscReal E[9], PetscReal J[9])
+{
+  const PetscReal tr = E[0] + E[4] + E[8];
+  for (PetscInt i = 0; i < 9; i++) J[i] = -E[i];
+  J[0] += tr;
+  J[4] += tr;
+  J[8] += tr;
+}
+
+/*@C
+  PhlexFloatingEvaluate - the inertia quantities and momenta of a floating body at a state and its rates
+
+  Collective
+
+  Input Parameters:
++ b      - the body (floating)
+. units  - scales
+. t      - time [s] (inputs)
+. u, v   - elastic displacement and velocity
+. ud, vd - their rates (non-dimensional time), or NULL (zero)
+. q, qd  - rigid state [r | R | v_P | w] and its rate (qd may be NULL)
+
+  Output Parameter:
+. f - the evaluated context (work vectors inside are reused)
+@*/
+PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, PetscReal t, Vec u, Vec v, Vec ud, Vec vd, const PetscReal q[18], const PetscReal qd[18], PhlexFloatingState *f)
+{
+  const PetscBool    full = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
+  const PetscScalar *ta, *wa, *ua, *va, *uda = NULL, *vda = NULL, *Mua, *Mvva, *Muda = NULL, *Mvda = NULL;
+  PetscInt           n, nloc;
+  PetscReal          loc[3 + 3 + 3 + 3 + 9 + 9 + 9 + 9 + 9 + 9 + 9 + 9], glob[84];
+  PetscReal         *U = loc, *Ud = loc + 3, *Vf = loc + 6, *Vfd = loc + 9, *Wu = loc + 12, *Wud = loc + 21, *Wv = loc + 30, *Wvd = loc + 39, *Nuu = loc + 48, *Nudu = loc + 57, *Nuv = loc + 66, *Nuvd = loc + 75;
+
+  PetscFunctionBeginUser;
+  if (!f->Mu) {
+    PetscCall(VecDuplicate(u, &f->Mu));
+    PetscCall(VecDuplicate(u, &f->Mvv));
+    PetscCall(VecDuplicate(u, &f->Mud));
+    PetscCall(VecDuplicate(u, &f->Mvd));
+    PetscCall(VecDuplicate(u, &f->bext));
+  }
+  for (PetscInt k = 0; k < 3; k++) {
+    f->r[k]  = q[k];
+    f->vP[k] = q[12 + k];
+    f->w[k]  = q[15 + k];
+    f->rd[k] = qd ? qd[k] : 0.0;
+    f->vPd[k] = qd ? qd[12 + k] : 0.0;
+    f->wd[k]  = qd ? qd[15 + k] : 0.0;
+  }
+  for (PetscInt k = 0; k < 9; k++) {
+    f->R[k]  = q[3 + k];
+    f->Rd[k] = qd ? qd[3 + k] : 0.0;
+  }
+  /* Mv-products needed by the inertia terms */
+  if (full) PetscCall(MatMult(b->Mv, u, f->Mu));
+  else PetscCall(VecSet(f->Mu, 0.0));
+  PetscCall(MatMult(b->Mv, v, f->Mvv));
+  if (full && ud) PetscCall(MatMult(b->Mv, ud, f->Mud));
+  else PetscCall(VecSet(f->Mud, 0.0));
+  if (vd) PetscCall(MatMult(b->Mv, vd, f->Mvd));
+  else PetscCall(VecSet(f->Mvd, 0.0));
+
+  PetscCall(PetscArrayzero(loc, 84));
+  PetscCall(VecGetLocalSize(u, &n));
+  nloc = n / 3;
+  PetscCall(VecGetArrayRead(b->tnode, &ta));
+  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  PetscCall(VecGetArrayRead(u, &ua));
+  PetscCall(VecGetArrayRead(v, &va));
+  if (ud) PetscCall(VecGetArrayRead(ud, &uda));
+  if (vd) PetscCall(VecGetArrayRead(vd, &vda));
+  PetscCall(VecGetArrayRead(f->Mu, &Mua));
+  PetscCall(VecGetArrayRead(f->Mvv, &Mvva));
+  PetscCall(VecGetArrayRead(f->Mud, &Muda));
+  PetscCall(VecGetArrayRead(f->Mvd, &Mvda));
+  LocalTdot(nloc, ta, ua, U);
+  LocalTdot(nloc, ta, va, Vf);
+  if (ud) LocalTdot(nloc, ta, uda, Ud);
+  if (vd) LocalTdot(nloc, ta, vda, Vfd);
+  LocalOuter(nloc, wa, ua, Wu);
+  LocalOuter(nloc, wa, va, Wv);
+  if (ud) LocalOuter(nloc, wa, uda, Wud);
+  if (vd) LocalOuter(nloc, wa, vda, Wvd);
+  if (full) {
+    LocalOuter(nloc, ua, Mua, Nuu);
+    LocalOuter(nloc, ua, Mvva, Nuv);
+    if (ud) LocalOuter(nloc, uda, Mua, Nudu); /* int rho ud_b u_c */
+    if (vd) LocalOuter(nloc, ua, Mvda, Nuvd);
+    /* Nuv collects int rho u_b v_c; the rate of L also needs int rho ud_b v_c: add it into Nuvd */
+    if (ud) LocalOuter(nloc, uda, Mvva, Nuvd);
+  }
+  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(VecRestoreArrayRead(u, &ua));
+  PetscCall(VecRestoreArrayRead(v, &va));
+  if (ud) PetscCall(VecRestoreArrayRead(ud, &uda));
+  if (vd) PetscCall(VecRestoreArrayRead(vd, &vda));
+  PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
+  PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
+  PetscCall(VecRestoreArrayRead(f->Mud, &Muda));
+  PetscCall(VecRestoreArrayRead(f->Mvd, &Mvda));
+  PetscCall(MPIU_Allreduce(loc, glob, 84, MPIU_REAL, MPI_SUM, b->comm));
+  U = glob; Ud = glob + 3; Vf = glob + 6; Vfd = glob + 9; Wu = glob + 12; Wud = glob + 21; Wv = glob + 30; Wvd = glob + 39; Nuu = glob + 48; Nudu = glob + 57; Nuv = glob + 66; Nuvd = glob + 75;
+
+  /* s, E, J and rates (paper eq. momenta with s_u, J_u) */
+  f->m = b->inertia.m;
+  for (PetscInt k = 0; k < 3; k++) {
+    f->s[k]    = b->inertia.s0[k] + (full ? U[k] : 0.0);
+    f->sd[k]   = full ? Ud[k] : 0.0;
+    f->Vf[k]   = Vf[k];
+    f->Vfd[k]  = Vfd[k];
+    f->sgrav[k] = b->inertia.s0[k] + U[k]; /* gravity acts on the current position in either model */
+  }
+  for (PetscInt bb = 0; bb < 3; bb++)
+    for (PetscInt c = 0; c < 3; c++) {
+      const PetscInt k = 3 * bb + c, kt = 3 * c + bb;
+      f->E[k]  = b->inertia.E0[k] + (full ? Wu[k] + Wu[kt] + Nuu[k] : 0.0);
+      f->Ed[k] = full ? Wud[k] + Wud[kt] + Nudu[k] + Nudu[kt] : 0.0;
+    }
+  InertiaFromE(f->E, f->J);
+  InertiaFromE(f->Ed, f->Jd);
+  {
+    PetscReal K[9], Kd[9];
+    for (PetscInt k = 0; k < 9; k++) {
+      K[k]  = Wv[k] + (full ? Nuv[k] : 0.0);
+      Kd[k] = Wvd[k] + (full ? Nuvd[k] : 0.0);
+    }
+    Eps(K, f->L);
+    Eps(Kd, f->Ld);
+  }
+  /* momenta and their rates */
+  {
+    PetscReal a[3], c[3];
+    PhlexCross(f->w, f->s, a);
+    for (PetscInt k = 0; k < 3; k++) f->pt[k] = f->m * f->vP[k] + a[k] + f->Vf[k];
+    PhlexCross(f->s, f->vP, a);
+    PhlexMatVec3(f->J, f->w, c);
+    for (PetscInt k = 0; k < 3; k++) f->pr[k] = a[k] + c[k] + f->L[k];
+    /* p_t' = m vP' + w' x s + w x s' + int rho v' */
+    PhlexCross(f->wd, f->s, a);
+    PhlexCross(f->w, f->sd, c);
+    for (PetscInt k = 0; k < 3; k++) f->ptd[k] = f->m * f->vPd[k] + a[k] + c[k] + f->Vfd[k];
+    /* p_r' = s' x vP + s x vP' + J' w + J w' + L' */
+    PhlexCross(f->sd, f->vP, a);
+    PhlexCross(f->s, f->vPd, c);
+    for (PetscInt k = 0; k < 3; k++) f->prd[k] = a[k] + c[k] + f->Ld[k];
+    PhlexMatVec3(f->Jd, f->w, a);
+    PhlexMatVec3(f->J, f->wd, c);
+    for (PetscInt k = 0; k < 3; k++) f->prd[k] += a[k] + c[k];
+  }
+  /* gravity in the body frame and the inputs */
+  PhlexMatTVec3(f->R, b->gravity, f->gbody);
+  PetscCall(PhlexFloatingInputs(b, units, t, u, f));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFloatingInputs - external loads of a floating body at time t: the elastic load b_ext (ports and body force)
+  and the resultant force and moment about P on the frame (ports, frame wrench, body force); in the full model the
+  moment arms include u (sum_l u(l) x b_ext(l))
+
+  Collective
+@*/
+PetscErrorCode PhlexFloatingInputs(PhlexBody b, const PhlexUnits *units, PetscReal t, Vec u, PhlexFloatingState *f)
+{
+  PetscReal          Mloc[3] = {0, 0, 0}, Mu[3];
+  const PetscScalar *ua, *ba;
+  PetscInt           n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexBodyLoadVector(b, t, units, f->bext));
+  for (PetscInt k = 0; k < 3; k++) f->Fext[k] = f->Mext[k] = 0.0;
+  for (PetscInt p = 0; p < b->nports; p++) {
+    PetscReal in[6], c[3], a[3];
+    if (!b->ports[p].loaded) continue;
+    PetscCall(PhlexPortInput(&b->ports[p], t, units, in));
+    for (PetscInt k = 0; k < 3; k++) c[k] = (b->ports[p].centroid[k] - b->origin[k]) / units->length;
+    PhlexCross(c, in, a);
+    for (PetscInt k = 0; k < 3; k++) {
+      f->Fext[k] += in[k];
+      f->Mext[k] += a[k] + in[3 + k];
+    }
+  }
+  if (b->frame_loaded) {
+    PetscReal fr;
+    PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+    for (PetscInt k = 0; k < 3; k++) {
+      f->Fext[k] += fr * b->frame_force[k] / units->force;
+      f->Mext[k] += fr * b->frame_moment[k] / (units->force * units->length);
+    }
+  }
+  if (b->has_body_force) {
+    PetscReal fr, beta[3], a[3];
+    PetscCall(PhlexProfileEvaluate(b->body_force_profile, t, &fr));
+    for (PetscInt k = 0; k < 3; k++) beta[k] = fr * b->body_force[k] * units->length / units->modulus;
+    PhlexCross(b->inertia.svol, beta, a);
+    for (PetscInt k = 0; k < 3; k++) {
+      f->Fext[k] += b->inertia.vol * beta[k];
+      f->Mext[k] += a[k];
+    }
+  }
+  if (!b->frozen_inertia) {
+    PetscCall(VecGetLocalSize(u, &n));
+    PetscCall(VecGetArrayRead(u, &ua));
+    PetscCall(VecGetArrayRead(f->bext, &ba));
+    for (PetscInt l = 0; l < n / 3; l++) {
+      PetscReal x[3], y[3], a[3];
+      for (PetscInt k = 0; k < 3; k++) {
+        x[k] = PetscRealPart(ua[3 * l + k]);
+        y[k] = PetscRealPart(ba[3 * l + k]);
+      }
+      PhlexCross(x, y, a);
+      for (PetscInt k = 0; k < 3; k++) Mloc[k] += a[k];
+    }
+    PetscCall(VecRestoreArrayRead(u, &ua));
+    PetscCall(VecRestoreArrayRead(f->bext, &ba));
+    PetscCall(MPIU_Allreduce(Mloc, Mu, 3, MPIU_REAL, MPI_SUM, b->comm));
+    for (PetscInt k = 0; k < 3; k++) f->Mext[k] += Mu[k];
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFloatingResidual - adds the floating-frame terms to the elastic momentum residual Fv (which already holds
+  Mv v' + G^T Sigma - b_ext) and computes the 18 rigid residuals Fq (all in non-dimensional time)
+
+  Collective
+@*/
+PetscErrorCode PhlexFloatingResidual(PhlexBody b, PhlexFloatingState *f, Vec u, Vec v, Vec ud, Vec Fv, PetscReal Fq[18])
+{
+  const PetscBool    full = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
+  PetscScalar       *fa;
+  const PetscScalar *ta, *wa, *ua, *va, *uda, *Mua, *Mvva, *Muda;
+  PetscInt           n;
+  PetscReal          C[9], vxw[3], a[3], c[3], wdxw[9];
+
+  PetscFunctionBeginUser;
+  /* kinematics: r' = R v_P, R' = R [w]x  (Fq rows 0-11) */
+  PhlexMatVec3(f->R, f->vP, a);
+  for (PetscInt k = 0; k < 3; k++) Fq[k] = f->rd[k] - a[k];
+  {
+    PetscReal S[9], RS[9];
+    PhlexSkew(f->w, S);
+    PhlexMatMat3(f->R, S, RS);
+    for (PetscInt k = 0; k < 9; k++) Fq[3 + k] = f->Rd[k] - RS[k];
+  }
+  /* p_t' + w x p_t - F - R^T m g */
+  PhlexCross(f->w, f->pt, a);
+  for (PetscInt k = 0; k < 3; k++) Fq[12 + k] = f->ptd[k] + a[k] - f->Fext[k] - f->m * f->gbody[k];
+  /* p_r' + w x p_r + vP x p_t - M - s x R^T g */
+  PhlexCross(f->w, f->pr, a);
+  PhlexCross(f->vP, f->pt, c);
+  for (PetscInt k = 0; k < 3; k++) Fq[15 + k] = f->prd[k] + a[k] + c[k] - f->Mext[k];
+  PhlexCross(f->sgrav, f->gbody, a);
+  for (PetscInt k = 0; k < 3; k++) Fq[15 + k] -= a[k];
+
+  /* elastic rows: p_f' - Mv v' = t vP' + int rho phi (w' x y) + Mv (w x ud), minus dT/du, minus t R^T g */
+  PhlexCross(f->vP, f->w, vxw);
+  for (PetscInt i = 0; i < 9; i++) C[i] = -f->w[i / 3] * f->w[i % 3];
+  {
+    const PetscReal w2 = PhlexDot3(f->w, f->w);
+    C[0] += w2;
+    C[4] += w2;
+    C[8] += w2;
+  }
+  PhlexSkew(f->wd, wdxw);
+  PetscCall(VecGetLocalSize(u, &n));
+  PetscCall(VecGetArray(Fv, &fa));
+  PetscCall(VecGetArrayRead(b->tnode, &ta));
+  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  PetscCall(VecGetArrayRead(u, &ua));
+  PetscCall(VecGetArrayRead(v, &va));
+  PetscCall(VecGetArrayRead(f->Mu, &Mua));
+  PetscCall(VecGetArrayRead(f->Mvv, &Mvva));
+  PetscCall(VecGetArrayRead(f->Mud, &Muda));
+  uda = NULL;
+  if (ud) PetscCall(VecGetArrayRead(ud, &uda));
+  for (PetscInt l = 0; l < n / 3; l++) {
+    const PetscReal tl = PetscRealPart(ta[3 * l]);
+    PetscReal       z[3], acc[3], tmp[3], tmp2[3];
+    for (PetscInt k = 0; k < 3; k++) z[k] = PetscRealPart(wa[3 * l + k] + Mua[3 * l + k]); /* int rho y phi_l */
+    /* t vP' + int rho phi (w' x y) = t vP' + w' x z */
+    PhlexCross(f->wd, z, acc);
+    for (PetscInt k = 0; k < 3; k++) acc[k] += tl * f->vPd[k] - tl * f->gbody[k];
+    if (full) {
+      PetscReal Mud_l[3], Mv_l[3];
+      for (PetscInt k = 0; k < 3; k++) {
+        Mud_l[k] = PetscRealPart(Muda[3 * l + k]);
+        Mv_l[k]  = PetscRealPart(Mvva[3 * l + k]);
+      }
+      /* + Mv (w x ud): node-wise cross commutes with Mv */
+      PhlexCross(f->w, Mud_l, tmp);
+      /* - dT/du = - [t (vP x w) + C z + Mv v x w]  (C = |w|^2 I - w w^T, (w x y) x w = C y) */
+      PhlexMatVec3(C, z, tmp2);
+      for (PetscInt k = 0; k < 3; k++) acc[k] += tmp[k] - tl * vxw[k] - tmp2[k];
+      PhlexCross(Mv_l, f->w, tmp);
+      for (PetscInt k = 0; k < 3; k++) acc[k] -= tmp[k];
+    }
+    for (PetscInt k = 0; k < 3; k++) fa[3 * l + k] += acc[k];
+  }
+  PetscCall(VecRestoreArray(Fv, &fa));
+  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(VecRestoreArrayRead(u, &ua));
+  PetscCall(VecRestoreArrayRead(v, &va));
+  PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
+  PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
+  PetscCall(VecRestoreArrayRead(f->Mud, &Muda));
+  if (ud) PetscCall(VecRestoreArrayRead(ud, &uda));
+  PetscFunctionReturn(0);
+}
+
+/* D[a][e] = d (J(u) w)_a / d u(l)_e = 2 z_e w_a - z_a w_e - delta_ae (z . w), z = int rho y phi_l */
+static inline void InertiaDerivative(const PetscReal z[3], const PetscReal w[3], PetscReal D[9])
+{
+  const PetscReal zw = PhlexDot3(z, w);
+  for (PetscInt a = 0; a < 3; a++)
+    for (PetscInt e = 0; e < 3; e++) D[3 * a + e] = 2.0 * z[e] * w[a] - z[a] * w[e] - (a == e ? zw : 0.0);
+}
+
+/*@C
+  PhlexFloatingJacobian - dF/dX + shift dF/dX' of the floating-frame terms (non-dimensional shift)
+
+  Collective
+
+  Output Parameters:
++ Bvv, Bvu - node-wise 3x3 matrices: the elastic-row blocks are shift Mv + Bvv Mv (velocity) and Bvu Mv
+             (displacement); they vanish in the frozen model
+. Bc       - n_local x 18 (column-major, leading dimension ld): d(elastic rows)/d(rigid unknowns)
+. Cu, Cv   - n_local x 18 (column-major, ld): d(rigid row k)/d u, d v, i.e. the transposes of the rigid rows
+- Arr      - 18 x 18 row-major rigid block (meaningful on every rank)
+
+  Notes:
+  Rigid unknowns in the order r (0-2), R (3-11, row-wise), v_P (12-14), w (15-17).
+@*/
+PetscErrorCode PhlexFloatingJacobian(PhlexBody b, PhlexFloatingState *f, PetscReal shift, Vec u, Vec v, PetscScalar *Bc, PetscScalar *Cu, PetscScalar *Cv, PetscInt ld, PetscReal Bvv[9], PetscReal Bvu[9], PetscReal Arr[324])
+{
+  const PetscBool    full = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
+  const PetscReal   *w = f->w, *wd = f->wd, *vP = f->vP, *g = b->gravity;
+  const PetscScalar *ta, *wa, *Mua, *Mvva, *Muda, *Mvda, *ba;
+  PetscInt           n;
+  PetscReal          S[9], C[9], sx[9];
+
+  PetscFunctionBeginUser;
+  PhlexSkew(w, S);
+  for (PetscInt i = 0; i < 9; i++) C[i] = -w[i / 3] * w[i % 3];
+  {
+    const PetscReal w2 = PhlexDot3(w, w);
+    C[0] += w2;
+    C[4] += w2;
+    C[8] += w2;
+  }
+  /* node-wise blocks: A_vv = shift Mv + [w]x Mv, A_vu = (shift [w]x + [w']x - C) Mv (full model) */
+  {
+    PetscReal Sd[9];
+    PhlexSkew(wd, Sd);
+    for (PetscInt i = 0; i < 9; i++) {
+      Bvv[i] = full ? S[i] : 0.0;
+      Bvu[i] = full ? shift * S[i] + Sd[i] - C[i] : 0.0;
+    }
+  }
+
+  /* rigid block (rows 0-17, columns 0-17) */
+  PetscCall(PetscArrayzero(Arr, 324));
+#define A(i, j) Arr[18 * (i) + (j)]
+  /* r' - R vP */
+  for (PetscInt i = 0; i < 3; i++) {
+    A(i, i) = shift;
+    for (PetscInt j = 0; j < 3; j++) {
+      A(i, 3 + 3 * i + j) = -vP[j];
+      A(i, 12 + j)        = -f->R[3 * i + j];
+    }
+  }
+  /* R' - R [w]x: d/dR_ik = shift delta_kj - S_kj, d/dw_a = -sum_k R_ik eps_kaj */
+  for (PetscInt i = 0; i < 3; i++)
+    for (PetscInt j = 0; j < 3; j++) {
+      const PetscInt row = 3 + 3 * i + j;
+      for (PetscInt k = 0; k < 3; k++) A(row, 3 + 3 * i + k) = (k == j ? shift : 0.0) - S[3 * k + j];
+      for (PetscInt a = 0; a < 3; a++) {
+        PetscReal s = 0;
+        for (PetscInt k = 0; k < 3; k++) {
+          const PetscReal eps = (k == a || a == j || k == j) ? 0.0 : ((k - a + 3) % 3 == 2 ? 1.0 : -1.0); /* eps_kaj */
+          s += f->R[3 * i + k] * eps;
+        }
+        A(row, 15 + a) = -s;
+      }
+    }
+  /* p_t' + w x p_t - F - R^T m g */
+  PhlexSkew(f->s, sx);
+  {
+    PetscReal Spt[9], SwSs[9], Ssd[9];
+    PhlexSkew(f->pt, Spt);
+    PhlexSkew(f->sd, Ssd);
+    PhlexMatMat3(S, sx, SwSs);
+    for (PetscInt a = 0; a < 3; a++)
+      for (PetscInt c = 0; c < 3; c++) {
+        A(12 + a, 12 + c) = (a == c ? shift * f->m : 0.0) + f->m * S[3 * a + c];
+        A(12 + a, 15 + c) = -shift * sx[3 * a + c] - Ssd[3 * a + c] - Spt[3 * a + c] - SwSs[3 * a + c];
+      }
+    for (PetscInt i = 0; i < 3; i++)
+      for (PetscInt j = 0; j < 3; j++) A(12 + j, 3 + 3 * i + j) += -f->m * g[i];
+  }
+  /* p_r' + w x p_r + vP x p_t - M - s x R^T g */
+  {
+    PetscReal Ssd[9], Spt[9], Spr[9], SvP[9], SwSs[9], SwJ[9], SvPSs[9];
+    PhlexSkew(f->sd, Ssd);
+    PhlexSkew(f->pt, Spt);
+    PhlexSkew(f->pr, Spr);
+    PhlexSkew(vP, SvP);
+    PhlexMatMat3(S, sx, SwSs);
+    PhlexMatMat3(S, f->J, SwJ);
+    PhlexMatMat3(SvP, sx, SvPSs);
+    for (PetscInt a = 0; a < 3; a++)
+      for (PetscInt c = 0; c < 3; c++) {
+        const PetscInt k = 3 * a + c;
+        A(15 + a, 12 + c) = shift * sx[k] + Ssd[k] + SwSs[k] - Spt[k] + f->m * SvP[k];
+        A(15 + a, 15 + c) = shift * f->J[k] + f->Jd[k] - Spr[k] + SwJ[k] - SvPSs[k];
+      }
+    for (PetscInt i = 0; i < 3; i++)
+      for (PetscInt j = 0; j < 3; j++) {
+        PetscReal ej[3] = {0, 0, 0}, a3[3];
+        ej[j] = 1.0;
+        PhlexCross(f->sgrav, ej, a3);
+        for (PetscInt a = 0; a < 3; a++) A(15 + a, 3 + 3 * i + j) += -g[i] * a3[a];
+      }
+  }
+#undef A
+
+  /* field borders, node by node */
+  PetscCall(VecGetLocalSize(u, &n));
+  PetscCall(VecGetArrayRead(b->tnode, &ta));
+  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  PetscCall(VecGetArrayRead(f->Mu, &Mua));
+  PetscCall(VecGetArrayRead(f->Mvv, &Mvva));
+  PetscCall(VecGetArrayRead(f->Mud, &Muda));
+  PetscCall(VecGetArrayRead(f->Mvd, &Mvda));
+  PetscCall(VecGetArrayRead(f->bext, &ba));
+  for (PetscInt col = 0; col < 18; col++)
+    for (PetscInt i = 0; i < n; i++) Bc[col * ld + i] = Cu[col * ld + i] = Cv[col * ld + i] = 0.0;
+  for (PetscInt l = 0; l < n / 3; l++) {
+    const PetscReal tl = PetscRealPart(ta[3 * l]);
+    PetscReal       z[3], zd[3], Mvl[3], Mvdl[3], bl[3];
+    for (PetscInt k = 0; k < 3; k++) {
+      z[k]    = PetscRealPart(wa[3 * l + k] + Mua[3 * l + k]);
+      zd[k]   = PetscRealPart(Muda[3 * l + k]);
+      Mvl[k]  = PetscRealPart(Mvva[3 * l + k]);
+      Mvdl[k] = PetscRealPart(Mvda[3 * l + k]);
+      bl[k]   = PetscRealPart(ba[3 * l + k]);
+    }
+    /* elastic rows x rigid columns: Bc[(l,c), col] */
+    for (PetscInt c = 0; c < 3; c++) {
+      const PetscInt row = 3 * l + c;
+      /* R_ij: gravity -t g_i delta_cj */
+      for (PetscInt i = 0; i < 3; i++) Bc[(3 + 3 * i + c) * ld + row] = -tl * g[i];
+    }
+    for (PetscInt j = 0; j < 3; j++) {
+      PetscReal ej[3] = {0, 0, 0}, col[3], a3[3];
+      ej[j] = 1.0;
+      /* vP_j: shift t e_j - t (e_j x w) */
+      PhlexCross(ej, w, a3);
+      for (PetscInt c = 0; c < 3; c++) col[c] = shift * tl * ej[c] - (full ? tl * a3[c] : 0.0);
+      for (PetscInt c = 0; c < 3; c++) Bc[(12 + j) * ld + 3 * l + c] = col[c];
+      /* w_a (a = j): shift e_a x z + [e_a x Mud - t vP x e_a - dC/dw_a z - Mv v x e_a] */
+      PhlexCross(ej, z, col);
+      for (PetscInt c = 0; c < 3; c++) col[c] *= shift;
+      if (full) {
+        PetscReal t1[3], t2[3], t3[3];
+        PhlexCross(ej, zd, t1);
+        PhlexCross(vP, ej, t2);
+        PhlexCross(Mvl, ej, t3);
+        for (PetscInt c = 0; c < 3; c++) {
+          const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
+          col[c] += t1[c] - tl * t2[c] - dCz - t3[c];
+        }
+      }
+      for (PetscInt c = 0; c < 3; c++) Bc[(15 + j) * ld + 3 * l + c] = col[c];
+    }
+    /* rigid rows x elastic columns: Cu[(l,e), row], Cv[(l,e), row] */
+    for (PetscInt e = 0; e < 3; e++) {
+      const PetscInt colidx = 3 * l + e;
+      PetscReal      ee[3] = {0, 0, 0}, a3[3], b3[3], c3[3];
+      ee[e] = 1.0;
+      /* v: p_t row: t (shift e_e + w x e_e) */
+      PhlexCross(w, ee, a3);
+      for (PetscInt k = 0; k < 3; k++) Cv[(12 + k) * ld + colidx] = tl * (shift * ee[k] + a3[k]);
+      /* v: p_r row: shift (z x e_e) [+ Mud x e_e] + w x (z x e_e) + vP x (t e_e) */
+      {
+        PetscReal zxe[3], wz[3], r3[3];
+        PhlexCross(z, ee, zxe);
+        PhlexCross(w, zxe, wz);
+        PhlexCross(vP, ee, r3);
+        for (PetscInt k = 0; k < 3; k++) Cv[(15 + k) * ld + colidx] = shift * zxe[k] + wz[k] + tl * r3[k];
+        if (full) {
+          PetscReal mdx[3];
+          PhlexCross(zd, ee, mdx);
+          for (PetscInt k = 0; k < 3; k++) Cv[(15 + k) * ld + colidx] += mdx[k];
+        }
+      }
+      /* u: sgrav depends on u in both models: p_r row -t (e_e x R^T g) */
+      PhlexCross(ee, f->gbody, b3);
+      for (PetscInt k = 0; k < 3; k++) Cu[(15 + k) * ld + colidx] = -tl * b3[k];
+      if (full) {
+        PetscReal D[9], Dd[9], Dwd[9], dpr[3], t1[3], t2[3], wsum[3];
+        /* p_t row: t [(w' + shift w) x e_e + w x (w x e_e)] */
+        for (PetscInt k = 0; k < 3; k++) wsum[k] = wd[k] + shift * w[k];
+        PhlexCross(wsum, ee, a3);
+        PhlexCross(w, ee, t1);
+        PhlexCross(w, t1, t2);
+        for (PetscInt k = 0; k < 3; k++) Cu[(12 + k) * ld + colidx] = tl * (a3[k] + t2[k]);
+        /* p_r row */
+        InertiaDerivative(z, w, D);
+        InertiaDerivative(zd, w, Dd);
+        InertiaDerivative(z, wd, Dwd);
+        /* dp_r/du(l,e) = t (e_e x vP) + D e_e + e_e x Mv v */
+        PhlexCross(ee, vP, t1);
+        PhlexCross(ee, Mvl, t2);
+        for (PetscInt k = 0; k < 3; k++) dpr[k] = tl * t1[k] + D[3 * k + e] + t2[k];
+        PhlexCross(w, dpr, c3); /* w x dp_r/du */
+        {
+          PetscReal t3[3], t4[3], t5[3], t6[3];
+          PhlexCross(ee, vP, t3);     /* shift t (e_e x vP) from s' x vP */
+          PhlexCross(ee, f->vPd, t4); /* t (e_e x vP') from s x vP' */
+          PhlexCross(ee, Mvl, t5);    /* shift (e_e x Mv v) from L' */
+          PhlexCross(ee, Mvdl, t6);   /* e_e x Mv v' from L' */
+          PhlexCross(w, ee, t1);
+          PhlexCross(vP, t1, t2);     /* vP x (w x e_e) t from vP x p_t */
+          PhlexCross(ee, bl, b3);     /* - e_e x b_ext from -M */
+          for (PetscInt k = 0; k < 3; k++) Cu[(15 + k) * ld + colidx] += shift * tl * t3[k] + tl * t4[k] + shift * D[3 * k + e] + Dd[3 * k + e] + Dwd[3 * k + e] + shift * t5[k] + t6[k] + c3[k] + tl * t2[k] - b3[k];
+        }
+      }
+    }
+  }
+  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
+  PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
+  PetscCall(VecRestoreArrayRead(f->Mud, &Muda));
+  PetscCall(VecRestoreArrayRead(f->Mvd, &Mvda));
+  PetscCall(VecRestoreArrayRead(f->bext, &ba));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFloatingPortOutputs - collocated outputs of the ports of a floating body (non-dimensional): the port
+  distributions applied to the velocity field v_P + w x (x - P [+ u]) + v, i.e. the rigid part
+  (v_P + w x (c - P), w) plus B^T (v [+ w x u]); u enters in the full model only, as in the moment arms of the inputs,
+  so that F . y_v + T . y_w is exactly the power of the port
+
+  Collective
+
+  Input Parameters:
++ b      - the body
+. units  - scales
+. vP, w  - frame velocity and angular velocity (body frame)
+. u, v   - elastic displacement and velocity
+- work   - a work vector of the velocity space
+
+  Output Parameter:
+. y - outputs per port
+@*/
+PetscErrorCode PhlexFloatingPortOutputs(PhlexBody b, const PhlexUnits *units, const PetscReal vP[3], const PetscReal w[3], Vec u, Vec v, Vec work, PetscReal y[][6])
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecCopy(v, work));
+  if (!b->frozen_inertia) {
+    const PetscScalar *ua;
+    PetscScalar       *wa;
+    PetscInt           n;
+    PetscCall(VecGetLocalSize(u, &n));
+    PetscCall(VecGetArrayRead(u, &ua));
+    PetscCall(VecGetArray(work, &wa));
+    for (PetscInt l = 0; l < n / 3; l++) {
+      PetscReal x[3], a[3];
+      for (PetscInt k = 0; k < 3; k++) x[k] = PetscRealPart(ua[3 * l + k]);
+      PhlexCross(w, x, a);
+      for (PetscInt k = 0; k < 3; k++) wa[3 * l + k] += a[k];
+    }
+    PetscCall(VecRestoreArrayRead(u, &ua));
+    PetscCall(VecRestoreArray(work, &wa));
+  }
+  PetscCall(PhlexBodyPortOutputs(b, work, y));
+  for (PetscInt p = 0; p < b->nports; p++) {
+    PetscReal c[3], a[3];
+    for (PetscInt k = 0; k < 3; k++) c[k] = (b->ports[p].centroid[k] - b->origin[k]) / units->length;
+    PhlexCross(w, c, a);
+    for (PetscInt k = 0; k < 3; k++) {
+      y[p][k] += vP[k] + a[k];
+      y[p][3 + k] += w[k];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFloatingEnergy - kinetic energy T = 1/2 int rho |V|^2 and gravity potential -g . (m r + R s) (non-dimensional)
+
+  Not collective (uses an evaluated state)
+@*/
+PetscErrorCode PhlexFloatingEnergy(PhlexBody b, PhlexFloatingState *f, Vec v, PetscReal *kinetic, PetscReal *potential)
+{
+  PetscScalar vMv;
+  PetscReal   a[3], Jw[3], Rs[3];
+
+  PetscFunctionBeginUser;
+  PetscCall(VecDot(v, f->Mvv, &vMv));
+  PhlexCross(f->w, f->s, a);
+  PhlexMatVec3(f->J, f->w, Jw);
+  *kinetic = 0.5 * f->m * PhlexDot3(f->vP, f->vP) + PhlexDot3(f->vP, a) + 0.5 * PhlexDot3(f->w, Jw) + PhlexDot3(f->vP, f->Vf) + PhlexDot3(f->w, f->L) + 0.5 * PetscRealPart(vMv);
+  PhlexMatVec3(f->R, f->sgrav, Rs);
+  *potential = -(f->m * PhlexDot3(b->gravity, f->r) + PhlexDot3(b->gravity, Rs));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFloatingMomenta - inertial linear momentum R p_t and angular momentum about the inertial origin
+  R p_r + r x R p_t (non-dimensional)
+@*/
+PetscErrorCode PhlexFloatingMomenta(PhlexFloatingState *f, PetscReal P[3], PetscReal L[3])
+{
+  PetscReal a[3];
+
+  PetscFunctionBeginUser;
+  PhlexMatVec3(f->R, f->pt, P);
+  PhlexMatVec3(f->R, f->pr, L);
+  PhlexCross(f->r, P, a);
+  for (PetscInt k = 0; k < 3; k++) L[k] += a[k];
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFloatingStateDestroy - frees the work vectors of an evaluation context
+@*/
+PetscErrorCode PhlexFloatingStateDestroy(PhlexFloatingState *f)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecDestroy(&f->Mu));
+  PetscCall(VecDestroy(&f->Mvv));
+  PetscCall(VecDestroy(&f->Mud));
+  PetscCall(VecDestroy(&f->Mvd));
+  PetscCall(VecDestroy(&f->bext));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,147 @@
+/* Rotation algebra and 3x3 helpers of the floating frame (paper Section 3: R stored row-wise, R' = R [w]x).
+   Pure functions on arrays: no PETSc objects. Matrices are row-major 3x3. */
+#include <phlex_impl.h>
+
+/* c = a x b */
+void PhlexCross(const PetscReal a[3], const PetscReal b[3], PetscReal c[3])
+{
+  const PetscReal c0 = a[1] * b[2] - a[2] * b[1], c1 = a[2] * b[0] - a[0] * b[2], c2 = a[0] * b[1] - a[1] * b[0];
+  c[0] = c0;
+  c[1] = c1;
+  c[2] = c2;
+}
+
+PetscReal PhlexDot3(const PetscReal a[3], const PetscReal b[3])
+{
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+/* S = [a]x, the matrix with S b = a x b */
+void PhlexSkew(const PetscReal a[3], PetscReal S[9])
+{
+  S[0] = 0;
+  S[1] = -a[2];
+  S[2] = a[1];
+  S[3] = a[2];
+  S[4] = 0;
+  S[5] = -a[0];
+  S[6] = -a[1];
+  S[7] = a[0];
+  S[8] = 0;
+}
+
+/* y = A x (y may alias x) */
+void PhlexMatVec3(const PetscReal A[9], const PetscReal x[3], PetscReal y[3])
+{
+  const PetscReal y0 = A[0] * x[0] + A[1] * x[1] + A[2] * x[2], y1 = A[3] * x[0] + A[4] * x[1] + A[5] * x[2], y2 = A[6] * x[0] + A[7] * x[1] + A[8] * x[2];
+  y[0] = y0;
+  y[1] = y1;
+  y[2] = y2;
+}
+
+/* y = A^T x (y may alias x) */
+void PhlexMatTVec3(const PetscReal A[9], const PetscReal x[3], PetscReal y[3])
+{
+  const PetscReal y0 = A[0] * x[0] + A[3] * x[1] + A[6] * x[2], y1 = A[1] * x[0] + A[4] * x[1] + A[7] * x[2], y2 = A[2] * x[0] + A[5] * x[1] + A[8] * x[2];
+  y[0] = y0;
+  y[1] = y1;
+  y[2] = y2;
+}
+
+/* C = A B (C must not alias A or B) */
+void PhlexMatMat3(const PetscReal A[9], const PetscReal B[9], PetscReal C[9])
+{
+  for (PetscInt i = 0; i < 3; i++)
+    for (PetscInt j = 0; j < 3; j++) C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+/* ||R^T R - I||_F */
+PetscReal PhlexOrthogonalityError(const PetscReal R[9])
+{
+  PetscReal e = 0;
+
+  for (PetscInt i = 0; i < 3; i++)
+    for (PetscInt j = 0; j < 3; j++) {
+      const PetscReal d = R[i] * R[j] + R[3 + i] * R[3 + j] + R[6 + i] * R[6 + j] - (i == j ? 1.0 : 0.0);
+      e += d * d;
+    }
+  return PetscSqrtReal(e);
+}
+
+/* Nearest rotation to a nearly orthogonal R (orthogonal polar factor) by Newton-Schulz steps
+   R <- R (3 I - R^T R) / 2, quadratically convergent for ||R^T R - I|| < 1 */
+void PhlexOrthonormalize(PetscReal R[9])
+{
+  for (PetscInt it = 0; it < 4 && PhlexOrthogonalityError(R) > 10 * PETSC_MACHINE_EPSILON; it++) {
+    PetscReal A[9], N[9];
+    for (PetscInt i = 0; i < 3; i++)
+      for (PetscInt j = 0; j < 3; j++) A[3 * i + j] = 0.5 * ((i == j ? 3.0 : 0.0) - (R[i] * R[j] + R[3 + i] * R[3 + j] + R[6 + i] * R[6 + j]));
+    PhlexMatMat3(R, A, N);
+    for (PetscInt k = 0; k < 9; k++) R[k] = N[k];
+  }
+}
+
+/* Unit quaternion (w, x, y, z) of a rotation matrix (Shepperd's method); w >= 0 */
+void PhlexRotationToQuaternion(const PetscReal R[9], PetscReal q[4])
+{
+  const PetscReal tr = R[0] + R[4] + R[8];
+  PetscReal       n;
+
+  if (tr > R[0] && tr > R[4] && tr > R[8]) {
+    const PetscReal s = 2.0 * PetscSqrtReal(1.0 + tr);
+    q[0]              = 0.25 * s;
+    q[1]              = (R[7] - R[5]) / s;
+    q[2]              = (R[2] - R[6]) / s;
+    q[3]              = (R[3] - R[1]) / s;
+  } else if (R[0] >= R[4] && R[0] >= R[8]) {
+    const PetscReal s = 2.0 * PetscSqrtReal(1.0 + R[0] - R[4] - R[8]);
+    q[0]              = (R[7] - R[5]) / s;
+    q[1]              = 0.25 * s;
+    q[2]              = (R[1] + R[3]) / s;
+    q[3]              = (R[2] + R[6]) / s;
+  } else if (R[4] >= R[8]) {
+    const PetscReal s = 2.0 * PetscSqrtReal(1.0 + R[4] - R[0] - R[8]);
+    q[0]              = (R[2] - R[6]) / s;
+    q[1]              = (R[1] + R[3]) / s;
+    q[2]              = 0.25 * s;
+    q[3]              = (R[5] + R[7]) / s;
+  } else {
+    const PetscReal s = 2.0 * PetscSqrtReal(1.0 + R[8] - R[0] - R[4]);
+    q[0]              = (R[3] - R[1]) / s;
+    q[1]              = (R[2] + R[6]) / s;
+    q[2]              = (R[5] + R[7]) / s;
+    q[3]              = 0.25 * s;
+  }
+  if (q[0] < 0)
+    for (PetscInt k = 0; k < 4; k++) q[k] = -q[k];
+  n = PetscSqrtReal(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  for (PetscInt k = 0; k < 4; k++) q[k] /= n;
+}
+
+/* Rotation matrix of a quaternion (w, x, y, z), normalised first */
+void PhlexQuaternionToRotation(const PetscReal qin[4], PetscReal R[9])
+{
+  const PetscReal n = PetscSqrtReal(qin[0] * qin[0] + qin[1] * qin[1] + qin[2] * qin[2] + qin[3] * qin[3]);
+  const PetscReal w = qin[0] / n, x = qin[1] / n, y = qin[2] / n, z = qin[3] / n;
+
+  R[0] = 1 - 2 * (y * y + z * z);
+  R[1] = 2 * (x * y - w * z);
+  R[2] = 2 * (x * z + w * y);
+  R[3] = 2 * (x * y + w * z);
+  R[4] = 1 - 2 * (x * x + z * z);
+  R[5] = 2 * (y * z - w * x);
+  R[6] = 2 * (x * z - w * y);
+  R[7] = 2 * (y * z + w * x);
+  R[8] = 1 - 2 * (x * x + y * y);
+}
+
+/* Rotation of an axis (normalised) and an angle [rad] */
+void PhlexAxisAngleToRotation(const PetscReal axis[3], PetscReal angle, PetscReal R[9])
+{
+  const PetscReal n = PetscSqrtReal(PhlexDot3(axis, axis));
+  PetscReal       q[4];
+
+  q[0] = PetscCosReal(0.5 * angle);
+  for (PetscInt k = 0; k < 3; k++) q[1 + k] = (n > 0 ? axis[k] / n : 0.0) * PetscSinReal(0.5 * angle);
+  PhlexQuaternionToRotation(q, R);
+}
