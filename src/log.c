@@ -2,7 +2,7 @@
 #include <phlex.h>
 
 PetscClassId  PHLEX_CLASSID;
-PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist;
+PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp;
 PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes, PHLEX_StageOutput;
 
 /*@C
@@ -22,6 +22,10 @@ PetscErrorCode PhlexLogRegister(void)
   PetscCall(PetscLogEventRegister("PhlexModesSolve", PHLEX_CLASSID, &PHLEX_ModesSolve));
   PetscCall(PetscLogEventRegister("PhlexOutput", PHLEX_CLASSID, &PHLEX_Output));
   PetscCall(PetscLogEventRegister("PhlexPortDist", PHLEX_CLASSID, &PHLEX_PortDist));
+  PetscCall(PetscLogEventRegister("PhlexFloatResid", PHLEX_CLASSID, &PHLEX_FloatResidual));
+  PetscCall(PetscLogEventRegister("PhlexFloatJac", PHLEX_CLASSID, &PHLEX_FloatJacobian));
+  PetscCall(PetscLogEventRegister("PhlexBordBasis", PHLEX_CLASSID, &PHLEX_BorderedBasis));
+  PetscCall(PetscLogEventRegister("PhlexBordSetUp", PHLEX_CLASSID, &PHLEX_BorderedSetUp));
   PetscCall(PetscLogStageRegister("Phlex Setup", &PHLEX_StageSetup));
   PetscCall(PetscLogStageRegister("Phlex Transient", &PHLEX_StageTransient));
   PetscCall(PetscLogStageRegister("Phlex Modes", &PHLEX_StageModes));

@@ -358,6 +358,27 @@ PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter w, const char name[]
   PetscCall(DMLocalToGlobalEnd(w->dm_vertex, lout, INSERT_VALUES, out));
   PetscCall(PetscObjectSetName((PetscObject)out, name));
   PetscCall(VecView(out, w->viewer));
+  {
+    PetscBool geometry;
+    PetscCall(PetscStrcmp(name, w->geometry_field, &geometry));
+    if (geometry) {
+      /* also as a plain (vertices x 3) dataset per step, the XDMF geometry of that step: ParaView's XDMF reader cannot
+         cache a hyperslab geometry and complains at every step */
+      Vec      g;
+      PetscInt n;
+      char     gname[64];
+      PetscCall(VecGetLocalSize(out, &n));
+      PetscCall(VecCreateMPI(PetscObjectComm((PetscObject)out), n, PETSC_DETERMINE, &g));
+      PetscCall(VecSetBlockSize(g, 3));
+      PetscCall(VecCopy(out, g));
+      PetscCall(PetscSNPrintf(gname, sizeof(gname), "step_%" PetscInt_FMT, w->nsteps - 1));
+      PetscCall(PetscObjectSetName((PetscObject)g, gname));
+      PetscCall(PetscViewerHDF5PushGroup(w->viewer, "/moving_geometry"));
+      PetscCall(VecView(g, w->viewer));
+      PetscCall(PetscViewerHDF5PopGroup(w->viewer));
+      PetscCall(VecDestroy(&g));
+    }
+  }
   PetscCall(DMRestoreGlobalVector(w->dm_vertex, &out));
   PetscCall(DMRestoreLocalVector(w->dm_vertex, &lout));
   PetscCall(RegisterField(w, PETSC_TRUE, name, 3));
@@ -471,9 +492,7 @@ static PetscErrorCode WriteXDMF(PhlexFieldWriter w)
     fprintf(fp, "   <Grid Name=\"%s_%d\" GridType=\"Uniform\">\n    <Time Value=\"%.12g\"/>\n", w->name, (int)k, (double)w->times[k]);
     fprintf(fp, "    <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%d\">\n     <DataItem Dimensions=\"%d 4\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n    </Topology>\n", (int)w->ncells, (int)w->ncells, h5name);
     if (w->geometry_field[0]) {
-      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d 3\" Type=\"HyperSlab\">\n", (int)w->nvertex);
-      fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d 3</DataItem>\n", (int)k, (int)w->nvertex);
-      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Geometry>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->geometry_field);
+      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/moving_geometry/step_%d</DataItem>\n    </Geometry>\n", (int)w->nvertex, h5name, (int)k);
     } else {
       fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n    </Geometry>\n", (int)w->nvertex, h5name);
     }

@@ -93,6 +93,7 @@ static PetscErrorCode BorderedSetUpBasis(PC pc, PC_Bordered *bd)
   PetscCall(PetscObjectStateGet((PetscObject)bd->A, &sa));
   PetscCall(PetscObjectStateGet((PetscObject)bd->W, &sw));
   if (bd->Y && sa == bd->Astate && sw == bd->Wstate) PetscFunctionReturn(0);
+  PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pc, 0, 0, 0));
   PetscCall(KSPSetOperators(bd->ksp, bd->A, bd->A));
   PetscCall(KSPSetUp(bd->ksp));
   PetscCall(MatDestroy(&bd->Y));
@@ -106,6 +107,7 @@ static PetscErrorCode BorderedSetUpBasis(PC pc, PC_Bordered *bd)
   bd->Astate = sa;
   bd->Wstate = sw;
   bd->nfactor++;
+  PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pc, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 
@@ -152,6 +154,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     PetscCall(PetscMalloc5(bd->k * bd->k, &bd->gram, bd->k, &bd->gram_piv, bd->k * m, &bd->beta, m * m, &bd->S, m, &bd->S_piv));
   }
   PetscCall(BorderedSetUpBasis(pc, bd));
+  PetscCall(PetscLogEventBegin(PHLEX_BorderedSetUp, pc, 0, 0, 0));
 
   PetscCall(PetscMalloc3(bd->k * m, &WtB, m * bd->k, &CtY, m * m, &Dfull));
   {
@@ -199,6 +202,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
   PetscCall(PetscBLASIntCast(m, &mb));
   PetscCallBLAS("LAPACKgetrf", LAPACKgetrf_(&mb, &mb, bd->S, &mb, bd->S_piv, &info));
   PetscCheck(!info, PetscObjectComm((PetscObject)pc), PETSC_ERR_MAT_LU_ZRPVT, "PC phlexbordered: singular Schur complement of the border (LAPACK getrf info %d)", (int)info);
+  PetscCall(PetscLogEventEnd(PHLEX_BorderedSetUp, pc, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 

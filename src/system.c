@@ -377,6 +377,7 @@ PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, 
     PetscReal    Fq[18];
     Vec          Fqv;
     PetscScalar *fa;
+    PetscCall(PetscLogEventBegin(PHLEX_FloatResidual, 0, 0, 0, 0));
     PetscCall(PhlexSystemEvaluateFloating(sys, t, X, Xdot));
     PetscCall(VecAXPY(Fv, -1.0, sys->fs.bext));
     PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &u));
@@ -387,6 +388,7 @@ PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, 
     for (PetscInt k = 0; k < sys->qlocal; k++) fa[k] = Fq[k];
     PetscCall(VecRestoreArray(Fqv, &fa));
     PetscCall(VecRestoreSubVector(F, sys->is[PHLEX_FIELD_RIGID], &Fqv));
+    PetscCall(PetscLogEventEnd(PHLEX_FloatResidual, 0, 0, 0, 0));
   }
 
   PetscCall(VecRestoreSubVector(Xdot, sys->is[PHLEX_FIELD_DISPLACEMENT], &u_t));
@@ -411,6 +413,7 @@ static PetscErrorCode SystemFloatingJacobian(PhlexSystem *sys, PetscReal t, Vec 
   Vec          u, v;
 
   PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_FloatJacobian, 0, 0, 0, 0));
   PetscCall(PhlexSystemEvaluateFloating(sys, t, X, Xdot));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &u));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &v));
@@ -440,6 +443,7 @@ static PetscErrorCode SystemFloatingJacobian(PhlexSystem *sys, PetscReal t, Vec 
   /* the shells' values changed (the dense blocks' states were raised by their array access) */
   PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvv));
   PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvu));
+  PetscCall(PetscLogEventEnd(PHLEX_FloatJacobian, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 
