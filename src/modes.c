@@ -163,6 +163,10 @@ PetscErrorCode PhlexBodyComputeModes(PhlexBody b, const PhlexUnits *units, Petsc
   PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
   PetscCall(EPSSetTarget(eps, sigma));
   PetscCall(EPSSetTolerances(eps, 1e-12, PETSC_DEFAULT));
+  /* B (the velocity mass, or the body's whole kinetic-energy matrix when floating) is positive definite, so the
+     shift-and-invert eigenvectors carry no null-space component to purify; purification costs one more solve per
+     eigenvector (a fifth of the run at 2.2e5 dofs, BENCHMARKS.md) and changed no digit. -modes_eps_purify 1 restores it. */
+  PetscCall(EPSSetPurify(eps, PETSC_FALSE));
   PetscCall(EPSGetST(eps, &st));
   PetscCall(STSetType(st, STSINVERT));
   PetscCall(STGetKSP(st, &ksp));
