@@ -62,25 +62,19 @@ static PetscErrorCode MaterialSetFromOptions(PhlexBody b, PhlexMaterial *m, cons
 
 static PetscErrorCode ICSetFromOptions(PhlexBody b, PhlexIC *ic, const char field[], PetscInt ncomp)
 {
-  char      prefix[128];
-  PetscInt  n;
-  PetscBool flg;
+  char prefix[128], who[PHLEX_NAME_LEN + 8];
 
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sic_%s_", b->prefix, field));
+  PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
   PetscOptionsBegin(b->comm, prefix, "Initial condition options", NULL);
   PetscCall(PetscOptionsEnum("-type", "Initial condition: zero, uniform, rigid (v + w x (x - origin)), beam (Euler-Bernoulli cantilever mode), mode (computed elastic mode)", "PhlexBodySetFromOptions", PhlexICTypes, (PetscEnum)ic->type, (PetscEnum *)&ic->type, NULL));
-  n = ncomp;
-  PetscCall(PetscOptionsRealArray("-value", ncomp == 6 ? "uniform: stress components xx,yy,zz,yz,xz,xy [Pa]" : "uniform/rigid: vector [SI]", "PhlexBodySetFromOptions", ic->value, &n, &flg));
-  PetscCheck(!flg || n == ncomp, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%svalue needs %" PetscInt_FMT " components, got %" PetscInt_FMT, b->name, prefix, ncomp, n);
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-angular", "rigid: angular velocity [rad/s]", "PhlexBodySetFromOptions", ic->angular, &n, NULL));
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-origin", "rigid: point of the rotation axis [m]", "PhlexBodySetFromOptions", ic->origin, &n, NULL));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-value", ncomp == 6 ? "uniform: stress components xx,yy,zz,yz,xz,xy [Pa]" : "uniform/rigid: vector [SI]", "PhlexBodySetFromOptions", ncomp, ic->value, NULL));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-angular", "rigid: angular velocity [rad/s]", "PhlexBodySetFromOptions", 3, ic->angular, NULL));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-origin", "rigid: point of the rotation axis [m]", "PhlexBodySetFromOptions", 3, ic->origin, NULL));
   PetscCall(PetscOptionsInt("-mode", "beam/mode: mode number (1 = lowest)", "PhlexBodySetFromOptions", ic->mode, &ic->mode, NULL));
   PetscCall(PetscOptionsReal("-amplitude", "beam/mode: largest value of the field [SI]", "PhlexBodySetFromOptions", ic->amplitude, &ic->amplitude, NULL));
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-direction", "beam: deflection direction", "PhlexBodySetFromOptions", ic->direction, &n, NULL));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-direction", "beam: deflection direction", "PhlexBodySetFromOptions", 3, ic->direction, NULL));
   PetscOptionsEnd();
   PetscCheck(ic->mode >= 1, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%smode must be >= 1, got %" PetscInt_FMT, b->name, prefix, ic->mode);
   PetscCheck(ncomp == 3 || (ic->type != PHLEX_IC_RIGID && ic->type != PHLEX_IC_BEAM), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%stype %s is not available for the stress", b->name, prefix, PhlexICTypes[ic->type]);
@@ -115,6 +109,8 @@ PetscErrorCode PhlexBodySetFromOptions(PhlexBody b)
   for (PetscInt i = 0; i < PHLEX_MAX_PORTS; i++) pptr[i] = NULL;
   PetscOptionsBegin(b->comm, b->prefix, "Body options", NULL);
   PetscCall(PetscOptionsString("-name", "Name of the body (messages, output files)", "PhlexBodySetFromOptions", b->name, b->name, sizeof(b->name), NULL));
+  char who[PHLEX_NAME_LEN + 8]; /* "body <name>" in messages */
+  PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
   PetscCall(PetscOptionsString("-dm_plex_filename", "gmsh mesh file of the body (.msh 2.2 or 4.1)", "PhlexBodySetFromOptions", b->mesh_file, b->mesh_file, sizeof(b->mesh_file), &flg_mesh));
   PetscCall(PetscOptionsInt("-petscspace_degree", "Velocity degree k (1 or 2); stress: discontinuous degree k-1", "PhlexBodySetFromOptions", b->degree, &b->degree, NULL));
   PetscCall(PetscOptionsString("-frame_patch", "Physical surface where u_f = v_f = 0 (clamped patch, frame origin); empty: free body", "PhlexBodySetFromOptions", b->frame_patch, b->frame_patch, sizeof(b->frame_patch), NULL));
@@ -122,9 +118,7 @@ PetscErrorCode PhlexBodySetFromOptions(PhlexBody b)
   if (!flg) nregions = 0;
   PetscCall(PetscOptionsStringArray("-ports", "Physical surfaces carrying wrench inputs (-port_<name>_force ...)", "PhlexBodySetFromOptions", pptr, &nports, &flg));
   if (!flg) nports = 0;
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-body_force", "Uniform body force density (body frame) [N/m^3]", "PhlexBodySetFromOptions", b->body_force, &n, &b->has_body_force));
-  PetscCheck(!b->has_body_force || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sbody_force needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-body_force", "Uniform body force density (body frame) [N/m^3]", "PhlexBodySetFromOptions", 3, b->body_force, &b->has_body_force));
   {
     PetscInt  motion = b->floating ? 1 : 0, inertia = b->frozen_inertia ? 1 : 0;
     PetscReal quat[4] = {1, 0, 0, 0}, aa[4] = {1, 0, 0, 0};
@@ -133,13 +127,9 @@ PetscErrorCode PhlexBodySetFromOptions(PhlexBody b)
     PetscCall(PetscOptionsEList("-inertia", "Floating body: inertia with x + u_f (full) or at u_f = 0 (frozen, quadratic Hamiltonian)", "PhlexBodySetFromOptions", PhlexInertiaTypes, 2, PhlexInertiaTypes[inertia], &inertia, NULL));
     b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
     b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
-    n                 = 3;
-    PetscCall(PetscOptionsRealArray("-position", "Floating body: initial position r_P of the frame origin (default: the frame-patch centroid, i.e. the mesh as drawn) [m]", "PhlexBodySetFromOptions", b->position0, &n, &fp));
-    PetscCheck(!fp || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sposition needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-position", "Floating body: initial position r_P of the frame origin (default: the frame-patch centroid, i.e. the mesh as drawn) [m]", "PhlexBodySetFromOptions", 3, b->position0, &fp));
     b->position_given = fp;
-    n                 = 4;
-    PetscCall(PetscOptionsRealArray("-orientation_quaternion", "Floating body: initial orientation R as a quaternion w,x,y,z [-]", "PhlexBodySetFromOptions", quat, &n, &fq));
-    PetscCheck(!fq || n == 4, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sorientation_quaternion needs 4 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-orientation_quaternion", "Floating body: initial orientation R as a quaternion w,x,y,z [-]", "PhlexBodySetFromOptions", 4, quat, &fq));
     n = 4;
     PetscCall(PetscOptionsRealArray("-orientation_axis_angle", "Floating body: initial orientation R as axis x,y,z and angle [deg]", "PhlexBodySetFromOptions", aa, &n, &fa));
     PetscCheck(!fa || n == 4, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sorientation_axis_angle needs 4 numbers (axis, angle in degrees), got %" PetscInt_FMT, b->name, b->prefix, n);
@@ -152,18 +142,10 @@ PetscErrorCode PhlexBodySetFromOptions(PhlexBody b)
       PetscCheck(aa[0] * aa[0] + aa[1] * aa[1] + aa[2] * aa[2] > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: the axis of -%sorientation_axis_angle must not be zero", b->name, b->prefix);
       PhlexAxisAngleToRotation(aa, aa[3] * PETSC_PI / 180.0, b->rotation0);
     }
-    n = 3;
-    PetscCall(PetscOptionsRealArray("-velocity", "Floating body: initial velocity v_P of the frame origin (body frame) [m/s]", "PhlexBodySetFromOptions", b->velocity0, &n, &fv));
-    PetscCheck(!fv || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%svelocity needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
-    n = 3;
-    PetscCall(PetscOptionsRealArray("-angular_velocity", "Floating body: initial angular velocity w_P (body frame) [rad/s]", "PhlexBodySetFromOptions", b->omega0, &n, &fw));
-    PetscCheck(!fw || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sangular_velocity needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
-    n = 3;
-    PetscCall(PetscOptionsRealArray("-frame_force", "Floating body: force on the frame origin (body frame) [N]", "PhlexBodySetFromOptions", b->frame_force, &n, &ff));
-    PetscCheck(!ff || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sframe_force needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
-    n = 3;
-    PetscCall(PetscOptionsRealArray("-frame_moment", "Floating body: moment about the frame origin (body frame) [N m]", "PhlexBodySetFromOptions", b->frame_moment, &n, &fm));
-    PetscCheck(!fm || n == 3, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sframe_moment needs 3 components, got %" PetscInt_FMT, b->name, b->prefix, n);
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-velocity", "Floating body: initial velocity v_P of the frame origin (body frame) [m/s]", "PhlexBodySetFromOptions", 3, b->velocity0, &fv));
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-angular_velocity", "Floating body: initial angular velocity w_P (body frame) [rad/s]", "PhlexBodySetFromOptions", 3, b->omega0, &fw));
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_force", "Floating body: force on the frame origin (body frame) [N]", "PhlexBodySetFromOptions", 3, b->frame_force, &ff));
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_moment", "Floating body: moment about the frame origin (body frame) [N m]", "PhlexBodySetFromOptions", 3, b->frame_moment, &fm));
     b->frame_loaded = (ff || fm) ? PETSC_TRUE : PETSC_FALSE;
     /* a fixed body has no rigid state: its rigid options would be silently ignored */
     if (!b->floating) {

@@ -61,3 +61,17 @@ PetscErrorCode PhlexErrorHandlerPush(void)
   PetscCall(PetscPushErrorHandler(PhlexErrorHandler, NULL));
   PetscFunctionReturn(0);
 }
+
+/* A real-array option that must have exactly n numbers when given (inside PetscOptionsBegin/End, whose
+   PetscOptionsObject is passed on). A wrong count is an input error naming what it belongs to and the option. */
+PetscErrorCode PhlexOptionsRealN(PetscOptionItems *PetscOptionsObject, MPI_Comm comm, const char what[], const char prefix[], const char opt[], const char text[], const char man[], PetscInt n, PetscReal value[], PetscBool *set)
+{
+  PetscInt  got = n;
+  PetscBool flg = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsRealArray(opt, text, man, value, &got, &flg));
+  PetscCheck(!flg || got == n, comm, PETSC_ERR_USER_INPUT, "%s: option -%s%s needs %" PetscInt_FMT " components, got %" PetscInt_FMT, what, prefix, opt + 1, n, got);
+  if (set) *set = flg;
+  PetscFunctionReturn(0);
+}

@@ -244,7 +244,6 @@ static PetscErrorCode PortDistAdd(void *ctx, PetscInt nq, const PetscReal *x, co
 PetscErrorCode PhlexPortSetFromOptions(PhlexBody body, PhlexPort p)
 {
   char      prefix[256], what[256];
-  PetscInt  n;
   PetscBool flg_force = PETSC_FALSE, flg_traction = PETSC_FALSE, flg_moment = PETSC_FALSE;
   PetscReal traction[3] = {0, 0, 0};
 
@@ -252,15 +251,9 @@ PetscErrorCode PhlexPortSetFromOptions(PhlexBody body, PhlexPort p)
   PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sport_%s_", body->prefix, p->name));
   PetscCall(PetscSNPrintf(what, sizeof(what), "body %s, port %s", body->name, p->name));
   PetscOptionsBegin(body->comm, prefix, "Port options", NULL);
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-force", "Force amplitude on the port (body frame) [N]", "PhlexPortSetFromOptions", p->force, &n, &flg_force));
-  PetscCheck(!flg_force || n == 3, body->comm, PETSC_ERR_USER_INPUT, "%s: option -%sforce needs 3 components, got %" PetscInt_FMT, what, prefix, n);
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-moment", "Moment amplitude about the patch centroid (body frame) [N m]", "PhlexPortSetFromOptions", p->moment, &n, &flg_moment));
-  PetscCheck(!flg_moment || n == 3, body->comm, PETSC_ERR_USER_INPUT, "%s: option -%smoment needs 3 components, got %" PetscInt_FMT, what, prefix, n);
-  n = 3;
-  PetscCall(PetscOptionsRealArray("-traction", "Uniform traction amplitude (body frame) [Pa], alternative to -force", "PhlexPortSetFromOptions", traction, &n, &flg_traction));
-  PetscCheck(!flg_traction || n == 3, body->comm, PETSC_ERR_USER_INPUT, "%s: option -%straction needs 3 components, got %" PetscInt_FMT, what, prefix, n);
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, body->comm, what, prefix, "-force", "Force amplitude on the port (body frame) [N]", "PhlexPortSetFromOptions", 3, p->force, &flg_force));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, body->comm, what, prefix, "-moment", "Moment amplitude about the patch centroid (body frame) [N m]", "PhlexPortSetFromOptions", 3, p->moment, &flg_moment));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, body->comm, what, prefix, "-traction", "Uniform traction amplitude (body frame) [Pa], alternative to -force", "PhlexPortSetFromOptions", 3, traction, &flg_traction));
   PetscOptionsEnd();
   PetscCheck(!(flg_force && flg_traction), body->comm, PETSC_ERR_USER_INPUT, "%s: give either -%sforce or -%straction, not both", what, prefix, prefix);
   if (flg_traction) {
