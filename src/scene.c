@@ -43,10 +43,7 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
   PetscCall(PetscOptionsReal("-scale_length", "Reference length of the non-dimensionalisation [m] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_length, &s->scale_length, NULL));
   PetscCall(PetscOptionsReal("-scale_density", "Reference density [kg/m^3] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_density, &s->scale_density, NULL));
   PetscCall(PetscOptionsReal("-scale_modulus", "Reference modulus [Pa] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_modulus, &s->scale_modulus, NULL));
-  {
-    PetscInt n = 3;
-    PetscCall(PetscOptionsRealArray("-gravity", "Gravitational acceleration (inertial frame) acting on floating bodies [m/s^2]", "PhlexSceneSetFromOptions", s->gravity, &n, NULL));
-  }
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, s->comm, "scene", "", "-gravity", "Gravitational acceleration (inertial frame) acting on floating bodies [m/s^2]", "PhlexSceneSetFromOptions", 3, s->gravity, NULL));
   PetscOptionsEnd();
   PetscCheck(s->nbodies == 1, s->comm, PETSC_ERR_SUP, "-num_bodies %" PetscInt_FMT ": this version simulates one body per scene", s->nbodies);
   PetscCheck(s->scale_length >= 0 && s->scale_density >= 0 && s->scale_modulus >= 0, s->comm, PETSC_ERR_USER_INPUT, "-scale_length, -scale_density and -scale_modulus must be positive (or 0 for automatic)");
