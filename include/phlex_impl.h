@@ -326,8 +326,10 @@ PETSC_INTERN PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *);
 /* modes.c */
 PETSC_INTERN PetscErrorCode PhlexBodyComputeModes(PhlexBody, const PhlexUnits *, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
 
-/* expect.c: self-verification */
+/* error.c: option input with checked length */
 PETSC_INTERN PetscErrorCode PhlexOptionsRealN(PetscOptionItems *, MPI_Comm, const char[], const char[], const char[], const char[], const char[], PetscInt, PetscReal[], PetscBool *);
+
+/* expect.c: self-verification */
 PETSC_INTERN PetscErrorCode PhlexExpectMax(MPI_Comm, const char[], const char[], PetscReal, PetscReal, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexExpectValues(MPI_Comm, const char[], const char[], PetscInt, const PetscReal[], PetscInt, const PetscReal[], PetscReal);
 
