@@ -157,7 +157,7 @@ static inline void InertiaFromE(const PetscReal E[9], PetscReal J[9])
 PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, PetscReal t, Vec u, Vec v, Vec ud, Vec vd, const PetscReal q[18], const PetscReal qd[18], PhlexFloatingState *f)
 {
   const PetscBool    full = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
-  const PetscScalar *ta, *wa, *ua, *va, *uda = NULL, *vda = NULL, *Mua, *Mvva, *Muda = NULL, *Mvda = NULL;
+  const PetscScalar *ta, *wa, *ua, *va, *uda = NULL, *vda = NULL, *Mua, *Mvva, *Mvda = NULL;
   PetscInt           n, nloc;
   PetscReal          loc[3 + 3 + 3 + 3 + 9 + 9 + 9 + 9 + 9 + 9 + 9 + 9], glob[84];
   PetscReal         *U = loc, *Ud = loc + 3, *Vf = loc + 6, *Vfd = loc + 9, *Wu = loc + 12, *Wud = loc + 21, *Wv = loc + 30, *Wvd = loc + 39, *Nuu = loc + 48, *Nudu = loc + 57, *Nuv = loc + 66, *Nuvd = loc + 75;
@@ -202,7 +202,6 @@ PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, Petsc
   if (vd) PetscCall(VecGetArrayRead(vd, &vda));
   PetscCall(VecGetArrayRead(f->Mu, &Mua));
   PetscCall(VecGetArrayRead(f->Mvv, &Mvva));
-  PetscCall(VecGetArrayRead(f->Mud, &Muda));
   PetscCall(VecGetArrayRead(f->Mvd, &Mvda));
   LocalTdot(nloc, ta, ua, U);
   LocalTdot(nloc, ta, va, Vf);
@@ -228,7 +227,6 @@ PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, Petsc
   if (vd) PetscCall(VecRestoreArrayRead(vd, &vda));
   PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
   PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
-  PetscCall(VecRestoreArrayRead(f->Mud, &Muda));
   PetscCall(VecRestoreArrayRead(f->Mvd, &Mvda));
   PetscCall(MPIU_Allreduce(loc, glob, 84, MPIU_REAL, MPI_SUM, b->comm));
   U = glob; Ud = glob + 3; Vf = glob + 6; Vfd = glob + 9; Wu = glob + 12; Wud = glob + 21; Wv = glob + 30; Wvd = glob + 39; Nuu = glob + 48; Nudu = glob + 57; Nuv = glob + 66; Nuvd = glob + 75;
