@@ -19,7 +19,7 @@ CFLAGS    ?= -O2 -g
 CFLAGS    += -std=c99 -Wall -Wextra -Wno-unused-parameter -MMD -MP
 LDLIBS    = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -llapack -lblas -lm
 
-SRC       := $(sort $(wildcard src/*.c))
+SRC       := $(sort $(wildcard src/*.c src/*/*.c))
 OBJ       := $(patsubst src/%.c,build/%.o,$(SRC))
 BIN       := bin/phlex
 
@@ -33,10 +33,11 @@ all: $(BIN)
 $(BIN): $(OBJ) | bin
 	$(CC) $(CFLAGS) -o $@ $(OBJ) $(LDLIBS)
 
-build/%.o: src/%.c | build
+build/%.o: src/%.c
+	@mkdir -p $(@D)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
-bin build:
+bin:
 	@mkdir -p $@
 
 deps:
@@ -63,7 +64,7 @@ bench: $(BIN)
 	@$(MAKE) --no-print-directory -C bench
 
 format:
-	clang-format -i src/*.c include/*.h
+	clang-format -i src/*.c src/*/*.c include/*.h include/private/*.h
 
 clean:
 	rm -rf build bin

@@ -1,5 +1,5 @@
 /* phlex: flexible multibody dynamics of 3D elastic bodies in port-Hamiltonian form (PETSc/SLEPc).
-   Public handles, enums and prototypes. The structs live in phlex_impl.h. */
+   Public handles, enums and prototypes. The structs live in phlex_impl.h and include/private/. */
 #ifndef PHLEX_H
 #define PHLEX_H
 
@@ -8,8 +8,8 @@
 #include <slepceps.h>
 
 typedef struct _p_PhlexScene   *PhlexScene;
-typedef struct _p_PhlexBody    *PhlexBody;
-typedef struct _p_PhlexPort    *PhlexPort;
+typedef struct _p_PhlexPart    *PhlexPart;  /* any part of a mechanism: flexible body, rigid body, lumped mass, ground */
+typedef struct _p_PhlexJoint   *PhlexJoint; /* a transformer interconnection between two ports */
 typedef struct _p_PhlexProfile *PhlexProfile;
 typedef struct _p_PhlexOutput  *PhlexOutput;
 
@@ -19,7 +19,8 @@ typedef enum {
 } PhlexAnalysisType;
 PETSC_EXTERN const char *const PhlexAnalysisTypes[];
 
-/* Reference scales of the non-dimensionalisation (SI). Every internal quantity is divided by its scale. */
+/* Reference scales of the non-dimensionalisation (SI), one set for the whole scene. Every internal quantity is
+   divided by its scale. */
 typedef struct {
   PetscReal length;   /* L [m] */
   PetscReal density;  /* rho_ref [kg/m^3] */
@@ -34,7 +35,7 @@ typedef struct {
 
 /* log.c */
 PETSC_EXTERN PetscClassId  PHLEX_CLASSID;
-PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp;
+PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly;
 PETSC_EXTERN PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes, PHLEX_StageOutput;
 PETSC_EXTERN PetscErrorCode PhlexLogRegister(void);
 
@@ -45,6 +46,7 @@ PETSC_EXTERN PetscErrorCode PhlexErrorHandlerPush(void);
 PETSC_EXTERN PetscErrorCode PhlexProfileCreate(MPI_Comm, const char[], const char[], PhlexProfile *);
 PETSC_EXTERN PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile);
 PETSC_EXTERN PetscErrorCode PhlexProfileEvaluate(PhlexProfile, PetscReal, PetscReal *);
+PETSC_EXTERN PetscErrorCode PhlexProfileIntegrate(PhlexProfile, PetscReal, PetscReal *);
 PETSC_EXTERN PetscErrorCode PhlexProfileView(PhlexProfile, PetscViewer);
 PETSC_EXTERN PetscErrorCode PhlexProfileDescribe(PhlexProfile, char[], size_t);
 PETSC_EXTERN PetscErrorCode PhlexProfileDestroy(PhlexProfile *);
@@ -57,14 +59,21 @@ PETSC_EXTERN PetscErrorCode PhlexSceneGetAnalysis(PhlexScene, PhlexAnalysisType 
 PETSC_EXTERN PetscErrorCode PhlexSceneView(PhlexScene, PetscViewer);
 PETSC_EXTERN PetscErrorCode PhlexSceneDestroy(PhlexScene *);
 
-/* body.c */
-PETSC_EXTERN PetscErrorCode PhlexBodyCreate(MPI_Comm, PetscInt, PhlexBody *);
-PETSC_EXTERN PetscErrorCode PhlexBodySetFromOptions(PhlexBody);
-PETSC_EXTERN PetscErrorCode PhlexBodySetUp(PhlexBody, const PhlexUnits *);
-PETSC_EXTERN PetscErrorCode PhlexBodyView(PhlexBody, PetscViewer);
-PETSC_EXTERN PetscErrorCode PhlexBodyDestroy(PhlexBody *);
+/* part.c: the part contract (life cycle; the operations are in include/private/part.h) */
+PETSC_EXTERN PetscErrorCode PhlexPartRegisterAll(void);
+PETSC_EXTERN PetscErrorCode PhlexPartRegister(const char[], PetscErrorCode (*)(PhlexPart));
+PETSC_EXTERN PetscErrorCode PhlexPartCreate(MPI_Comm, PetscInt, PhlexPart *);
+PETSC_EXTERN PetscErrorCode PhlexPartSetFromOptions(PhlexPart);
+PETSC_EXTERN PetscErrorCode PhlexPartView(PhlexPart, PetscViewer);
+PETSC_EXTERN PetscErrorCode PhlexPartDestroy(PhlexPart *);
 
-/* modes.c and integrate.c: the analyses */
+/* joint.c */
+PETSC_EXTERN PetscErrorCode PhlexJointCreate(PhlexScene, PetscInt, PhlexJoint *);
+PETSC_EXTERN PetscErrorCode PhlexJointSetFromOptions(PhlexJoint);
+PETSC_EXTERN PetscErrorCode PhlexJointView(PhlexJoint, PetscViewer);
+PETSC_EXTERN PetscErrorCode PhlexJointDestroy(PhlexJoint *);
+
+/* modes.c and transient.c: the analyses */
 PETSC_EXTERN PetscErrorCode PhlexSceneSolveModes(PhlexScene);
 PETSC_EXTERN PetscErrorCode PhlexSceneSolveTransient(PhlexScene);
 

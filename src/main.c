@@ -2,7 +2,7 @@
    Scene create -> set from options -> set up -> analysis -> destroy. */
 #include <phlex_impl.h>
 
-static const char help[] = "phlex: 3D elastic bodies in port-Hamiltonian form (PETSc/SLEPc).\n"
+static const char help[] = "phlex: flexible multibody dynamics of 3D elastic bodies in port-Hamiltonian form (PETSc/SLEPc).\n"
                            "  bin/phlex -options_file options/<scene>.yaml [-options_file options/solver/<preset>.yaml] [options]\n"
                            "  -help lists every option with its unit; README.md has the option tables.\n";
 
@@ -39,6 +39,7 @@ int main(int argc, char **argv)
   PetscCall(PhlexErrorHandlerPush());
   PetscCall(PhlexLogRegister());
   PetscCall(PhlexPCRegister());
+  PetscCall(PhlexPartRegisterAll());
   ierr = Run(&scene);
   if (ierr) {
     /* no half-written result: remove the run's temporary files; an input error was printed by the handler */

@@ -2,7 +2,7 @@
 #include <phlex.h>
 
 PetscClassId  PHLEX_CLASSID;
-PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp;
+PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly;
 PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes, PHLEX_StageOutput;
 
 /*@C
@@ -26,6 +26,9 @@ PetscErrorCode PhlexLogRegister(void)
   PetscCall(PetscLogEventRegister("PhlexFloatJac", PHLEX_CLASSID, &PHLEX_FloatJacobian));
   PetscCall(PetscLogEventRegister("PhlexBordBasis", PHLEX_CLASSID, &PHLEX_BorderedBasis));
   PetscCall(PetscLogEventRegister("PhlexBordSetUp", PHLEX_CLASSID, &PHLEX_BorderedSetUp));
+  PetscCall(PetscLogEventRegister("PhlexJointResid", PHLEX_CLASSID, &PHLEX_JointResidual));
+  PetscCall(PetscLogEventRegister("PhlexJointJac", PHLEX_CLASSID, &PHLEX_JointJacobian));
+  PetscCall(PetscLogEventRegister("PhlexAssembly", PHLEX_CLASSID, &PHLEX_Assembly));
   PetscCall(PetscLogStageRegister("Phlex Setup", &PHLEX_StageSetup));
   PetscCall(PetscLogStageRegister("Phlex Transient", &PHLEX_StageTransient));
   PetscCall(PetscLogStageRegister("Phlex Modes", &PHLEX_StageModes));

@@ -1,4 +1,5 @@
-/* A flexible body in large rigid motion (paper Sections 2-4): the rigid-elastic coupling of the floating frame.
+/* The dynamics of a moving frame (paper Sections 2-4): a flexible body in large rigid motion with the full
+   rigid-elastic coupling of its floating frame, or a rigid body (the same equations without an elastic field).
 
    State (non-dimensional, body frame): the elastic fields u, v (free velocity dofs, one x,y,z triple per node),
    Sigma, and q = [r (3) | R (9, row-wise) | v_P (3) | w (3)]. With y = x + u the position of a material point
@@ -20,88 +21,7 @@
 #include <phlex_impl.h>
 
 /* ---------------------------------------------------------------------------------------------------------- */
-/* Inertia invariants                                                                                          */
-
-/*@C
-  PhlexBodySetUpFloating - inertia invariants of a floating body about the frame origin P (non-dimensional):
-  m, s0 = int rho x, E0 = int rho x x^T, the volume, int x dV, and the nodal vectors t, w of the elastic space
-
-  Collective
-@*/
-PetscErrorCode PhlexBodySetUpFloating(PhlexBody b, const PhlexUnits *u)
-{
-  PhlexElementBasis V;
-  PetscQuadrature   q;
-  const PetscReal  *qpoints;
-  PetscInt          nq, nn = b->nb_v / 3;
-  PetscReal         loc[1 + 3 + 9 + 1 + 3] = {0}, glob[17];
-
-  PetscFunctionBeginUser;
-  PetscCall(PhlexBodyGetBasis(b, PETSC_FALSE, &V));
-  PetscCall(PetscFEGetQuadrature(b->fe_v, &q));
-  PetscCall(PetscQuadratureGetData(q, NULL, NULL, &nq, &qpoints, NULL));
-  PetscCall(DMCreateGlobalVector(b->dm, &b->tnode));
-  PetscCall(VecDuplicate(b->tnode, &b->wnode));
-  PetscCall(VecDuplicate(b->tnode, &b->vnode));
-  PetscCall(VecSet(b->tnode, 0.0));
-  PetscCall(VecSet(b->wnode, 0.0));
-  PetscCall(VecSet(b->vnode, 0.0));
-  /* closure indices of the frame-patch dofs are negative (constrained): drop them */
-  PetscCall(VecSetOption(b->tnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
-  PetscCall(VecSetOption(b->wnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
-  PetscCall(VecSetOption(b->vnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
-  for (PetscInt c = b->cStart; c < b->cEnd; c++) {
-    const PetscInt      ci  = c - b->cStart;
-    const PhlexMaterial *mat = &b->materials[b->cell_material[ci]];
-    const PetscReal      rho = mat->density / u->density;
-    const PetscInt      *idx = &b->cell_vdofs[ci * b->nb_v];
-    PetscReal            v0[3], J[9], invJ[9], detJ, dV;
-    PetscScalar          te[3 * PHLEX_MAX_NODES], we[3 * PHLEX_MAX_NODES], ve[3 * PHLEX_MAX_NODES];
-
-    PetscCall(DMPlexComputeCellGeometryAffineFEM(b->dm, c, v0, J, invJ, &detJ));
-    for (PetscInt i = 0; i < 3 * nn; i++) te[i] = we[i] = ve[i] = 0.0;
-    for (PetscInt qq = 0; qq < nq; qq++) {
-      PetscReal x[3];
-      /* x relative to P, non-dimensional: x = v0 + J (xi + 1) */
-      for (PetscInt d = 0; d < 3; d++) x[d] = (v0[d] + J[3 * d] * (qpoints[3 * qq] + 1) + J[3 * d + 1] * (qpoints[3 * qq + 1] + 1) + J[3 * d + 2] * (qpoints[3 * qq + 2] + 1) - b->origin[d]) / u->length;
-      dV = V.weights[qq] * detJ / (u->length * u->length * u->length);
-      loc[0] += rho * dV;
-      for (PetscInt d = 0; d < 3; d++) {
-        loc[1 + d] += rho * dV * x[d];
-        loc[14 + d] += dV * x[d];
-        for (PetscInt e = 0; e < 3; e++) loc[4 + 3 * d + e] += rho * dV * x[d] * x[e];
-      }
-      loc[13] += dV;
-      for (PetscInt a = 0; a < nn; a++) {
-        const PetscReal phi = V.node_phi[qq * V.nnodes + a];
-        for (PetscInt d = 0; d < 3; d++) {
-          te[3 * a + d] += rho * dV * phi;
-          we[3 * a + d] += rho * dV * phi * x[d];
-          ve[3 * a + d] += dV * phi;
-        }
-      }
-    }
-    PetscCall(VecSetValues(b->tnode, 3 * nn, idx, te, ADD_VALUES));
-    PetscCall(VecSetValues(b->wnode, 3 * nn, idx, we, ADD_VALUES));
-    PetscCall(VecSetValues(b->vnode, 3 * nn, idx, ve, ADD_VALUES));
-  }
-  PetscCall(PhlexBodyRestoreBasis(&V));
-  PetscCall(VecAssemblyBegin(b->tnode));
-  PetscCall(VecAssemblyEnd(b->tnode));
-  PetscCall(VecAssemblyBegin(b->wnode));
-  PetscCall(VecAssemblyEnd(b->wnode));
-  PetscCall(VecAssemblyBegin(b->vnode));
-  PetscCall(VecAssemblyEnd(b->vnode));
-  PetscCall(MPIU_Allreduce(loc, glob, 17, MPIU_REAL, MPI_SUM, b->comm));
-  b->inertia.m = glob[0];
-  for (PetscInt d = 0; d < 3; d++) {
-    b->inertia.s0[d]   = glob[1 + d];
-    b->inertia.svol[d] = glob[14 + d];
-  }
-  for (PetscInt k = 0; k < 9; k++) b->inertia.E0[k] = glob[4 + k];
-  b->inertia.vol = glob[13];
-  PetscFunctionReturn(0);
-}
+/* Node-wise reductions over the elastic space (local triples, then one reduction)                             */
 
 /* ---------------------------------------------------------------------------------------------------------- */
 /* Node-wise reductions over the elastic space (local triples, then one reduction)                             */
@@ -139,31 +59,33 @@ static inline void InertiaFromE(const PetscReal E[9], PetscReal J[9])
 }
 
 /*@C
-  PhlexFloatingEvaluate - the inertia quantities and momenta of a floating body at a state and its rates
+  PhlexFrameEvaluate - the inertia quantities and momenta of a moving frame at a state and its rates
 
-  Collective
+  Collective (a frame without a field: not collective)
 
   Input Parameters:
-+ b      - the body (floating)
-. units  - scales
-. t      - time [s] (inputs)
-. u, v   - elastic displacement and velocity
++ fr     - the frame
+. u, v   - elastic displacement and velocity (NULL without a field)
 . ud, vd - their rates (non-dimensional time), or NULL (zero)
 . q, qd  - rigid state [r | R | v_P | w] and its rate (qd may be NULL)
+
+  Notes:
+  The external loads (f->Fext, f->Mext about P, f->bext) are set by the caller afterwards, then
+  PhlexFrameAddLoadArms adds the u-dependent moment arms of the full model.
 
   Output Parameter:
 . f - the evaluated context (work vectors inside are reused)
 @*/
-PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, PetscReal t, Vec u, Vec v, Vec ud, Vec vd, const PetscReal q[18], const PetscReal qd[18], PhlexFloatingState *f)
+PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, const PetscReal q[18], const PetscReal qd[18], PhlexFrameState *f)
 {
-  const PetscBool    full = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
+  const PetscBool    full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
   const PetscScalar *ta, *wa, *ua, *va, *uda = NULL, *vda = NULL, *Mua, *Mvva, *Mvda = NULL;
   PetscInt           n, nloc;
   PetscReal          loc[3 + 3 + 3 + 3 + 9 + 9 + 9 + 9 + 9 + 9 + 9 + 9], glob[84];
   PetscReal         *U = loc, *Ud = loc + 3, *Vf = loc + 6, *Vfd = loc + 9, *Wu = loc + 12, *Wud = loc + 21, *Wv = loc + 30, *Wvd = loc + 39, *Nuu = loc + 48, *Nudu = loc + 57, *Nuv = loc + 66, *Nuvd = loc + 75;
 
   PetscFunctionBeginUser;
-  if (!f->Mu) {
+  if (fr->tnode && !f->Mu) {
     PetscCall(VecDuplicate(u, &f->Mu));
     PetscCall(VecDuplicate(u, &f->Mvv));
     PetscCall(VecDuplicate(u, &f->Mud));
@@ -182,20 +104,22 @@ PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, Petsc
     f->R[k]  = q[3 + k];
     f->Rd[k] = qd ? qd[3 + k] : 0.0;
   }
+  PetscCall(PetscArrayzero(loc, 84));
+  PetscCall(PetscArrayzero(glob, 84));
+  if (fr->tnode) {
   /* Mv-products needed by the inertia terms */
-  if (full) PetscCall(MatMult(b->Mv, u, f->Mu));
+  if (full) PetscCall(MatMult(fr->Mv, u, f->Mu));
   else PetscCall(VecSet(f->Mu, 0.0));
-  PetscCall(MatMult(b->Mv, v, f->Mvv));
-  if (full && ud) PetscCall(MatMult(b->Mv, ud, f->Mud));
+  PetscCall(MatMult(fr->Mv, v, f->Mvv));
+  if (full && ud) PetscCall(MatMult(fr->Mv, ud, f->Mud));
   else PetscCall(VecSet(f->Mud, 0.0));
-  if (vd) PetscCall(MatMult(b->Mv, vd, f->Mvd));
+  if (vd) PetscCall(MatMult(fr->Mv, vd, f->Mvd));
   else PetscCall(VecSet(f->Mvd, 0.0));
 
-  PetscCall(PetscArrayzero(loc, 84));
   PetscCall(VecGetLocalSize(u, &n));
   nloc = n / 3;
-  PetscCall(VecGetArrayRead(b->tnode, &ta));
-  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  PetscCall(VecGetArrayRead(fr->tnode, &ta));
+  PetscCall(VecGetArrayRead(fr->wnode, &wa));
   PetscCall(VecGetArrayRead(u, &ua));
   PetscCall(VecGetArrayRead(v, &va));
   if (ud) PetscCall(VecGetArrayRead(ud, &uda));
@@ -219,8 +143,8 @@ PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, Petsc
     /* Nuv collects int rho u_b v_c; the rate of L also needs int rho ud_b v_c: add it into Nuvd */
     if (ud) LocalOuter(nloc, uda, Mvva, Nuvd);
   }
-  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
-  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(VecRestoreArrayRead(fr->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(fr->wnode, &wa));
   PetscCall(VecRestoreArrayRead(u, &ua));
   PetscCall(VecRestoreArrayRead(v, &va));
   if (ud) PetscCall(VecRestoreArrayRead(ud, &uda));
@@ -228,22 +152,23 @@ PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, Petsc
   PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
   PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
   PetscCall(VecRestoreArrayRead(f->Mvd, &Mvda));
-  PetscCall(MPIU_Allreduce(loc, glob, 84, MPIU_REAL, MPI_SUM, b->comm));
+  PetscCall(MPIU_Allreduce(loc, glob, 84, MPIU_REAL, MPI_SUM, fr->comm));
+  }
   U = glob; Ud = glob + 3; Vf = glob + 6; Vfd = glob + 9; Wu = glob + 12; Wud = glob + 21; Wv = glob + 30; Wvd = glob + 39; Nuu = glob + 48; Nudu = glob + 57; Nuv = glob + 66; Nuvd = glob + 75;
 
   /* s, E, J and rates (paper eq. momenta with s_u, J_u) */
-  f->m = b->inertia.m;
+  f->m = fr->inertia.m;
   for (PetscInt k = 0; k < 3; k++) {
-    f->s[k]    = b->inertia.s0[k] + (full ? U[k] : 0.0);
+    f->s[k]    = fr->inertia.s0[k] + (full ? U[k] : 0.0);
     f->sd[k]   = full ? Ud[k] : 0.0;
     f->Vf[k]   = Vf[k];
     f->Vfd[k]  = Vfd[k];
-    f->sgrav[k] = b->inertia.s0[k] + U[k]; /* gravity acts on the current position in either model */
+    f->sgrav[k] = fr->inertia.s0[k] + U[k]; /* gravity acts on the current position in either model */
   }
   for (PetscInt bb = 0; bb < 3; bb++)
     for (PetscInt c = 0; c < 3; c++) {
       const PetscInt k = 3 * bb + c, kt = 3 * c + bb;
-      f->E[k]  = b->inertia.E0[k] + (full ? Wu[k] + Wu[kt] + Nuu[k] : 0.0);
+      f->E[k]  = fr->inertia.E0[k] + (full ? Wu[k] + Wu[kt] + Nuu[k] : 0.0);
       f->Ed[k] = full ? Wud[k] + Wud[kt] + Nudu[k] + Nudu[kt] : 0.0;
     }
   InertiaFromE(f->E, f->J);
@@ -256,6 +181,7 @@ PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, Petsc
     }
     Eps(K, f->L);
     Eps(Kd, f->Ld);
+    Eps(Wv, f->Lx);
   }
   /* momenta and their rates */
   {
@@ -277,58 +203,26 @@ PetscErrorCode PhlexFloatingEvaluate(PhlexBody b, const PhlexUnits *units, Petsc
     PhlexMatVec3(f->J, f->wd, c);
     for (PetscInt k = 0; k < 3; k++) f->prd[k] += a[k] + c[k];
   }
-  /* gravity in the body frame and the inputs */
-  PhlexMatTVec3(f->R, b->gravity, f->gbody);
-  PetscCall(PhlexFloatingInputs(b, units, t, u, f));
+  /* gravity in the body frame */
+  PhlexMatTVec3(f->R, fr->gravity, f->gbody);
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexFloatingInputs - external loads of a floating body at time t: the elastic load b_ext (ports and body force)
-  and the resultant force and moment about P on the frame (ports, frame wrench, body force); in the full model the
-  moment arms include u (sum_l u(l) x b_ext(l))
+  PhlexFrameAddLoadArms - adds to the moment about P the u-dependent arms of the elastic load in the full model,
+  sum_l u(l) x b_ext(l) (the caller has set f->bext, f->Fext and f->Mext)
 
   Collective
 @*/
-PetscErrorCode PhlexFloatingInputs(PhlexBody b, const PhlexUnits *units, PetscReal t, Vec u, PhlexFloatingState *f)
+PetscErrorCode PhlexFrameAddLoadArms(PhlexFrame *fr, Vec u, PhlexFrameState *f)
 {
   PetscReal          Mloc[3] = {0, 0, 0}, Mu[3];
   const PetscScalar *ua, *ba;
   PetscInt           n;
 
   PetscFunctionBeginUser;
-  PetscCall(PhlexBodyLoadVector(b, t, units, f->bext));
-  for (PetscInt k = 0; k < 3; k++) f->Fext[k] = f->Mext[k] = 0.0;
-  for (PetscInt p = 0; p < b->nports; p++) {
-    PetscReal in[6], c[3], a[3];
-    if (!b->ports[p].loaded) continue;
-    PetscCall(PhlexPortInput(&b->ports[p], t, units, in));
-    for (PetscInt k = 0; k < 3; k++) c[k] = (b->ports[p].centroid[k] - b->origin[k]) / units->length;
-    PhlexCross(c, in, a);
-    for (PetscInt k = 0; k < 3; k++) {
-      f->Fext[k] += in[k];
-      f->Mext[k] += a[k] + in[3 + k];
-    }
-  }
-  if (b->frame_loaded) {
-    PetscReal fr;
-    PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
-    for (PetscInt k = 0; k < 3; k++) {
-      f->Fext[k] += fr * b->frame_force[k] / units->force;
-      f->Mext[k] += fr * b->frame_moment[k] / (units->force * units->length);
-    }
-  }
-  if (b->has_body_force) {
-    PetscReal fr, beta[3], a[3];
-    PetscCall(PhlexProfileEvaluate(b->body_force_profile, t, &fr));
-    for (PetscInt k = 0; k < 3; k++) beta[k] = fr * b->body_force[k] * units->length / units->modulus;
-    PhlexCross(b->inertia.svol, beta, a);
-    for (PetscInt k = 0; k < 3; k++) {
-      f->Fext[k] += b->inertia.vol * beta[k];
-      f->Mext[k] += a[k];
-    }
-  }
-  if (!b->frozen_inertia) {
+  if (!fr->tnode) PetscFunctionReturn(0);
+  if (!fr->frozen) {
     PetscCall(VecGetLocalSize(u, &n));
     PetscCall(VecGetArrayRead(u, &ua));
     PetscCall(VecGetArrayRead(f->bext, &ba));
@@ -343,21 +237,22 @@ PetscErrorCode PhlexFloatingInputs(PhlexBody b, const PhlexUnits *units, PetscRe
     }
     PetscCall(VecRestoreArrayRead(u, &ua));
     PetscCall(VecRestoreArrayRead(f->bext, &ba));
-    PetscCall(MPIU_Allreduce(Mloc, Mu, 3, MPIU_REAL, MPI_SUM, b->comm));
+    PetscCall(MPIU_Allreduce(Mloc, Mu, 3, MPIU_REAL, MPI_SUM, fr->comm));
     for (PetscInt k = 0; k < 3; k++) f->Mext[k] += Mu[k];
   }
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexFloatingResidual - adds the floating-frame terms to the elastic momentum residual Fv (which already holds
-  Mv v' + G^T Sigma - b_ext) and computes the 18 rigid residuals Fq (all in non-dimensional time)
+  PhlexFrameResidual - adds the moving-frame terms to the elastic momentum residual Fv (which already holds
+  Mv v' + G^T Sigma - b_ext; NULL without a field) and computes the 18 rigid residuals Fq (all in non-dimensional
+  time)
 
-  Collective
+  Collective (without a field: not collective)
 @*/
-PetscErrorCode PhlexFloatingResidual(PhlexBody b, PhlexFloatingState *f, Vec u, Vec v, Vec ud, Vec Fv, PetscReal Fq[18])
+PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec v, Vec ud, Vec Fv, PetscReal Fq[18])
 {
-  const PetscBool    full = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
+  const PetscBool    full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
   PetscScalar       *fa;
   const PetscScalar *ta, *wa, *ua, *va, *uda, *Mua, *Mvva, *Muda;
   PetscInt           n;
@@ -393,10 +288,11 @@ PetscErrorCode PhlexFloatingResidual(PhlexBody b, PhlexFloatingState *f, Vec u, 
     C[8] += w2;
   }
   PhlexSkew(f->wd, wdxw);
+  if (!fr->tnode) PetscFunctionReturn(0);
   PetscCall(VecGetLocalSize(u, &n));
   PetscCall(VecGetArray(Fv, &fa));
-  PetscCall(VecGetArrayRead(b->tnode, &ta));
-  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  PetscCall(VecGetArrayRead(fr->tnode, &ta));
+  PetscCall(VecGetArrayRead(fr->wnode, &wa));
   PetscCall(VecGetArrayRead(u, &ua));
   PetscCall(VecGetArrayRead(v, &va));
   PetscCall(VecGetArrayRead(f->Mu, &Mua));
@@ -428,8 +324,8 @@ PetscErrorCode PhlexFloatingResidual(PhlexBody b, PhlexFloatingState *f, Vec u, 
     for (PetscInt k = 0; k < 3; k++) fa[3 * l + k] += acc[k];
   }
   PetscCall(VecRestoreArray(Fv, &fa));
-  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
-  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(VecRestoreArrayRead(fr->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(fr->wnode, &wa));
   PetscCall(VecRestoreArrayRead(u, &ua));
   PetscCall(VecRestoreArrayRead(v, &va));
   PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
@@ -448,7 +344,7 @@ static inline void InertiaDerivative(const PetscReal z[3], const PetscReal w[3],
 }
 
 /*@C
-  PhlexFloatingJacobian - dF/dX + shift dF/dX' of the floating-frame terms (non-dimensional shift)
+  PhlexFrameJacobian - dF/dX + shift dF/dX' of the floating-frame terms (non-dimensional shift)
 
   Collective
 
@@ -462,10 +358,10 @@ static inline void InertiaDerivative(const PetscReal z[3], const PetscReal w[3],
   Notes:
   Rigid unknowns in the order r (0-2), R (3-11, row-wise), v_P (12-14), w (15-17).
 @*/
-PetscErrorCode PhlexFloatingJacobian(PhlexBody b, PhlexFloatingState *f, PetscReal shift, Vec u, Vec v, PetscScalar *Bc, PetscScalar *Cu, PetscScalar *Cv, PetscInt ld, PetscReal Bvv[9], PetscReal Bvu[9], PetscReal Arr[324])
+PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal shift, Vec u, Vec v, PetscScalar *Bc, PetscScalar *Cu, PetscScalar *Cv, PetscInt ld, PetscReal Bvv[9], PetscReal Bvu[9], PetscReal Arr[324])
 {
-  const PetscBool    full = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
-  const PetscReal   *w = f->w, *wd = f->wd, *vP = f->vP, *g = b->gravity;
+  const PetscBool    full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
+  const PetscReal   *w = f->w, *wd = f->wd, *vP = f->vP, *g = fr->gravity;
   const PetscScalar *ta, *wa, *Mua, *Mvva, *Muda, *Mvda, *ba;
   PetscInt           n;
   PetscReal          S[9], C[9], sx[9];
@@ -556,9 +452,10 @@ PetscErrorCode PhlexFloatingJacobian(PhlexBody b, PhlexFloatingState *f, PetscRe
 #undef A
 
   /* field borders, node by node */
+  if (!fr->tnode) PetscFunctionReturn(0);
   PetscCall(VecGetLocalSize(u, &n));
-  PetscCall(VecGetArrayRead(b->tnode, &ta));
-  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  PetscCall(VecGetArrayRead(fr->tnode, &ta));
+  PetscCall(VecGetArrayRead(fr->wnode, &wa));
   PetscCall(VecGetArrayRead(f->Mu, &Mua));
   PetscCall(VecGetArrayRead(f->Mvv, &Mvva));
   PetscCall(VecGetArrayRead(f->Mud, &Muda));
@@ -659,8 +556,8 @@ PetscErrorCode PhlexFloatingJacobian(PhlexBody b, PhlexFloatingState *f, PetscRe
       }
     }
   }
-  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
-  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(VecRestoreArrayRead(fr->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(fr->wnode, &wa));
   PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
   PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
   PetscCall(VecRestoreArrayRead(f->Mud, &Muda));
@@ -670,81 +567,30 @@ PetscErrorCode PhlexFloatingJacobian(PhlexBody b, PhlexFloatingState *f, PetscRe
 }
 
 /*@C
-  PhlexFloatingPortOutputs - collocated outputs of the ports of a floating body (non-dimensional): the port
-  distributions applied to the velocity field v_P + w x (x - P [+ u]) + v, i.e. the rigid part
-  (v_P + w x (c - P), w) plus B^T (v [+ w x u]); u enters in the full model only, as in the moment arms of the inputs,
-  so that F . y_v + T . y_w is exactly the power of the port
+  PhlexFrameEnergy - kinetic energy T = 1/2 int rho |V|^2 and gravity potential -g . (m r + R s) (non-dimensional)
 
-  Collective
-
-  Input Parameters:
-+ b      - the body
-. units  - scales
-. vP, w  - frame velocity and angular velocity (body frame)
-. u, v   - elastic displacement and velocity
-- work   - a work vector of the velocity space
-
-  Output Parameter:
-. y - outputs per port
+  Collective with a field (uses an evaluated state)
 @*/
-PetscErrorCode PhlexFloatingPortOutputs(PhlexBody b, const PhlexUnits *units, const PetscReal vP[3], const PetscReal w[3], Vec u, Vec v, Vec work, PetscReal y[][6])
+PetscErrorCode PhlexFrameEnergy(PhlexFrame *fr, PhlexFrameState *f, Vec v, PetscReal *kinetic, PetscReal *potential)
 {
-  PetscFunctionBeginUser;
-  PetscCall(VecCopy(v, work));
-  if (!b->frozen_inertia) {
-    const PetscScalar *ua;
-    PetscScalar       *wa;
-    PetscInt           n;
-    PetscCall(VecGetLocalSize(u, &n));
-    PetscCall(VecGetArrayRead(u, &ua));
-    PetscCall(VecGetArray(work, &wa));
-    for (PetscInt l = 0; l < n / 3; l++) {
-      PetscReal x[3], a[3];
-      for (PetscInt k = 0; k < 3; k++) x[k] = PetscRealPart(ua[3 * l + k]);
-      PhlexCross(w, x, a);
-      for (PetscInt k = 0; k < 3; k++) wa[3 * l + k] += a[k];
-    }
-    PetscCall(VecRestoreArrayRead(u, &ua));
-    PetscCall(VecRestoreArray(work, &wa));
-  }
-  PetscCall(PhlexBodyPortOutputs(b, work, y));
-  for (PetscInt p = 0; p < b->nports; p++) {
-    PetscReal c[3], a[3];
-    for (PetscInt k = 0; k < 3; k++) c[k] = (b->ports[p].centroid[k] - b->origin[k]) / units->length;
-    PhlexCross(w, c, a);
-    for (PetscInt k = 0; k < 3; k++) {
-      y[p][k] += vP[k] + a[k];
-      y[p][3 + k] += w[k];
-    }
-  }
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexFloatingEnergy - kinetic energy T = 1/2 int rho |V|^2 and gravity potential -g . (m r + R s) (non-dimensional)
-
-  Not collective (uses an evaluated state)
-@*/
-PetscErrorCode PhlexFloatingEnergy(PhlexBody b, PhlexFloatingState *f, Vec v, PetscReal *kinetic, PetscReal *potential)
-{
-  PetscScalar vMv;
+  PetscScalar vMv = 0.0;
   PetscReal   a[3], Jw[3], Rs[3];
 
   PetscFunctionBeginUser;
-  PetscCall(VecDot(v, f->Mvv, &vMv));
+  if (fr->tnode) PetscCall(VecDot(v, f->Mvv, &vMv));
   PhlexCross(f->w, f->s, a);
   PhlexMatVec3(f->J, f->w, Jw);
   *kinetic = 0.5 * f->m * PhlexDot3(f->vP, f->vP) + PhlexDot3(f->vP, a) + 0.5 * PhlexDot3(f->w, Jw) + PhlexDot3(f->vP, f->Vf) + PhlexDot3(f->w, f->L) + 0.5 * PetscRealPart(vMv);
   PhlexMatVec3(f->R, f->sgrav, Rs);
-  *potential = -(f->m * PhlexDot3(b->gravity, f->r) + PhlexDot3(b->gravity, Rs));
+  *potential = -(f->m * PhlexDot3(fr->gravity, f->r) + PhlexDot3(fr->gravity, Rs));
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexFloatingMomenta - inertial linear momentum R p_t and angular momentum about the inertial origin
+  PhlexFrameMomenta - inertial linear momentum R p_t and angular momentum about the inertial origin
   R p_r + r x R p_t (non-dimensional)
 @*/
-PetscErrorCode PhlexFloatingMomenta(PhlexFloatingState *f, PetscReal P[3], PetscReal L[3])
+PetscErrorCode PhlexFrameMomenta(PhlexFrameState *f, PetscReal P[3], PetscReal L[3])
 {
   PetscReal a[3];
 
@@ -757,9 +603,9 @@ PetscErrorCode PhlexFloatingMomenta(PhlexFloatingState *f, PetscReal P[3], Petsc
 }
 
 /*@C
-  PhlexFloatingStateDestroy - frees the work vectors of an evaluation context
+  PhlexFrameStateDestroy - frees the work vectors of an evaluation context
 @*/
-PetscErrorCode PhlexFloatingStateDestroy(PhlexFloatingState *f)
+PetscErrorCode PhlexFrameStateDestroy(PhlexFrameState *f)
 {
   PetscFunctionBeginUser;
   PetscCall(VecDestroy(&f->Mu));
@@ -767,5 +613,62 @@ PetscErrorCode PhlexFloatingStateDestroy(PhlexFloatingState *f)
   PetscCall(VecDestroy(&f->Mud));
   PetscCall(VecDestroy(&f->Mvd));
   PetscCall(VecDestroy(&f->bext));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFrameRigidMass - the mass matrix of the frame's rigid motion (v_P, w) at u = 0: [[m I, -[s0]x], [[s0]x, J0]]
+  (row-major 6 x 6)
+@*/
+PetscErrorCode PhlexFrameRigidMass(const PhlexInertia *in, PetscReal M[36])
+{
+  PetscReal S[9], J[9];
+
+  PetscFunctionBeginUser;
+  PhlexSkew(in->s0, S);
+  InertiaFromE(in->E0, J);
+  for (PetscInt i = 0; i < 3; i++)
+    for (PetscInt j = 0; j < 3; j++) {
+      M[6 * i + j]           = i == j ? in->m : 0.0;
+      M[6 * i + 3 + j]       = -S[3 * i + j];
+      M[6 * (3 + i) + j]     = S[3 * i + j];
+      M[6 * (3 + i) + 3 + j] = J[3 * i + j];
+    }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFrameWriteHeader - the header of a frame's CSV series (<part>_rigid.csv)
+@*/
+PetscErrorCode PhlexFrameWriteHeader(char header[], size_t len)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(header, "time,rx,ry,rz,cx,cy,cz,R11,R12,R13,R21,R22,R23,R31,R32,R33,qw,qx,qy,qz,vPx,vPy,vPz,wx,wy,wz,Px,Py,Pz,Lx,Ly,Lz,orthogonality", len));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFrameWriteRow - one row of a frame's CSV series (SI): position of P and of the centre of mass, rotation (matrix
+  and quaternion), v_P, w (body frame), inertial momenta, orthogonality error ||R^T R - I||_F; returns the momenta
+  (non-dimensional) for the drift checks
+@*/
+PetscErrorCode PhlexFrameWriteRow(PetscViewer csv, PetscReal t, PhlexFrameState *f, const PhlexUnits *u, PetscReal P[3], PetscReal L[3])
+{
+  PetscReal qt[4], Rs[3], orth = PhlexOrthogonalityError(f->R);
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFrameMomenta(f, P, L));
+  PhlexRotationToQuaternion(f->R, qt);
+  PhlexMatVec3(f->R, f->sgrav, Rs);
+  PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(f->r[k] * u->length)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)((f->r[k] + Rs[k] / f->m) * u->length)));
+  for (PetscInt k = 0; k < 9; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)f->R[k]));
+  for (PetscInt k = 0; k < 4; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)qt[k]));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(f->vP[k] * u->velocity)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(f->w[k] / u->time)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(P[k] * u->mass * u->velocity)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(L[k] * u->mass * u->velocity * u->length)));
+  PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e\n", (double)orth));
   PetscFunctionReturn(0);
 }

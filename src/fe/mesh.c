@@ -186,7 +186,7 @@ static const char *DimName(PetscInt dim)
   Output Parameter:
 . tag - the physical tag (value of "Face Sets" or "Cell Sets")
 @*/
-PetscErrorCode PhlexMeshFindGroup(PhlexBody body, const char name[], PetscInt dim, const char option[], PetscInt *tag)
+PetscErrorCode PhlexMeshFindGroup(PhlexFlexible body, const char name[], PetscInt dim, const char option[], PetscInt *tag)
 {
   char      avail[1024] = "";
   PetscInt  found = -1, count = 0, gcount = 0;
@@ -249,7 +249,7 @@ PetscErrorCode PhlexMeshFindGroup(PhlexBody body, const char name[], PetscInt di
   strains of the Q_k velocity, so the element-wise stress elimination is not the displacement stiffness and Q1/Q0
   has hourglass (zero-energy) modes.
 @*/
-PetscErrorCode PhlexMeshLoad(PhlexBody body)
+PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
 {
   DM               dm, dmdist = NULL;
   PetscPartitioner part;
@@ -322,7 +322,7 @@ PetscErrorCode PhlexMeshLoad(PhlexBody body)
   PETSc reorients gmsh tetrahedra to its own convention; a cell whose Jacobian determinant is then negative was
   inverted in the file, and one with a volume below 1e-10 of the cube of its longest edge is degenerate.
 @*/
-PetscErrorCode PhlexMeshCheckGeometry(PhlexBody body, const PhlexUnits *units)
+PetscErrorCode PhlexMeshCheckGeometry(PhlexFlexible body)
 {
   PetscInt     cStart, cEnd, info[2] = {-1, 0}, ginfo[2];
   PetscReal    v0[3], J[9], invJ[9], detJ, loc[6], glob[6];
@@ -391,6 +391,5 @@ PetscErrorCode PhlexMeshCheckGeometry(PhlexBody body, const PhlexUnits *units)
     body->bbox_min[d] = glob[d];
     body->bbox_max[d] = -glob[3 + d];
   }
-  (void)units;
   PetscFunctionReturn(0);
 }

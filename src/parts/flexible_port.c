@@ -1,9 +1,10 @@
-/* Ports: named boundary surfaces of a body carrying a wrench input distributed over the patch, and their
-   power-conjugate outputs (DESIGN section 3). Also the boundary-face integration used for patch geometry. */
+/* Ports of a flexible body: named boundary surfaces. Their geometry (area, centroid, area inertia), the distribution
+   of a wrench over the patch (the columns of B) whose transpose gives the collocated output (DESIGN section 3), and
+   the boundary-face integration they use. */
 #include <phlex_impl.h>
 #include <petscsf.h>
 
-/* 3x3 helpers */
+/* 3x3 inverse */
 static void Inverse3(const PetscReal A[9], PetscReal B[9], PetscReal *det)
 {
   *det = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) + A[2] * (A[3] * A[7] - A[4] * A[6]);
@@ -34,7 +35,7 @@ static void Inverse3(const PetscReal A[9], PetscReal B[9], PetscReal *det)
   Notes:
   Each face is visited on the one rank that owns it.
 @*/
-PetscErrorCode PhlexSurfaceIntegrate(PhlexBody body, PetscInt tag, PetscInt degree, PhlexSurfaceFunc func, void *ctx)
+PetscErrorCode PhlexSurfaceIntegrate(PhlexFlexible body, PetscInt tag, PetscInt degree, PhlexSurfaceFunc func, void *ctx)
 {
   DMLabel          label;
   IS               is;
@@ -170,7 +171,7 @@ static PetscErrorCode PortMomentsAdd(void *ctx, PetscInt nq, const PetscReal *x,
 
   Collective
 @*/
-PetscErrorCode PhlexSurfaceMoments(PhlexBody body, PetscInt tag, PetscReal *area, PetscReal centroid[3], PetscReal inertia[9])
+PetscErrorCode PhlexSurfaceMoments(PhlexFlexible body, PetscInt tag, PetscReal *area, PetscReal centroid[3], PetscReal inertia[9])
 {
   PortMoments m;
   PetscReal   buf[13], gbuf[13], S[9], tr;
@@ -194,7 +195,7 @@ PetscErrorCode PhlexSurfaceMoments(PhlexBody body, PetscInt tag, PetscReal *area
 }
 
 typedef struct {
-  PhlexPort        port;
+  PhlexFlexPort    *port;
   const PhlexUnits *units;
 } PortDistCtx;
 
@@ -202,7 +203,7 @@ typedef struct {
 static PetscErrorCode PortDistAdd(void *ctx, PetscInt nq, const PetscReal *x, const PetscReal *w, const PetscReal *phi, const PetscInt *comp, const PetscInt *idx, PetscInt nb)
 {
   PortDistCtx     *pc = (PortDistCtx *)ctx;
-  PhlexPort        p  = pc->port;
+  PhlexFlexPort   *p  = pc->port;
   const PetscReal  L  = pc->units->length;
   const PetscReal  Ahat = p->area / (L * L);
   PetscReal        Iinv_hat[9];
@@ -231,51 +232,12 @@ static PetscErrorCode PortDistAdd(void *ctx, PetscInt nq, const PetscReal *x, co
 }
 
 /*@C
-  PhlexPortSetFromOptions - reads a port's input options
-
-  Collective
-
-  Options Database Keys (prefix -<body>port_<name>_):
-+ -force Fx,Fy,Fz     - force amplitude [N] (body frame)
-. -moment Tx,Ty,Tz    - moment amplitude about the patch centroid [N m]
-. -traction tx,ty,tz  - uniform traction amplitude [Pa] (alternative to -force)
-- -profile_type ...   - time profile (PhlexProfileSetFromOptions)
-@*/
-PetscErrorCode PhlexPortSetFromOptions(PhlexBody body, PhlexPort p)
-{
-  char      prefix[256], what[256];
-  PetscBool flg_force = PETSC_FALSE, flg_traction = PETSC_FALSE, flg_moment = PETSC_FALSE;
-  PetscReal traction[3] = {0, 0, 0};
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sport_%s_", body->prefix, p->name));
-  PetscCall(PetscSNPrintf(what, sizeof(what), "body %s, port %s", body->name, p->name));
-  PetscOptionsBegin(body->comm, prefix, "Port options", NULL);
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, body->comm, what, prefix, "-force", "Force amplitude on the port (body frame) [N]", "PhlexPortSetFromOptions", 3, p->force, &flg_force));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, body->comm, what, prefix, "-moment", "Moment amplitude about the patch centroid (body frame) [N m]", "PhlexPortSetFromOptions", 3, p->moment, &flg_moment));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, body->comm, what, prefix, "-traction", "Uniform traction amplitude (body frame) [Pa], alternative to -force", "PhlexPortSetFromOptions", 3, traction, &flg_traction));
-  PetscOptionsEnd();
-  PetscCheck(!(flg_force && flg_traction), body->comm, PETSC_ERR_USER_INPUT, "%s: give either -%sforce or -%straction, not both", what, prefix, prefix);
-  if (flg_traction) {
-    /* converted to a force once the area is known (PhlexPortSetUp); keep the traction in force[] meanwhile */
-    for (PetscInt d = 0; d < 3; d++) p->force[d] = traction[d];
-    p->traction_input = PETSC_TRUE;
-  }
-  p->loaded = PETSC_FALSE;
-  for (PetscInt d = 0; d < 3; d++)
-    if (p->force[d] != 0.0 || p->moment[d] != 0.0) p->loaded = PETSC_TRUE;
-  PetscCall(PhlexProfileCreate(body->comm, prefix, what, &p->profile));
-  PetscCall(PhlexProfileSetFromOptions(p->profile));
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexPortSetUp - finds the port's surface, computes its area, centroid and inertia, and assembles the
+  PhlexFlexPortSetUp - finds the port's surface, computes its area, centroid and inertia, and assembles the
   distribution vectors (the port's columns of B)
 
   Collective
 @*/
-PetscErrorCode PhlexPortSetUp(PhlexBody body, PhlexPort p, const PhlexUnits *units)
+PetscErrorCode PhlexFlexPortSetUp(PhlexFlexible body, PhlexFlexPort *p, const PhlexUnits *units)
 {
   PortDistCtx ctx;
   PetscReal   det;
@@ -288,8 +250,8 @@ PetscErrorCode PhlexPortSetUp(PhlexBody body, PhlexPort p, const PhlexUnits *uni
   PetscCall(PhlexSurfaceMoments(body, p->tag, &p->area, p->centroid, p->inertia));
   Inverse3(p->inertia, p->inertia_inv, &det);
   PetscCheck(det > 0, body->comm, PETSC_ERR_USER_INPUT, "body %s, port %s: the surface has a singular area inertia", body->name, p->name);
-  if (p->traction_input)
-    for (PetscInt d = 0; d < 3; d++) p->force[d] *= p->area;
+  if (p->load.traction_input)
+    for (PetscInt d = 0; d < 3; d++) p->load.force[d] *= p->area;
 
   ctx.port  = p;
   ctx.units = units;
@@ -307,30 +269,12 @@ PetscErrorCode PhlexPortSetUp(PhlexBody body, PhlexPort p, const PhlexUnits *uni
 }
 
 /*@C
-  PhlexPortInput - the non-dimensional wrench input u(t) = f(t) [F; T] of a port
-
-  Not collective
+  PhlexFlexPortDestroy - frees a port's vectors and profile
 @*/
-PetscErrorCode PhlexPortInput(PhlexPort p, PetscReal t, const PhlexUnits *units, PetscReal u[6])
-{
-  PetscReal f;
-
-  PetscFunctionBeginUser;
-  PetscCall(PhlexProfileEvaluate(p->profile, t, &f));
-  for (PetscInt d = 0; d < 3; d++) {
-    u[d]     = f * p->force[d] / units->force;
-    u[3 + d] = f * p->moment[d] / (units->force * units->length);
-  }
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexPortDestroy - frees a port's vectors and profile
-@*/
-PetscErrorCode PhlexPortDestroy(PhlexPort p)
+PetscErrorCode PhlexFlexPortDestroy(PhlexFlexPort *p)
 {
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < 6; k++) PetscCall(VecDestroy(&p->dist[k]));
-  PetscCall(PhlexProfileDestroy(&p->profile));
+  PetscCall(PhlexPortLoadDestroy(&p->load));
   PetscFunctionReturn(0);
 }

@@ -197,6 +197,53 @@ PetscErrorCode PhlexProfileEvaluate(PhlexProfile p, PetscReal t, PetscReal *f)
 }
 
 /*@C
+  PhlexProfileIntegrate - the integral F(t) = int_0^t f(s) ds (the position of a prescribed velocity)
+
+  Not collective
+@*/
+PetscErrorCode PhlexProfileIntegrate(PhlexProfile p, PetscReal t, PetscReal *F)
+{
+  const PetscReal t0 = PetscMax(p->start_time, 0.0), s = t - p->start_time;
+
+  PetscFunctionBeginUser;
+  *F = 0.0;
+  switch (p->type) {
+  case PHLEX_PROFILE_CONSTANT:
+    *F = t > t0 ? t - t0 : 0.0;
+    break;
+  case PHLEX_PROFILE_RAMP: {
+    /* f = s / ramp on (0, ramp), 1 after: int = s^2 / (2 ramp), then ramp / 2 + (s - ramp) */
+    const PetscReal a = PetscMax(0.0, -p->start_time); /* the part of the ramp before t = 0 */
+    PetscReal       Fa = a <= 0 ? 0.0 : (a >= p->ramp_time ? p->ramp_time / 2 + (a - p->ramp_time) : a * a / (2 * p->ramp_time));
+    PetscReal       Fs = s <= 0 ? 0.0 : (s >= p->ramp_time ? p->ramp_time / 2 + (s - p->ramp_time) : s * s / (2 * p->ramp_time));
+    *F                 = t > t0 ? Fs - Fa : 0.0;
+  } break;
+  case PHLEX_PROFILE_SINE: {
+    const PetscReal w = 2.0 * PETSC_PI * p->frequency, a = t0 - p->start_time;
+    *F                = t > t0 ? (PetscCosReal(w * a + p->phase) - PetscCosReal(w * s + p->phase)) / w : 0.0;
+  } break;
+  case PHLEX_PROFILE_TABLE: {
+    /* trapezoids of the piecewise-linear table over [0, t], constant extension outside */
+    const PetscInt n = p->ntable;
+    PetscReal      a = 0.0, fa, fb, b;
+    PetscCall(PhlexProfileEvaluate(p, 0.0, &fa));
+    fa /= p->scale;
+    for (PetscInt i = 0; i <= n && a < t; i++) {
+      b = i < n ? PetscMin(p->table_t[i], t) : t;
+      if (b <= a) continue;
+      PetscCall(PhlexProfileEvaluate(p, b, &fb));
+      fb /= p->scale;
+      *F += 0.5 * (fa + fb) * (b - a);
+      a  = b;
+      fa = fb;
+    }
+  } break;
+  }
+  *F *= p->scale;
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexProfileDescribe - a one-line description of the profile, e.g. "sine 120 Hz, phase 0 rad, from t = 0 s"
 @*/
 PetscErrorCode PhlexProfileDescribe(PhlexProfile p, char buf[], size_t len)

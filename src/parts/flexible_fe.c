@@ -1,210 +1,7 @@
-/* One elastic body: options, materials, finite element spaces, and the constant body-frame operators
-   (velocity mass, stress compliance mass, Grad coupling, condensed stiffness), assembled once. */
+/* A flexible body's finite element spaces and its constant body-frame operators (velocity mass, stress compliance
+   mass, Grad coupling, condensed stiffness, inertia invariants), assembled once (paper Section 4). */
 #include <phlex_impl.h>
 
-const char *const PhlexICTypes[] = {"zero", "uniform", "rigid", "beam", "mode", "PhlexICType", "PHLEX_IC_", NULL};
-static const char *const PhlexMotionTypes[]  = {"fixed", "floating", "PhlexMotion", "PHLEX_MOTION_", NULL};
-static const char *const PhlexInertiaTypes[] = {"full", "frozen", "PhlexInertia", "PHLEX_INERTIA_", NULL};
-
-/*@C
-  PhlexBodyCreate - creates body number index (options prefix "body<index>_")
-
-  Collective
-@*/
-PetscErrorCode PhlexBodyCreate(MPI_Comm comm, PetscInt index, PhlexBody *body)
-{
-  PhlexBody b;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscNew(&b));
-  b->comm      = comm;
-  b->index     = index;
-  b->degree    = 2;
-  b->frame_tag = -1;
-  PetscCall(PetscSNPrintf(b->prefix, sizeof(b->prefix), "body%" PetscInt_FMT "_", index));
-  PetscCall(PetscSNPrintf(b->name, sizeof(b->name), "body%" PetscInt_FMT, index));
-  b->ic_velocity.amplitude     = 1.0;
-  b->ic_displacement.amplitude = 1.0;
-  b->ic_stress.amplitude       = 1.0;
-  b->ic_velocity.mode = b->ic_displacement.mode = b->ic_stress.mode = 1;
-  b->rotation0[0] = b->rotation0[4] = b->rotation0[8] = 1.0;
-  *body                        = b;
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MaterialCheck(PhlexBody b, const PhlexMaterial *m, const char prefix[])
-{
-  PetscFunctionBeginUser;
-  PetscCheck(m->youngs_modulus > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: Young's modulus must be positive: -%syoungs_modulus %g", b->name, prefix, (double)m->youngs_modulus);
-  PetscCheck(m->poissons_ratio > -1.0 && m->poissons_ratio < 0.5, b->comm, PETSC_ERR_USER_INPUT, "body %s: Poisson's ratio must lie in (-1, 0.5): -%spoissons_ratio %g", b->name, prefix, (double)m->poissons_ratio);
-  PetscCheck(m->density > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: density must be positive: -%sdensity %g", b->name, prefix, (double)m->density);
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MaterialSetFromOptions(PhlexBody b, PhlexMaterial *m, const char prefix[], PetscBool required)
-{
-  PetscBool fE = PETSC_FALSE, fn = PETSC_FALSE, fr = PETSC_FALSE;
-
-  PetscFunctionBeginUser;
-  PetscOptionsBegin(b->comm, prefix, "Material options", NULL);
-  PetscCall(PetscOptionsReal("-youngs_modulus", "Young's modulus E [Pa]", "PhlexBodySetFromOptions", m->youngs_modulus, &m->youngs_modulus, &fE));
-  PetscCall(PetscOptionsReal("-poissons_ratio", "Poisson's ratio nu [-]", "PhlexBodySetFromOptions", m->poissons_ratio, &m->poissons_ratio, &fn));
-  PetscCall(PetscOptionsReal("-density", "Mass density rho [kg/m^3]", "PhlexBodySetFromOptions", m->density, &m->density, &fr));
-  PetscOptionsEnd();
-  if (required) {
-    PetscCheck(fE, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%syoungs_modulus [Pa]", b->name, prefix);
-    PetscCheck(fn, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%spoissons_ratio [-]", b->name, prefix);
-    PetscCheck(fr, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%sdensity [kg/m^3]", b->name, prefix);
-  }
-  PetscCall(MaterialCheck(b, m, prefix));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode ICSetFromOptions(PhlexBody b, PhlexIC *ic, const char field[], PetscInt ncomp)
-{
-  char prefix[128], who[PHLEX_NAME_LEN + 8];
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sic_%s_", b->prefix, field));
-  PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
-  PetscOptionsBegin(b->comm, prefix, "Initial condition options", NULL);
-  PetscCall(PetscOptionsEnum("-type", "Initial condition: zero, uniform, rigid (v + w x (x - origin)), beam (Euler-Bernoulli cantilever mode), mode (computed elastic mode)", "PhlexBodySetFromOptions", PhlexICTypes, (PetscEnum)ic->type, (PetscEnum *)&ic->type, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-value", ncomp == 6 ? "uniform: stress components xx,yy,zz,yz,xz,xy [Pa]" : "uniform/rigid: vector [SI]", "PhlexBodySetFromOptions", ncomp, ic->value, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-angular", "rigid: angular velocity [rad/s]", "PhlexBodySetFromOptions", 3, ic->angular, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-origin", "rigid: point of the rotation axis [m]", "PhlexBodySetFromOptions", 3, ic->origin, NULL));
-  PetscCall(PetscOptionsInt("-mode", "beam/mode: mode number (1 = lowest)", "PhlexBodySetFromOptions", ic->mode, &ic->mode, NULL));
-  PetscCall(PetscOptionsReal("-amplitude", "beam/mode: largest value of the field [SI]", "PhlexBodySetFromOptions", ic->amplitude, &ic->amplitude, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-direction", "beam: deflection direction", "PhlexBodySetFromOptions", 3, ic->direction, NULL));
-  PetscOptionsEnd();
-  PetscCheck(ic->mode >= 1, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%smode must be >= 1, got %" PetscInt_FMT, b->name, prefix, ic->mode);
-  PetscCheck(ncomp == 3 || (ic->type != PHLEX_IC_RIGID && ic->type != PHLEX_IC_BEAM), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%stype %s is not available for the stress", b->name, prefix, PhlexICTypes[ic->type]);
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexBodySetFromOptions - reads the body's options
-
-  Collective
-
-  Options Database Keys (prefix body<k>_):
-+ -name <s>                 - name used in messages and output files
-. -dm_plex_filename <file>  - gmsh mesh (.msh 2.2 or 4.1, ASCII or binary)
-. -petscspace_degree <k>    - velocity degree k (1 or 2); the stress is discontinuous of degree k-1
-. -frame_patch <group>      - physical surface where u_f = v_f = 0 (clamped patch); empty: free body
-. -youngs_modulus, -poissons_ratio, -density - material of the whole body
-. -regions r1,r2            - physical volumes with their own material (-region_<r>_youngs_modulus, ...)
-. -ports p1,p2              - physical surfaces carrying wrench inputs (-port_<p>_force, ...)
-. -body_force fx,fy,fz      - uniform body force density [N/m^3] with -body_force_profile_type ...
-- -ic_velocity_type, -ic_displacement_type, -ic_stress_type - initial conditions
-@*/
-PetscErrorCode PhlexBodySetFromOptions(PhlexBody b)
-{
-  char      regions[PHLEX_MAX_MATERIALS][PHLEX_NAME_LEN];
-  char     *rptr[PHLEX_MAX_MATERIALS], *pptr[PHLEX_MAX_PORTS];
-  PetscInt  nregions = PHLEX_MAX_MATERIALS, nports = PHLEX_MAX_PORTS, n;
-  PetscBool flg, flg_mesh = PETSC_FALSE, has_body_material;
-
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < PHLEX_MAX_MATERIALS; i++) rptr[i] = NULL;
-  for (PetscInt i = 0; i < PHLEX_MAX_PORTS; i++) pptr[i] = NULL;
-  PetscOptionsBegin(b->comm, b->prefix, "Body options", NULL);
-  PetscCall(PetscOptionsString("-name", "Name of the body (messages, output files)", "PhlexBodySetFromOptions", b->name, b->name, sizeof(b->name), NULL));
-  char who[PHLEX_NAME_LEN + 8]; /* "body <name>" in messages */
-  PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
-  PetscCall(PetscOptionsString("-dm_plex_filename", "gmsh mesh file of the body (.msh 2.2 or 4.1)", "PhlexBodySetFromOptions", b->mesh_file, b->mesh_file, sizeof(b->mesh_file), &flg_mesh));
-  PetscCall(PetscOptionsInt("-petscspace_degree", "Velocity degree k (1 or 2); stress: discontinuous degree k-1", "PhlexBodySetFromOptions", b->degree, &b->degree, NULL));
-  PetscCall(PetscOptionsString("-frame_patch", "Physical surface where u_f = v_f = 0 (clamped patch, frame origin); empty: free body", "PhlexBodySetFromOptions", b->frame_patch, b->frame_patch, sizeof(b->frame_patch), NULL));
-  PetscCall(PetscOptionsStringArray("-regions", "Physical volumes with their own material (-region_<name>_youngs_modulus ...)", "PhlexBodySetFromOptions", rptr, &nregions, &flg));
-  if (!flg) nregions = 0;
-  PetscCall(PetscOptionsStringArray("-ports", "Physical surfaces carrying wrench inputs (-port_<name>_force ...)", "PhlexBodySetFromOptions", pptr, &nports, &flg));
-  if (!flg) nports = 0;
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-body_force", "Uniform body force density (body frame) [N/m^3]", "PhlexBodySetFromOptions", 3, b->body_force, &b->has_body_force));
-  {
-    PetscInt  motion = b->floating ? 1 : 0, inertia = b->frozen_inertia ? 1 : 0;
-    PetscReal quat[4] = {1, 0, 0, 0}, aa[4] = {1, 0, 0, 0};
-    PetscBool fq = PETSC_FALSE, fa = PETSC_FALSE, fp = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE, fv = PETSC_FALSE, fw = PETSC_FALSE;
-    PetscCall(PetscOptionsEList("-motion", "Rigid motion of the body frame: fixed (clamped patch held) or floating (the frame moves)", "PhlexBodySetFromOptions", PhlexMotionTypes, 2, PhlexMotionTypes[motion], &motion, NULL));
-    PetscCall(PetscOptionsEList("-inertia", "Floating body: inertia with x + u_f (full) or at u_f = 0 (frozen, quadratic Hamiltonian)", "PhlexBodySetFromOptions", PhlexInertiaTypes, 2, PhlexInertiaTypes[inertia], &inertia, NULL));
-    b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
-    b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
-    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-position", "Floating body: initial position r_P of the frame origin (default: the frame-patch centroid, i.e. the mesh as drawn) [m]", "PhlexBodySetFromOptions", 3, b->position0, &fp));
-    b->position_given = fp;
-    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-orientation_quaternion", "Floating body: initial orientation R as a quaternion w,x,y,z [-]", "PhlexBodySetFromOptions", 4, quat, &fq));
-    n = 4;
-    PetscCall(PetscOptionsRealArray("-orientation_axis_angle", "Floating body: initial orientation R as axis x,y,z and angle [deg]", "PhlexBodySetFromOptions", aa, &n, &fa));
-    PetscCheck(!fa || n == 4, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sorientation_axis_angle needs 4 numbers (axis, angle in degrees), got %" PetscInt_FMT, b->name, b->prefix, n);
-    PetscCheck(!(fq && fa), b->comm, PETSC_ERR_USER_INPUT, "body %s: give -%sorientation_quaternion or -%sorientation_axis_angle, not both", b->name, b->prefix, b->prefix);
-    if (fq) {
-      PetscCheck(quat[0] * quat[0] + quat[1] * quat[1] + quat[2] * quat[2] + quat[3] * quat[3] > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sorientation_quaternion must not be zero", b->name, b->prefix);
-      PhlexQuaternionToRotation(quat, b->rotation0);
-    }
-    if (fa) {
-      PetscCheck(aa[0] * aa[0] + aa[1] * aa[1] + aa[2] * aa[2] > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: the axis of -%sorientation_axis_angle must not be zero", b->name, b->prefix);
-      PhlexAxisAngleToRotation(aa, aa[3] * PETSC_PI / 180.0, b->rotation0);
-    }
-    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-velocity", "Floating body: initial velocity v_P of the frame origin (body frame) [m/s]", "PhlexBodySetFromOptions", 3, b->velocity0, &fv));
-    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-angular_velocity", "Floating body: initial angular velocity w_P (body frame) [rad/s]", "PhlexBodySetFromOptions", 3, b->omega0, &fw));
-    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_force", "Floating body: force on the frame origin (body frame) [N]", "PhlexBodySetFromOptions", 3, b->frame_force, &ff));
-    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_moment", "Floating body: moment about the frame origin (body frame) [N m]", "PhlexBodySetFromOptions", 3, b->frame_moment, &fm));
-    b->frame_loaded = (ff || fm) ? PETSC_TRUE : PETSC_FALSE;
-    /* a fixed body has no rigid state: its rigid options would be silently ignored */
-    if (!b->floating) {
-      const char *given = fp ? "position" : fq ? "orientation_quaternion" : fa ? "orientation_axis_angle" : fv ? "velocity" : fw ? "angular_velocity" : ff ? "frame_force" : fm ? "frame_moment" : NULL;
-      PetscCheck(!given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%s%s describes the rigid motion of a floating frame; the body is fixed (-%smotion fixed): add -%smotion floating or remove the option", b->name, b->prefix, given, b->prefix, b->prefix);
-    }
-  }
-  PetscOptionsEnd();
-  if (b->floating) PetscCheck(b->frame_patch[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: a floating body needs a frame patch (-%sframe_patch <surface>): it fixes the body frame and its centroid is the frame origin", b->name, b->prefix);
-  if (b->frame_loaded) {
-    char prefix[256], what[256];
-    PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sframe_", b->prefix));
-    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s, frame wrench", b->name));
-    PetscCall(PhlexProfileCreate(b->comm, prefix, what, &b->frame_profile));
-    PetscCall(PhlexProfileSetFromOptions(b->frame_profile));
-  }
-
-  PetscCheck(flg_mesh && b->mesh_file[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: no mesh: set -%sdm_plex_filename <file.msh>", b->name, b->prefix);
-  PetscCheck(b->degree == 1 || b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%spetscspace_degree must be 1 or 2, got %" PetscInt_FMT, b->name, b->prefix, b->degree);
-
-  /* materials: either one for the whole body, or one per listed region */
-  b->nmaterials = nregions ? nregions : 1;
-  PetscCall(PetscOptionsHasName(NULL, b->prefix, "-youngs_modulus", &has_body_material));
-  if (!nregions) {
-    PetscCall(PetscStrcpy(b->materials[0].region, ""));
-    b->materials[0].tag = -1;
-    PetscCall(MaterialSetFromOptions(b, &b->materials[0], b->prefix, PETSC_TRUE));
-  } else {
-    PetscCheck(!has_body_material, b->comm, PETSC_ERR_USER_INPUT, "body %s: give the material either for the whole body (-%syoungs_modulus ...) or per region (-%sregions), not both", b->name, b->prefix, b->prefix);
-    for (PetscInt r = 0; r < nregions; r++) {
-      char prefix[256];
-      PetscCall(PetscStrncpy(regions[r], rptr[r], PHLEX_NAME_LEN));
-      PetscCall(PetscStrncpy(b->materials[r].region, regions[r], PHLEX_NAME_LEN));
-      b->materials[r].tag = -1;
-      PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sregion_%s_", b->prefix, regions[r]));
-      PetscCall(MaterialSetFromOptions(b, &b->materials[r], prefix, PETSC_TRUE));
-    }
-  }
-  for (PetscInt r = 0; r < nregions; r++) PetscCall(PetscFree(rptr[r]));
-
-  b->nports = nports;
-  for (PetscInt p = 0; p < nports; p++) {
-    PetscCall(PetscMemzero(&b->ports[p], sizeof(b->ports[p])));
-    PetscCall(PetscStrncpy(b->ports[p].name, pptr[p], PHLEX_NAME_LEN));
-    PetscCall(PetscFree(pptr[p]));
-    PetscCall(PhlexPortSetFromOptions(b, &b->ports[p]));
-  }
-  if (b->has_body_force) {
-    char prefix[256], what[256];
-    PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sbody_force_", b->prefix));
-    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s, body force", b->name));
-    PetscCall(PhlexProfileCreate(b->comm, prefix, what, &b->body_force_profile));
-    PetscCall(PhlexProfileSetFromOptions(b->body_force_profile));
-  }
-  PetscCall(ICSetFromOptions(b, &b->ic_velocity, "velocity", 3));
-  PetscCall(ICSetFromOptions(b, &b->ic_displacement, "displacement", 3));
-  PetscCall(ICSetFromOptions(b, &b->ic_stress, "stress", 6));
-  PetscFunctionReturn(0);
-}
 
 /* Discontinuous P_{k-1} Lagrange element with 6 components (the symmetric stress in Voigt order). */
 static PetscErrorCode CreateStressFE(MPI_Comm comm, PetscInt degree, PetscFE *fe)
@@ -245,7 +42,7 @@ static void ZeroBC(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOf
   for (PetscInt c = 0; c < 3; c++) bcval[c] = 0.0;
 }
 
-static PetscErrorCode SetUpSpaces(PhlexBody b)
+static PetscErrorCode SetUpSpaces(PhlexFlexible b)
 {
   PetscQuadrature q;
   const char     *vnames[] = {"x", "y", "z"};
@@ -300,7 +97,7 @@ static PetscErrorCode SetUpSpaces(PhlexBody b)
 }
 
 /* Material index of every local cell from the "Cell Sets" label. */
-static PetscErrorCode SetUpMaterials(PhlexBody b)
+static PetscErrorCode SetUpMaterials(PhlexFlexible b)
 {
   DMLabel  label;
   PetscInt ncells = b->cEnd - b->cStart, missing = -1, gmissing, val;
@@ -334,7 +131,7 @@ static PetscErrorCode SetUpMaterials(PhlexBody b)
 }
 
 /*@C
-  PhlexBodyGetBasis - tabulates the scalar node shapes of the velocity (stress = PETSC_FALSE) or stress element at
+  PhlexFlexibleGetBasis - tabulates the scalar node shapes of the velocity (stress = PETSC_FALSE) or stress element at
   the quadrature points
 
   Not collective
@@ -343,7 +140,7 @@ static PetscErrorCode SetUpMaterials(PhlexBody b)
   PETSc's vector Lagrange elements are node-major: basis function b is component b % Nc of node b / Nc, with the
   scalar shape of that node. This is checked on the tabulation.
 @*/
-PetscErrorCode PhlexBodyGetBasis(PhlexBody b, PetscBool stress, PhlexElementBasis *B)
+PetscErrorCode PhlexFlexibleGetBasis(PhlexFlexible b, PetscBool stress, PhlexElementBasis *B)
 {
   PetscFE         fe = stress ? b->fe_s : b->fe_v;
   PetscQuadrature q;
@@ -376,7 +173,7 @@ PetscErrorCode PhlexBodyGetBasis(PhlexBody b, PetscBool stress, PhlexElementBasi
   PetscFunctionReturn(0);
 }
 
-PetscErrorCode PhlexBodyRestoreBasis(PhlexElementBasis *B)
+PetscErrorCode PhlexFlexibleRestoreBasis(PhlexElementBasis *B)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscFree2(B->node_phi, B->node_dphi));
@@ -384,7 +181,7 @@ PetscErrorCode PhlexBodyRestoreBasis(PhlexElementBasis *B)
 }
 
 /* Global dofs of every local cell, cached once: DMPlexGetClosureIndices is the expensive part of an element loop. */
-static PetscErrorCode SetUpCellDofs(PhlexBody b)
+static PetscErrorCode SetUpCellDofs(PhlexFlexible b)
 {
   PetscSection section, gsection, gsec_s;
   PetscInt     ncells = b->cEnd - b->cStart;
@@ -406,7 +203,7 @@ static PetscErrorCode SetUpCellDofs(PhlexBody b)
 }
 
 /* Block (node) indices of a cell: velocity dofs come in x, y, z triples, constrained as a whole (-1). */
-static inline void CellNodeIndices(PhlexBody b, PetscInt c, PetscInt *nodes)
+static inline void CellNodeIndices(PhlexFlexible b, PetscInt c, PetscInt *nodes)
 {
   const PetscInt *idx = &b->cell_vdofs[c * b->nb_v];
   for (PetscInt a = 0; a < b->nb_v / 3; a++) nodes[a] = idx[3 * a] >= 0 ? idx[3 * a] / 3 : -1;
@@ -416,7 +213,7 @@ static inline void CellNodeIndices(PhlexBody b, PetscInt c, PetscInt *nodes)
    (upper triangle, block size 3): the format the sparse Cholesky solvers (MUMPS, CHOLMOD) factor directly. The block
    structure is counted from the node graph of the cells in serial and with MATPREALLOCATOR in parallel (which also
    sees the rows of nodes owned by other ranks). */
-static PetscErrorCode CreateVelocityMatrix(PhlexBody b, Mat *A)
+static PetscErrorCode CreateVelocityMatrix(PhlexFlexible b, Mat *A)
 {
   const PetscInt nn = b->nb_v / 3, ncells = b->cEnd - b->cStart, nloc = b->nv_local / 3;
   PetscMPIInt    size;
@@ -487,7 +284,7 @@ static PetscErrorCode CreateVelocityMatrix(PhlexBody b, Mat *A)
 }
 
 /* Exact preallocation of G (stress rows x velocity columns): each stress row couples to the velocity dofs of its cell. */
-static PetscErrorCode CreateCouplingMatrix(PhlexBody b, Mat *G)
+static PetscErrorCode CreateCouplingMatrix(PhlexFlexible b, Mat *G)
 {
   PetscInt vstart, vend, rstart, *dnz, *onz;
 
@@ -522,7 +319,7 @@ static PetscErrorCode CreateCouplingMatrix(PhlexBody b, Mat *G)
 }
 
 /* Non-dimensional affine geometry of every local cell: detJ, invJ (x scaled by the reference length). */
-static PetscErrorCode SetUpCellGeometry(PhlexBody b, const PhlexUnits *u)
+static PetscErrorCode SetUpCellGeometry(PhlexFlexible b, const PhlexUnits *u)
 {
   PetscReal v0[3], J[9], invJ[9], detJ;
   PetscReal vol = 0, mass = 0, mx[3] = {0, 0, 0}, buf[5], gbuf[5];
@@ -552,7 +349,7 @@ static PetscErrorCode SetUpCellGeometry(PhlexBody b, const PhlexUnits *u)
 }
 
 /* Element loop assembling the velocity operators Mv, K and the body-force vectors (non-dimensional, once). */
-static PetscErrorCode AssembleVelocityOperators(PhlexBody b, const PhlexUnits *u)
+static PetscErrorCode AssembleVelocityOperators(PhlexFlexible b, const PhlexUnits *u)
 {
   const PhlexElementReferenceIntegrals *R = &b->ref;
   const PetscInt                        nv = b->nb_v, nn = nv / 3;
@@ -599,12 +396,12 @@ static PetscErrorCode AssembleVelocityOperators(PhlexBody b, const PhlexUnits *u
 }
 
 /*@C
-  PhlexBodySetUpMixed - assembles the stress operators (compliance mass Ms, coupling G) needed by the time
+  PhlexFlexibleSetUpMixed - assembles the stress operators (compliance mass Ms, coupling G) needed by the time
   integration of the mixed system; modal analyses use the condensed velocity operators only and skip them
 
   Collective
 @*/
-PetscErrorCode PhlexBodySetUpMixed(PhlexBody b, const PhlexUnits *u)
+PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible b, const PhlexUnits *u)
 {
   const PhlexElementReferenceIntegrals *R = &b->ref;
   const PetscInt                        nv = b->nb_v, ns = b->nb_s;
@@ -653,7 +450,7 @@ PetscErrorCode PhlexBodySetUpMixed(PhlexBody b, const PhlexUnits *u)
 
 /* -phlex_check_condensation: the exact element-wise elimination G^T Ms^{-1} G against the stiffness used, on every
    local cell; prints the largest relative difference (DESIGN section 2: equal for constant material on affine cells). */
-static PetscErrorCode CheckCondensation(PhlexBody b, const PhlexUnits *u)
+static PetscErrorCode CheckCondensation(PhlexFlexible b, const PhlexUnits *u)
 {
   const PhlexElementReferenceIntegrals *R = &b->ref;
   const PetscInt                        nv = b->nb_v, ns = b->nb_s;
@@ -688,54 +485,53 @@ static PetscErrorCode CheckCondensation(PhlexBody b, const PhlexUnits *u)
 }
 
 /*@C
-  PhlexBodySetUp - reads and checks the mesh, builds the spaces and assembles the constant operators
+  PhlexFlexibleSetUpFE - builds the spaces of a loaded mesh and assembles the constant operators; a floating body
+  also gets its frame origin and inertia invariants
 
   Collective
 
   Input Parameters:
-+ b     - the body
++ b     - the body (mesh loaded and checked)
 - units - reference scales of the non-dimensionalisation
 @*/
-PetscErrorCode PhlexBodySetUp(PhlexBody b, const PhlexUnits *units)
+PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible b, const PhlexUnits *units)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BodySetUp, 0, 0, 0, 0));
-  if (!b->dm) {
-    PetscCall(PhlexMeshLoad(b));
-    PetscCall(PhlexMeshCheckGeometry(b, units));
-  }
   PetscCall(SetUpSpaces(b));
   PetscCall(SetUpMaterials(b));
   PetscCall(SetUpCellGeometry(b, units));
   PetscCall(SetUpCellDofs(b));
   {
     PhlexElementBasis V, S;
-    PetscCall(PhlexBodyGetBasis(b, PETSC_FALSE, &V));
-    PetscCall(PhlexBodyGetBasis(b, PETSC_TRUE, &S));
+    PetscCall(PhlexFlexibleGetBasis(b, PETSC_FALSE, &V));
+    PetscCall(PhlexFlexibleGetBasis(b, PETSC_TRUE, &S));
     PhlexElementReference(&V, &S, &b->ref);
-    PetscCall(PhlexBodyRestoreBasis(&V));
-    PetscCall(PhlexBodyRestoreBasis(&S));
+    PetscCall(PhlexFlexibleRestoreBasis(&V));
+    PetscCall(PhlexFlexibleRestoreBasis(&S));
   }
   PetscCall(AssembleVelocityOperators(b, units));
   PetscCall(CheckCondensation(b, units));
-  if (b->floating) {
-    for (PetscInt d = 0; d < 3; d++) {
-      b->origin[d] = b->frame_centroid[d];
-      if (!b->position_given) b->position0[d] = b->origin[d];
-    }
-    PetscCall(PhlexBodySetUpFloating(b, units));
+  /* the frame origin P: the frame patch's centroid, or the centre of mass with mean axes (or as given); a fixed
+     body's frame is the inertial one */
+  if (b->floating && !b->origin_given) {
+    for (PetscInt d = 0; d < 3; d++) b->origin[d] = b->frame_condition == PHLEX_FRAME_PATCH ? b->frame_centroid[d] : b->center_of_mass[d];
   }
-  for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexPortSetUp(b, &b->ports[p], units));
+  if (!b->floating)
+    for (PetscInt d = 0; d < 3; d++) b->origin[d] = 0.0;
+  if (b->floating && !b->pose.position_given)
+    for (PetscInt d = 0; d < 3; d++) b->pose.position[d] = b->origin[d];
+  if (b->floating) PetscCall(PhlexFlexibleSetUpInertia(b, units));
   PetscCall(PetscLogEventEnd(PHLEX_BodySetUp, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexBodyEnergy - kinetic and strain energy 1/2 v^T Mv v, 1/2 s^T Ms s (non-dimensional)
+  PhlexFlexibleEnergy - kinetic and strain energy 1/2 v^T Mv v, 1/2 s^T Ms s (non-dimensional)
 
   Collective
 @*/
-PetscErrorCode PhlexBodyEnergy(PhlexBody b, Vec v, Vec s, PetscReal *kinetic, PetscReal *strain)
+PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible b, Vec v, Vec s, PetscReal *kinetic, PetscReal *strain)
 {
   Vec         wv, ws;
   PetscScalar e;
@@ -755,103 +551,92 @@ PetscErrorCode PhlexBodyEnergy(PhlexBody b, Vec v, Vec s, PetscReal *kinetic, Pe
 }
 
 /*@C
-  PhlexBodyLoadVector - the non-dimensional load b(t) = B u(t) of the port wrenches and the body force
+  PhlexFlexibleSetUpInertia - inertia invariants of a floating body about its frame origin P (non-dimensional):
+  m, s0 = int rho x, E0 = int rho x x^T, the volume, int x dV, and the nodal vectors t, w of the elastic space
 
   Collective
 @*/
-PetscErrorCode PhlexBodyLoadVector(PhlexBody b, PetscReal t, const PhlexUnits *units, Vec load)
+PetscErrorCode PhlexFlexibleSetUpInertia(PhlexFlexible b, const PhlexUnits *u)
 {
-  PetscFunctionBeginUser;
-  PetscCall(VecSet(load, 0.0));
-  for (PetscInt p = 0; p < b->nports; p++) {
-    PetscReal u[6];
-    if (!b->ports[p].loaded) continue;
-    PetscCall(PhlexPortInput(&b->ports[p], t, units, u));
-    for (PetscInt k = 0; k < 6; k++)
-      if (u[k] != 0.0) PetscCall(VecAXPY(load, u[k], b->ports[p].dist[k]));
-  }
-  if (b->has_body_force) {
-    PetscReal f;
-    PetscCall(PhlexProfileEvaluate(b->body_force_profile, t, &f));
-    /* force density scale: force / length^3 = E_ref / L */
-    for (PetscInt c = 0; c < 3; c++)
-      if (b->body_force[c] != 0.0) PetscCall(VecAXPY(load, f * b->body_force[c] * units->length / units->modulus, b->fvol[c]));
-  }
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexBodyPortOutputs - the collocated outputs y = B^T v of every port (non-dimensional): patch-average velocity
-  and patch-average angular velocity
-
-  Collective
-@*/
-PetscErrorCode PhlexBodyPortOutputs(PhlexBody b, Vec v, PetscReal y[][6])
-{
-  PetscFunctionBeginUser;
-  for (PetscInt p = 0; p < b->nports; p++) {
-    PetscScalar d[6];
-    PetscCall(VecMDot(v, 6, b->ports[p].dist, d));
-    for (PetscInt k = 0; k < 6; k++) y[p][k] = PetscRealPart(d[k]);
-  }
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexBodyView - prints a summary of the body
-@*/
-PetscErrorCode PhlexBodyView(PhlexBody b, PetscViewer viewer)
-{
-  PetscInt ncells, gcells;
+  PhlexElementBasis V;
+  PetscQuadrature   q;
+  const PetscReal  *qpoints;
+  PetscInt          nq, nn = b->nb_v / 3;
+  PetscReal         loc[1 + 3 + 9 + 1 + 3] = {0}, glob[17];
 
   PetscFunctionBeginUser;
-  ncells = b->cEnd - b->cStart;
-  PetscCallMPI(MPI_Allreduce(&ncells, &gcells, 1, MPIU_INT, MPI_SUM, b->comm));
-  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: mesh %s, %" PetscInt_FMT " tetrahedra, velocity P%" PetscInt_FMT " (%" PetscInt_FMT " dofs), stress P%" PetscInt_FMT " discontinuous (%" PetscInt_FMT " dofs)\n", b->name, b->mesh_file, gcells, b->degree, b->nv_global, b->degree - 1, b->ns_global));
-  PetscCall(PetscViewerASCIIPushTab(viewer));
-  PetscCall(PetscViewerASCIIPrintf(viewer, "volume %.6g m^3, mass %.6g kg, centre of mass (%.6g, %.6g, %.6g) m\n", (double)b->volume, (double)b->mass, (double)b->center_of_mass[0], (double)b->center_of_mass[1], (double)b->center_of_mass[2]));
-  if (b->floating) {
-    PetscReal q[4];
-    PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on patch %s (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", b->frame_patch, (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
-    PhlexRotationToQuaternion(b->rotation0, q);
-    PetscCall(PetscViewerASCIIPrintf(viewer, "initial r_P (%.6g, %.6g, %.6g) m, orientation quaternion (%.6g, %.6g, %.6g, %.6g), v_P (%.6g, %.6g, %.6g) m/s, w_P (%.6g, %.6g, %.6g) rad/s (body frame)\n", (double)b->position0[0], (double)b->position0[1], (double)b->position0[2], (double)q[0], (double)q[1], (double)q[2], (double)q[3], (double)b->velocity0[0], (double)b->velocity0[1], (double)b->velocity0[2], (double)b->omega0[0], (double)b->omega0[1], (double)b->omega0[2]));
-    if (b->frame_loaded) {
-      char prof[256];
-      PetscCall(PhlexProfileDescribe(b->frame_profile, prof, sizeof(prof)));
-      PetscCall(PetscViewerASCIIPrintf(viewer, "frame wrench at P: force (%g, %g, %g) N, moment (%g, %g, %g) N m (body frame), profile %s\n", (double)b->frame_force[0], (double)b->frame_force[1], (double)b->frame_force[2], (double)b->frame_moment[0], (double)b->frame_moment[1], (double)b->frame_moment[2], prof));
+  PetscCall(PhlexFlexibleGetBasis(b, PETSC_FALSE, &V));
+  PetscCall(PetscFEGetQuadrature(b->fe_v, &q));
+  PetscCall(PetscQuadratureGetData(q, NULL, NULL, &nq, &qpoints, NULL));
+  PetscCall(DMCreateGlobalVector(b->dm, &b->tnode));
+  PetscCall(VecDuplicate(b->tnode, &b->wnode));
+  PetscCall(VecDuplicate(b->tnode, &b->vnode));
+  PetscCall(VecSet(b->tnode, 0.0));
+  PetscCall(VecSet(b->wnode, 0.0));
+  PetscCall(VecSet(b->vnode, 0.0));
+  /* closure indices of the frame-patch dofs are negative (constrained): drop them */
+  PetscCall(VecSetOption(b->tnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
+  PetscCall(VecSetOption(b->wnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
+  PetscCall(VecSetOption(b->vnode, VEC_IGNORE_NEGATIVE_INDICES, PETSC_TRUE));
+  for (PetscInt c = b->cStart; c < b->cEnd; c++) {
+    const PetscInt      ci  = c - b->cStart;
+    const PhlexMaterial *mat = &b->materials[b->cell_material[ci]];
+    const PetscReal      rho = mat->density / u->density;
+    const PetscInt      *idx = &b->cell_vdofs[ci * b->nb_v];
+    PetscReal            v0[3], J[9], invJ[9], detJ, dV;
+    PetscScalar          te[3 * PHLEX_MAX_NODES], we[3 * PHLEX_MAX_NODES], ve[3 * PHLEX_MAX_NODES];
+
+    PetscCall(DMPlexComputeCellGeometryAffineFEM(b->dm, c, v0, J, invJ, &detJ));
+    for (PetscInt i = 0; i < 3 * nn; i++) te[i] = we[i] = ve[i] = 0.0;
+    for (PetscInt qq = 0; qq < nq; qq++) {
+      PetscReal x[3];
+      /* x relative to P, non-dimensional: x = v0 + J (xi + 1) */
+      for (PetscInt d = 0; d < 3; d++) x[d] = (v0[d] + J[3 * d] * (qpoints[3 * qq] + 1) + J[3 * d + 1] * (qpoints[3 * qq + 1] + 1) + J[3 * d + 2] * (qpoints[3 * qq + 2] + 1) - b->origin[d]) / u->length;
+      dV = V.weights[qq] * detJ / (u->length * u->length * u->length);
+      loc[0] += rho * dV;
+      for (PetscInt d = 0; d < 3; d++) {
+        loc[1 + d] += rho * dV * x[d];
+        loc[14 + d] += dV * x[d];
+        for (PetscInt e = 0; e < 3; e++) loc[4 + 3 * d + e] += rho * dV * x[d] * x[e];
+      }
+      loc[13] += dV;
+      for (PetscInt a = 0; a < nn; a++) {
+        const PetscReal phi = V.node_phi[qq * V.nnodes + a];
+        for (PetscInt d = 0; d < 3; d++) {
+          te[3 * a + d] += rho * dV * phi;
+          we[3 * a + d] += rho * dV * phi * x[d];
+          ve[3 * a + d] += dV * phi;
+        }
+      }
     }
-  } else if (b->frame_patch[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "clamped patch (frame patch): %s\n", b->frame_patch));
-  else PetscCall(PetscViewerASCIIPrintf(viewer, "no clamped patch: free body\n"));
-  for (PetscInt m = 0; m < b->nmaterials; m++) {
-    const PhlexMaterial *mat = &b->materials[m];
-    PetscCall(PetscViewerASCIIPrintf(viewer, "material %s: E = %g Pa, nu = %g, rho = %g kg/m^3\n", mat->region[0] ? mat->region : "(whole body)", (double)mat->youngs_modulus, (double)mat->poissons_ratio, (double)mat->density));
+    PetscCall(VecSetValues(b->tnode, 3 * nn, idx, te, ADD_VALUES));
+    PetscCall(VecSetValues(b->wnode, 3 * nn, idx, we, ADD_VALUES));
+    PetscCall(VecSetValues(b->vnode, 3 * nn, idx, ve, ADD_VALUES));
   }
-  for (PetscInt p = 0; p < b->nports; p++) {
-    const PhlexPort port = &b->ports[p];
-    char            load[512] = "";
-    if (port->loaded) {
-      char prof[256];
-      PetscCall(PhlexProfileDescribe(port->profile, prof, sizeof(prof)));
-      PetscCall(PetscSNPrintf(load, sizeof(load), ", force (%g, %g, %g) N, moment (%g, %g, %g) N m, profile %s", (double)port->force[0], (double)port->force[1], (double)port->force[2], (double)port->moment[0], (double)port->moment[1], (double)port->moment[2], prof));
-    }
-    PetscCall(PetscViewerASCIIPrintf(viewer, "port %s: area %.6g m^2, centroid (%.6g, %.6g, %.6g) m%s\n", port->name, (double)port->area, (double)port->centroid[0], (double)port->centroid[1], (double)port->centroid[2], load));
+  PetscCall(PhlexFlexibleRestoreBasis(&V));
+  PetscCall(VecAssemblyBegin(b->tnode));
+  PetscCall(VecAssemblyEnd(b->tnode));
+  PetscCall(VecAssemblyBegin(b->wnode));
+  PetscCall(VecAssemblyEnd(b->wnode));
+  PetscCall(VecAssemblyBegin(b->vnode));
+  PetscCall(VecAssemblyEnd(b->vnode));
+  PetscCall(MPIU_Allreduce(loc, glob, 17, MPIU_REAL, MPI_SUM, b->comm));
+  b->inertia.m = glob[0];
+  for (PetscInt d = 0; d < 3; d++) {
+    b->inertia.s0[d]   = glob[1 + d];
+    b->inertia.svol[d] = glob[14 + d];
   }
-  PetscCall(PetscViewerASCIIPopTab(viewer));
+  for (PetscInt k = 0; k < 9; k++) b->inertia.E0[k] = glob[4 + k];
+  b->inertia.vol = glob[13];
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexBodyDestroy - destroys a body
+  PhlexFlexibleDestroyFE - frees the spaces, operators and mesh of a flexible body
 @*/
-PetscErrorCode PhlexBodyDestroy(PhlexBody *body)
+PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible b)
 {
-  PhlexBody b = *body;
-
   PetscFunctionBeginUser;
-  if (!b) PetscFunctionReturn(0);
-  for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexPortDestroy(&b->ports[p]));
-  PetscCall(PhlexProfileDestroy(&b->body_force_profile));
-  PetscCall(PhlexProfileDestroy(&b->frame_profile));
   PetscCall(VecDestroy(&b->tnode));
   PetscCall(VecDestroy(&b->wnode));
   PetscCall(VecDestroy(&b->vnode));
@@ -868,6 +653,5 @@ PetscErrorCode PhlexBodyDestroy(PhlexBody *body)
   PetscCall(PetscFree2(b->cell_vdofs, b->cell_soff));
   PetscCall(PetscFree(b->cell_geom));
   PetscCall(PetscFree(b->groups));
-  PetscCall(PetscFree(*body));
   PetscFunctionReturn(0);
 }

@@ -1,4 +1,4 @@
-/* Rotation algebra and 3x3 helpers of the floating frame (paper Section 3: R stored row-wise, R' = R [w]x).
+/* Rotation algebra and 3x3 helpers of moving frames and joints (paper Section 3: R stored row-wise, R' = R [w]x).
    Pure functions on arrays: no PETSc objects. Matrices are row-major 3x3. */
 #include <phlex_impl.h>
 
@@ -14,6 +14,11 @@ void PhlexCross(const PetscReal a[3], const PetscReal b[3], PetscReal c[3])
 PetscReal PhlexDot3(const PetscReal a[3], const PetscReal b[3])
 {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+PetscReal PhlexNorm3(const PetscReal a[3])
+{
+  return PetscSqrtReal(PhlexDot3(a, a));
 }
 
 /* S = [a]x, the matrix with S b = a x b */
@@ -53,6 +58,20 @@ void PhlexMatMat3(const PetscReal A[9], const PetscReal B[9], PetscReal C[9])
 {
   for (PetscInt i = 0; i < 3; i++)
     for (PetscInt j = 0; j < 3; j++) C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+/* C = A^T B (C must not alias A or B) */
+void PhlexMatTMat3(const PetscReal A[9], const PetscReal B[9], PetscReal C[9])
+{
+  for (PetscInt i = 0; i < 3; i++)
+    for (PetscInt j = 0; j < 3; j++) C[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
+}
+
+/* C = A B^T (C must not alias A or B) */
+void PhlexMatMatT3(const PetscReal A[9], const PetscReal B[9], PetscReal C[9])
+{
+  for (PetscInt i = 0; i < 3; i++)
+    for (PetscInt j = 0; j < 3; j++) C[3 * i + j] = A[3 * i] * B[3 * j] + A[3 * i + 1] * B[3 * j + 1] + A[3 * i + 2] * B[3 * j + 2];
 }
 
 /* ||R^T R - I||_F */
@@ -144,4 +163,59 @@ void PhlexAxisAngleToRotation(const PetscReal axis[3], PetscReal angle, PetscRea
   q[0] = PetscCosReal(0.5 * angle);
   for (PetscInt k = 0; k < 3; k++) q[1 + k] = (n > 0 ? axis[k] / n : 0.0) * PetscSinReal(0.5 * angle);
   PhlexQuaternionToRotation(q, R);
+}
+
+/* Rotation vector phi (axis times angle in [0, pi]) of a rotation matrix: R = exp([phi]x) */
+void PhlexRotationVector(const PetscReal R[9], PetscReal phi[3])
+{
+  PetscReal q[4], s, angle;
+
+  PhlexRotationToQuaternion(R, q); /* w >= 0: angle in [0, pi] */
+  s     = PetscSqrtReal(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  angle = 2.0 * PetscAtan2Real(s, q[0]);
+  for (PetscInt k = 0; k < 3; k++) phi[k] = s > 0 ? q[1 + k] / s * angle : 2.0 * q[1 + k]; /* small angles: 2 q_v */
+}
+
+/* R <- R exp([theta]x): a rotation by the body-frame rotation vector theta (assembly and drift corrections) */
+void PhlexRotationUpdate(PetscReal R[9], const PetscReal theta[3])
+{
+  PetscReal E[9], N[9], a = PhlexNorm3(theta);
+
+  PhlexAxisAngleToRotation(a > 0 ? theta : (PetscReal[3]){1, 0, 0}, a, E);
+  PhlexMatMat3(R, E, N);
+  for (PetscInt k = 0; k < 9; k++) R[k] = N[k];
+  PhlexOrthonormalize(R);
+}
+
+/* An orthonormal frame (rows e1, e2, e3) with e3 along 'axis' and e1 along the part of 'reference' orthogonal to it
+   (reference NULL or parallel to the axis: the coordinate axis least aligned with e3) */
+void PhlexCompleteFrame(const PetscReal axis[3], const PetscReal *reference, PetscReal F[9])
+{
+  PetscReal e3[3], e1[3], e2[3], n = PhlexNorm3(axis), r[3], d, rn;
+
+  for (PetscInt k = 0; k < 3; k++) e3[k] = axis[k] / n;
+  rn = 0;
+  if (reference) {
+    d = PhlexDot3(reference, e3);
+    for (PetscInt k = 0; k < 3; k++) r[k] = reference[k] - d * e3[k];
+    rn = PhlexNorm3(r);
+  }
+  if (!reference || rn < 1e-8 * PhlexNorm3(reference)) {
+    PetscInt  imin = 0;
+    PetscReal amin = PetscAbsReal(e3[0]);
+    for (PetscInt k = 1; k < 3; k++)
+      if (PetscAbsReal(e3[k]) < amin - 1e-12) {
+        amin = PetscAbsReal(e3[k]);
+        imin = k;
+      }
+    for (PetscInt k = 0; k < 3; k++) r[k] = (k == imin ? 1.0 : 0.0) - e3[imin] * e3[k];
+    rn = PhlexNorm3(r);
+  }
+  for (PetscInt k = 0; k < 3; k++) e1[k] = r[k] / rn;
+  PhlexCross(e3, e1, e2);
+  for (PetscInt k = 0; k < 3; k++) {
+    F[k]     = e1[k];
+    F[3 + k] = e2[k];
+    F[6 + k] = e3[k];
+  }
 }

@@ -1,0 +1,244 @@
+/* A flexible body: a 3D elastic solid discretised with mixed P_k velocity / discontinuous P_{k-1} stress elements
+   (paper Section 4), either fixed (clamped on its frame patch) or floating (its frame translates and rotates). */
+#ifndef PHLEX_PRIVATE_FLEXIBLE_H
+#define PHLEX_PRIVATE_FLEXIBLE_H
+
+#define PHLEX_MAX_MATERIALS 16
+
+/* Stress components (Voigt order) of the 6-component stress field; shear components hold the tensor entry. */
+enum { PHLEX_S_XX, PHLEX_S_YY, PHLEX_S_ZZ, PHLEX_S_YZ, PHLEX_S_XZ, PHLEX_S_XY };
+
+/* A gmsh physical group: name, topological dimension, tag. */
+typedef struct {
+  char     name[PHLEX_NAME_LEN];
+  PetscInt dim, tag;
+} PhlexPhysicalGroup;
+
+/* Isotropic linear elastic material of one volume region (or of the whole body). SI units. */
+typedef struct {
+  char      region[PHLEX_NAME_LEN]; /* physical volume name, empty for the whole body */
+  PetscInt  tag;                    /* "Cell Sets" value, -1 for the whole body */
+  PetscReal youngs_modulus, poissons_ratio, density;
+} PhlexMaterial;
+
+/* A port of a flexible body: a named boundary surface. Its wrench (force F, moment T about the patch centroid c) is
+   distributed as the traction tau = F/A + (I_c^{-1} T) x (x - c) (DESIGN section 3); the columns dist[k] of B are
+   the nodal loads of unit wrench components, and its collocated output is B^T v (patch-average velocity and angular
+   velocity). */
+typedef struct {
+  char          name[PHLEX_NAME_LEN];
+  PetscInt      tag;
+  PetscReal     area, centroid[3], inertia[9], inertia_inv[9]; /* SI patch geometry */
+  Vec           dist[6];                                      /* B columns (non-dimensional) */
+  PhlexPortLoad load;
+} PhlexFlexPort;
+
+/* Inertia invariants of a moving frame about its origin P (non-dimensional). */
+typedef struct {
+  PetscReal m, s0[3], E0[9]; /* int rho, int rho x, int rho x x^T */
+  PetscReal vol, svol[3];    /* int 1, int x (uniform body force) */
+} PhlexInertia;
+
+/* The dynamics of a moving frame carrying an optional elastic field (frame.c): a floating flexible body, or a rigid
+   body (no field). */
+typedef struct {
+  MPI_Comm         comm;
+  PetscBool        frozen;  /* inertia terms at u_f = 0 */
+  PhlexInertia     inertia;
+  Vec              tnode, wnode; /* per node: int rho phi, int rho x phi (NULL: no field) */
+  Mat              Mv;           /* velocity mass of the field (NULL: no field) */
+  const PetscReal *gravity;      /* non-dimensional, inertial frame */
+} PhlexFrame;
+
+/* A frame evaluated at a state and its rates (frame.c); all non-dimensional, body frame. */
+typedef struct {
+  PetscReal r[3], R[9], vP[3], w[3], rd[3], Rd[9], vPd[3], wd[3];
+  PetscReal m, s[3], sd[3], sgrav[3], Vf[3], Vfd[3], E[9], Ed[9], J[9], Jd[9], L[3], Ld[3];
+  PetscReal pt[3], pr[3], ptd[3], prd[3], gbody[3], Fext[3], Mext[3];
+  PetscReal Lx[3]; /* int rho (x - P) x v (the mean-axes rotation constraint) */
+  Vec       Mu, Mvv, Mud, Mvd, bext; /* Mv u, Mv v, Mv u', Mv v', elastic load (field only) */
+} PhlexFrameState;
+
+PETSC_INTERN PetscErrorCode PhlexFrameEvaluate(PhlexFrame *, Vec, Vec, Vec, Vec, const PetscReal[18], const PetscReal[18], PhlexFrameState *);
+PETSC_INTERN PetscErrorCode PhlexFrameAddLoadArms(PhlexFrame *, Vec, PhlexFrameState *);
+PETSC_INTERN PetscErrorCode PhlexFrameResidual(PhlexFrame *, PhlexFrameState *, Vec, Vec, Vec, Vec, PetscReal[18]);
+PETSC_INTERN PetscErrorCode PhlexFrameJacobian(PhlexFrame *, PhlexFrameState *, PetscReal, Vec, Vec, PetscScalar *, PetscScalar *, PetscScalar *, PetscInt, PetscReal[9], PetscReal[9], PetscReal[324]);
+PETSC_INTERN PetscErrorCode PhlexFrameEnergy(PhlexFrame *, PhlexFrameState *, Vec, PetscReal *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFrameMomenta(PhlexFrameState *, PetscReal[3], PetscReal[3]);
+PETSC_INTERN PetscErrorCode PhlexFrameStateDestroy(PhlexFrameState *);
+PETSC_INTERN PetscErrorCode PhlexFrameRigidMass(const PhlexInertia *, PetscReal[36]);
+PETSC_INTERN PetscErrorCode PhlexFrameWriteHeader(char[], size_t);
+PETSC_INTERN PetscErrorCode PhlexFrameWriteRow(PetscViewer, PetscReal, PhlexFrameState *, const PhlexUnits *, PetscReal[3], PetscReal[3]);
+
+/* Initial condition of a field. */
+typedef enum {
+  PHLEX_IC_ZERO,
+  PHLEX_IC_UNIFORM,
+  PHLEX_IC_RIGID,
+  PHLEX_IC_BEAM,
+  PHLEX_IC_MODE
+} PhlexICType;
+PETSC_EXTERN const char *const PhlexICTypes[];
+
+typedef struct {
+  PhlexICType type;
+  PetscReal   value[6];     /* uniform: velocity (3) or stress (6); rigid: translation velocity */
+  PetscReal   angular[3];   /* rigid: angular velocity, about 'origin' */
+  PetscReal   origin[3];
+  PetscInt    mode;         /* mode number (1-based) for PHLEX_IC_MODE and PHLEX_IC_BEAM */
+  PetscReal   amplitude;    /* max |field| for modes, tip value for beam */
+  PetscReal   direction[3]; /* beam deflection direction */
+} PhlexIC;
+
+/* How the body frame is fixed to a floating body. */
+typedef enum {
+  PHLEX_FRAME_PATCH,     /* u_f = v_f = 0 on a surface (the paper's Gamma_D): a rigid inclusion */
+  PHLEX_FRAME_MEAN_AXES  /* Tisserand/Buckens: int rho u_f = 0, int rho (x - P) x u_f = 0 (six multipliers) */
+} PhlexFrameCondition;
+PETSC_EXTERN const char *const PhlexFrameConditions[];
+
+typedef struct _p_PhlexFlexible *PhlexFlexible;
+
+/* element.c: element kernels on PetscFE tabulations (pure arithmetic) */
+#define PHLEX_MAX_NODES 10 /* P2 tetrahedron */
+typedef struct {
+  PetscInt         nq, nb, nc, nnodes; /* quadrature points, basis functions (all components), components, nodes */
+  const PetscReal *weights;            /* [nq] reference weights */
+  PetscReal       *node_phi;           /* [nq][nnodes] scalar shape of each node */
+  PetscReal       *node_dphi;          /* [nq][nnodes][3] its reference gradient */
+} PhlexElementBasis;
+typedef struct {
+  PetscInt  nv, ns; /* velocity and stress nodes */
+  PetscReal mass[PHLEX_MAX_NODES * PHLEX_MAX_NODES], grad[PHLEX_MAX_NODES * PHLEX_MAX_NODES * 9];
+  PetscReal smass[16], coup[4 * PHLEX_MAX_NODES * 3], load[PHLEX_MAX_NODES];
+} PhlexElementReferenceIntegrals;
+PETSC_INTERN void     PhlexElementReference(const PhlexElementBasis *, const PhlexElementBasis *, PhlexElementReferenceIntegrals *);
+PETSC_INTERN void     PhlexElementCompliance(PetscReal, PetscReal, PetscReal[36]);
+PETSC_INTERN void     PhlexElementMass(const PhlexElementReferenceIntegrals *, PetscReal, PetscReal, PetscReal *);
+PETSC_INTERN void     PhlexElementLoad(const PhlexElementReferenceIntegrals *, PetscReal, PetscReal *);
+PETSC_INTERN void     PhlexElementCoupling(const PhlexElementReferenceIntegrals *, PetscReal, const PetscReal[9], PetscReal *, PetscReal *);
+PETSC_INTERN void     PhlexElementComplianceMass(const PhlexElementReferenceIntegrals *, PetscReal, const PetscReal[36], PetscReal *);
+PETSC_INTERN void     PhlexElementStiffness(const PhlexElementReferenceIntegrals *, PetscReal, PetscReal, PetscReal, const PetscReal[9], PetscReal *);
+PETSC_INTERN PetscInt PhlexElementCondense(PetscInt, PetscInt, PetscReal *, const PetscReal *, PetscReal *, PetscReal *);
+PETSC_INTERN PetscInt PhlexDenseCholesky(PetscInt, PetscReal *);
+PETSC_INTERN void     PhlexDenseCholeskySolve(PetscInt, const PetscReal *, PetscInt, PetscReal *);
+
+struct _p_PhlexFlexible {
+  MPI_Comm            comm;
+  PhlexPart           part; /* the part it implements */
+  const char         *name, *prefix;
+  char                mesh_file[PETSC_MAX_PATH_LEN];
+  PetscInt            ngroups;
+  PhlexPhysicalGroup *groups;
+  PetscInt            degree;            /* velocity P_k, stress P_{k-1} discontinuous */
+  PetscInt            extra_refinements; /* uniform refinements on top of -dm_refine (convergence studies) */
+  char                frame_patch[PHLEX_NAME_LEN]; /* Dirichlet patch Gamma_D ("" for none) */
+  PetscInt            frame_tag;
+  PetscReal           frame_area, frame_centroid[3], frame_inertia[9]; /* SI geometry of the frame patch */
+  PetscInt            nmaterials;
+  PhlexMaterial       materials[PHLEX_MAX_MATERIALS];
+  PetscInt            nports;
+  PhlexFlexPort      *ports;
+  PetscReal           body_force[3]; /* N/m^3, body frame */
+  PhlexProfile        body_force_profile;
+  PetscBool           has_body_force;
+  PhlexIC             ic_velocity, ic_displacement, ic_stress;
+
+  /* floating frame */
+  PetscBool           floating;         /* rigid motion of the frame is an unknown */
+  PhlexFrameCondition frame_condition;  /* patch or mean axes */
+  PetscBool           frozen_inertia;   /* inertia terms at u_f = 0 */
+  PetscReal           origin[3];        /* frame origin P (SI mesh coordinates) */
+  PetscBool           origin_given;
+  PhlexPose           pose;             /* initial r_P, R, v_P, w */
+  PetscReal           frame_force[3], frame_moment[3]; /* wrench at P [N, N m] (body frame) */
+  PhlexProfile        frame_profile;
+  PetscBool           frame_loaded;
+  PhlexInertia        inertia;     /* about the frame origin (fixed body: about the inertial origin) */
+  PhlexFrame          frame;       /* the frame dynamics (floating) */
+  PhlexFrameState     fs;          /* its last evaluation */
+  Vec                 tnode, wnode, vnode; /* per node: int rho phi, int rho x phi, int phi (triples) */
+
+  /* discretisation */
+  DM        dm;   /* DMPlex with the velocity field (P_k vector, essential BC on the frame patch) */
+  DM        dm_s; /* clone with the stress field (P_{k-1} discontinuous, 6 components) */
+  PetscFE   fe_v, fe_s;
+  PetscInt  cStart, cEnd;
+  PetscInt  nb_v, nb_s;      /* basis functions per cell (all components) */
+  PetscInt *cell_material;   /* material index per local cell */
+  PetscInt *cell_vdofs;      /* per local cell: global velocity dofs of its closure (negative: constrained) */
+  PetscInt *cell_soff;       /* per local cell: global offset of its stress dofs */
+  PhlexElementReferenceIntegrals ref;
+  PetscReal *cell_geom;      /* per local cell: detJ, invJ[9] (non-dimensional) */
+  PetscReal  bbox_min[3], bbox_max[3];
+
+  /* constant body-frame operators (non-dimensional), assembled once */
+  Mat Mv;      /* velocity mass int rho phi.phi (SBAIJ) */
+  Mat K;       /* condensed stiffness G^T Ms^{-1} G (SBAIJ) */
+  Mat G;       /* coupling int Sigma : Grad(v), stress rows x velocity columns */
+  Mat Ms;      /* compliance mass, block diagonal (BAIJ, one block per cell) */
+  Vec fvol[3]; /* int phi e_c dOmega (uniform body forces) */
+
+  /* Jacobian pieces (transient), updated by the part */
+  PetscReal shift;          /* non-dimensional shift of the assembled blocks (0: none yet) */
+  Mat       Gt, Mvaij, Kaij, Jvv, Jvu, Sv;
+  PetscScalar *Bc, *Cu, *Cv, *Cpre; /* floating: dense borders of its own discrete unknowns (n_local x nq, column-major) */
+  PetscReal Bvv[9], Bvu[9];   /* floating: node-wise blocks applied after Mv */
+  Mat       W;                /* border basis: frame (12 columns) and the ports with joints (6 each) */
+  PetscInt *port_basis_col;   /* first column of each port's distribution in W (-1: not in W) */
+  Vec       load, work;       /* velocity-space work vectors */
+  Vec       ud, vd;           /* non-dimensional rates (floating) */
+  PetscReal (*port_ext)[6];   /* external port wrenches at the evaluated time (body frame) */
+  PetscReal (*port_y)[6];     /* port outputs at the evaluated state */
+  PetscReal (*port_arm)[18];  /* full model: sum_l u(l) x dist_k(l), 3 x 6 per port (moment arms of the port forces) */
+  PetscReal  t_eval, power_ext;
+  PetscBool  joints_added;    /* the joint wrenches are in the loads of the evaluated state */
+  Vec        bgrav;           /* fixed body: nodal gravity load */
+  PetscScalar *gram;          /* LU of W^T W */
+  PetscBLASInt *gram_piv;
+  PetscInt   kW;              /* columns of W */
+
+  /* output */
+  void *writer, *rigid_csv, *ports_csv;
+
+  /* sizes and integrals */
+  PetscInt  nv_local, ns_local;
+  PetscInt  nv_global, ns_global;
+  PetscReal volume, mass;      /* SI */
+  PetscReal center_of_mass[3]; /* SI */
+};
+
+/* mesh.c */
+PETSC_INTERN PetscErrorCode PhlexMeshReadPhysicalNames(MPI_Comm, const char[], const char[], PetscInt *, PhlexPhysicalGroup **);
+PETSC_INTERN PetscErrorCode PhlexMeshLoad(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexMeshFindGroup(PhlexFlexible, const char[], PetscInt, const char[], PetscInt *);
+PETSC_INTERN PetscErrorCode PhlexMeshCheckGeometry(PhlexFlexible);
+
+/* flexible_fe.c: spaces and constant operators */
+PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpInertia(PhlexFlexible, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleGetBasis(PhlexFlexible, PetscBool, PhlexElementBasis *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleRestoreBasis(PhlexElementBasis *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible, Vec, Vec, PetscReal *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible);
+
+/* flexible_port.c */
+typedef PetscErrorCode (*PhlexSurfaceFunc)(void *, PetscInt, const PetscReal *, const PetscReal *, const PetscReal *, const PetscInt *, const PetscInt *, PetscInt);
+PETSC_INTERN PetscErrorCode PhlexSurfaceIntegrate(PhlexFlexible, PetscInt, PetscInt, PhlexSurfaceFunc, void *);
+PETSC_INTERN PetscErrorCode PhlexSurfaceMoments(PhlexFlexible, PetscInt, PetscReal *, PetscReal[3], PetscReal[9]);
+PETSC_INTERN PetscErrorCode PhlexFlexPortSetUp(PhlexFlexible, PhlexFlexPort *, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexFlexPortDestroy(PhlexFlexPort *);
+
+/* flexible_ic.c */
+PETSC_INTERN PetscErrorCode PhlexFlexibleICSetFromOptions(PhlexFlexible, PhlexIC *, const char[], PetscInt);
+PETSC_INTERN PetscErrorCode PhlexFlexibleInitialState(PhlexPart, PhlexPartVec *);
+
+/* flexible_modes.c */
+PETSC_INTERN PetscErrorCode PhlexFlexibleComputeModes(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
+PETSC_INTERN PetscErrorCode PhlexFlexibleModesOutput(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleRefine(PhlexPart, PetscInt, PhlexPart *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleModesOrder(PhlexPart, char[], size_t);
+PETSC_INTERN PetscErrorCode PhlexFlexibleModesKind(PhlexPart, char[], size_t, PetscInt *);
+
+#endif

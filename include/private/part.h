@@ -1,0 +1,196 @@
+/* The part contract (DESIGN section 3): every part of a mechanism -- flexible FE body (fixed or floating), rigid
+   body, lumped mass, ground, later a reduced (modal) body -- implements this table of operations. The system, the
+   joints, the integrator and the outputs call parts only through it; none of them knows what kind a part is.
+
+   Unknowns of a part, in the global vector (system.c):
+     field blocks   u (displacement), Sigma (stress), v (velocity): distributed over all ranks, flexible bodies only;
+     discrete ones  q: a few unknowns (rigid frame, lumped position, internal multipliers, modal coordinates), on
+                    rank 0 in the global vector and handed to the part on every rank.
+   A part's residual rows are those of its unknowns. Its coupling to other parts goes through its ports: the velocity
+   of a port (its collocated output y = (translational velocity of the port point, angular velocity), body frame
+   components) and the distribution of a wrench w = (force, moment about the port point, body frame) over the part's
+   equations, which is the transpose of the output map (power w . y, paper Section 5). Joints set the wrenches.
+
+   All quantities are non-dimensional (PhlexUnits) except rates handed to evaluate/residual: time derivatives are in
+   SI time (TS); a part multiplies them by units->time. */
+#ifndef PHLEX_PRIVATE_PART_H
+#define PHLEX_PRIVATE_PART_H
+
+#define PHLEX_NAME_LEN 64
+
+/* Fields of the global unknown vector, each contiguous on every rank. */
+typedef enum {
+  PHLEX_FIELD_DISPLACEMENT,
+  PHLEX_FIELD_STRESS,
+  PHLEX_FIELD_VELOCITY,
+  PHLEX_FIELD_DISCRETE, /* rigid states, lumped states, multiplier impulses of joints and internal constraints */
+  PHLEX_NUM_FIELDS
+} PhlexField;
+PETSC_EXTERN const char *const PhlexFieldNames[];
+
+/* What a discrete unknown is: checkpoints name it, adaptive steps leave impulses out of the error norm, the
+   consistent start replaces velocities only. */
+typedef enum {
+  PHLEX_DOF_CONFIGURATION,
+  PHLEX_DOF_VELOCITY,
+  PHLEX_DOF_IMPULSE
+} PhlexDofKind;
+
+/* Offsets of a moving frame's unknowns among a part's discrete unknowns (-1: absent): position r of the frame
+   origin P (inertial), rotation R (row-wise, body to inertial), velocity v_P and angular velocity w (body frame). */
+typedef struct {
+  PetscInt r, R, v, w;
+} PhlexFrameIndex;
+
+/* A part's view of a global vector: its field blocks and its discrete unknowns (an array valid on every rank). */
+typedef struct {
+  Vec        u, s, v;
+  PetscReal *q;
+} PhlexPartVec;
+
+/* Matrices of a part's field blocks, referenced by the system's Jacobian (owned and updated by the part). */
+typedef struct {
+  Mat      G, Gt;    /* coupling (stress rows x velocity columns) and its transpose */
+  Mat      Ms;       /* compliance mass, block diagonal per cell */
+  PetscInt stress_bs; /* stress unknowns per cell (block size of Ms) */
+  Mat      Jvv, Jvu; /* velocity rows: d/dv (shift Mv [+ node-wise terms]) and d/du (node-wise terms, or NULL) */
+  Mat      Sv;       /* preconditioner: condensed velocity operator shift Mv + K/shift (AIJ, rigid modes attached) */
+} PhlexFieldOperators;
+
+/* Reference scales a part suggests before set-up (the scene takes the largest of each). */
+typedef struct {
+  PetscReal extent;  /* geometric size [m] */
+  PetscReal density; /* [kg/m^3], 0 if none */
+  PetscReal modulus; /* [Pa], 0 if none */
+  PetscReal mass;    /* [kg], 0 if none */
+} PhlexScaleHints;
+
+/* A port of a part. */
+typedef struct {
+  char      name[PHLEX_NAME_LEN];
+  PetscInt  dim;      /* 6 (force and moment) or 3 (a point: force only, no orientation) */
+  PetscReal point[3]; /* port point relative to the frame origin P, body frame, non-dimensional */
+} PhlexPortInfo;
+
+typedef struct {
+  PetscErrorCode (*setfromoptions)(PhlexPart);
+  PetscErrorCode (*geometry)(PhlexPart, PhlexScaleHints *); /* read meshes, suggest scales */
+  PetscErrorCode (*setup)(PhlexPart);                       /* operators, sizes, ports (part->units is set) */
+  PetscErrorCode (*view)(PhlexPart, PetscViewer);
+  PetscErrorCode (*destroy)(PhlexPart);
+  /* state */
+  PetscErrorCode (*initialstate)(PhlexPart, PhlexPartVec *);
+  PetscErrorCode (*evaluate)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *); /* t, X, X' (or NULL: rest) */
+  PetscErrorCode (*residual)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PhlexPartVec *);
+  PetscErrorCode (*jacobian)(PhlexPart, PetscReal, const PhlexPartVec *, PetscReal *, PetscInt); /* shift, X, its block of the dense discrete Jacobian (row-major, leading dim) */
+  PetscErrorCode (*poststep)(PhlexPart, PetscReal *, PetscReal *);         /* its discrete unknowns after a step; largest correction */
+  /* Jacobian pieces of the field blocks and of the border between fields and discrete unknowns */
+  PetscErrorCode (*fieldoperators)(PhlexPart, PhlexFieldOperators *);
+  PetscErrorCode (*bordermult)(PhlexPart, const PetscReal *, Vec);               /* y_v += B x_q (its own columns) */
+  PetscErrorCode (*bordermulttranspose)(PhlexPart, Vec, PetscReal, Vec, PetscReal *); /* y_q += a Cu^T x_u + Cv^T x_v (its own rows; NULL vectors are zero) */
+  PetscErrorCode (*borderbasis)(PhlexPart, Mat *);                               /* W: state-independent span of its borders */
+  PetscErrorCode (*borderrows)(PhlexPart, Mat, PetscReal *, PetscInt);           /* (Cv + Cu/shift)^T Y, nq x k column-major, ld */
+  PetscErrorCode (*bordercoefficients)(PhlexPart, PetscReal *, PetscInt);        /* beta: own border columns ~ W beta (k x nq, ld) */
+  /* ports */
+  PetscErrorCode (*portoutput)(PhlexPart, PetscInt, PetscReal[6]);                           /* y at the evaluated state */
+  PetscErrorCode (*portlinear)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal *, PetscReal[6]); /* dy for (a du, dv, dq); NULL: zero */
+  PetscErrorCode (*portlinearblock)(PhlexPart, PetscInt, Mat, PetscReal, PetscReal *);         /* dy for dv = columns of Y, du = Y/shift: 6 x k */
+  PetscErrorCode (*portforce)(PhlexPart, PetscInt, const PetscReal[6], Vec, PetscReal *);      /* += generalized force of w (fv may be NULL) */
+  PetscErrorCode (*portbasiscolumn)(PhlexPart, PetscInt, PetscInt *);                          /* first of the 6 columns of W spanning its field force */
+  PetscErrorCode (*portplacement)(PhlexPart, PetscInt, const PhlexPartVec *, PetscReal[3], PetscReal[9]); /* inertial position, orientation */
+  /* energy, inputs, outputs */
+  PetscErrorCode (*energy)(PhlexPart, const PhlexPartVec *, PetscReal *, PetscReal *, PetscReal *); /* kinetic, strain, potential at the evaluated state X */
+  PetscErrorCode (*momenta)(PhlexPart, PetscReal[3], PetscReal[3]);         /* inertial linear and angular momentum (about the origin), evaluated state */
+  PetscErrorCode (*inputpower)(PhlexPart, PetscReal *);                       /* power of its external inputs at the evaluated state */
+  PetscErrorCode (*rigidmass)(PhlexPart, PetscReal[36]);                      /* mass matrix of its frame motion (v_P, w), body frame */
+  PetscErrorCode (*outputopen)(PhlexPart, PhlexOutput, PetscBool);
+  PetscErrorCode (*outputstep)(PhlexPart, PetscInt, PetscReal, const PhlexPartVec *, PetscBool); /* series rows (step >= 0), fields if asked */
+  PetscErrorCode (*outputclose)(PhlexPart);
+  PetscErrorCode (*modes)(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
+  PetscErrorCode (*modesoutput)(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *);
+  PetscErrorCode (*refine)(PhlexPart, PetscInt, PhlexPart *); /* the same part on a finer discretisation */
+  PetscErrorCode (*modesorder)(PhlexPart, char[], size_t);      /* its discretisation and the order of its eigenvalues under refinement */
+  PetscErrorCode (*modeskind)(PhlexPart, char[], size_t, PetscInt *); /* "free", "clamped", ...; how many rigid-body modes it has (-1: none counted) */
+  PetscErrorCode (*place)(PhlexPart, const PetscReal[3], PetscReal *); /* put its port at a point (an attached part given no position) */
+} PhlexPartOps;
+
+struct _p_PhlexPart {
+  MPI_Comm          comm;
+  PetscInt          index; /* k of the prefix body<k>_; -1 for the ground */
+  char              prefix[32];
+  char              name[PHLEX_NAME_LEN];
+  char              type[32];
+  PhlexPartOps      ops;
+  void             *data;
+  const PhlexUnits *units;
+  PetscReal         gravity[3]; /* non-dimensional, inertial frame */
+
+  /* layout: set by setup */
+  PetscInt        nu, ns, nv; /* local sizes of the field blocks (nu = nv), 0 without a field */
+  PetscInt        Nu, Ns, Nv; /* global sizes */
+  PetscInt        nq;         /* discrete unknowns */
+  PhlexDofKind   *qkind;
+  char          (*qname)[16];
+  PhlexFrameIndex frame;
+  PetscBool       nonlinear; /* its residual is not linear in its unknowns (a moving frame) */
+
+  /* ports: set by setup; the wrench on each port from the joints (body frame, non-dimensional) is set by the
+     system before residual and jacobian */
+  PetscInt       nports;
+  PhlexPortInfo *ports;
+  PetscReal    (*wrench)[6];
+  PetscBool     *port_used; /* a joint acts on the port (its force distribution enters the border basis) */
+
+  char attach[2 * PHLEX_NAME_LEN + 2]; /* "body:port" this part asks to be joined to by a spherical joint ("" none) */
+
+  /* placement in the global unknowns: set by the system */
+  PetscInt qoff;          /* offset of q in the discrete field */
+  IS       isu, iss, isv; /* field blocks in the global vector */
+};
+
+/* part.c helpers */
+PETSC_INTERN PetscErrorCode PhlexPartSetUpLayout(PhlexPart, PetscInt, PetscInt, PetscInt, PetscInt, PetscInt);
+PETSC_INTERN PetscErrorCode PhlexPartSetDof(PhlexPart, PetscInt, PhlexDofKind, const char[]);
+PETSC_INTERN PetscErrorCode PhlexPartSetPorts(PhlexPart, PetscInt);
+PETSC_INTERN PetscErrorCode PhlexPartFindPort(PhlexPart, const char[], PetscInt *);
+PETSC_INTERN PetscErrorCode PhlexPartGetVec(PhlexPart, Vec, PetscReal *, PhlexPartVec *);
+PETSC_INTERN PetscErrorCode PhlexPartRestoreVec(PhlexPart, Vec, PhlexPartVec *);
+PETSC_INTERN PetscErrorCode PhlexPartCreateGround(MPI_Comm, PhlexPart *);
+PETSC_INTERN PetscBool      PhlexPartIsGround(PhlexPart);
+
+/* Wrench inputs of a port given in the scene (flexible and rigid bodies): amplitudes with a time profile, directions
+   fixed in the body frame or in the inertial frame. */
+typedef enum {
+  PHLEX_DIRECTION_BODY,
+  PHLEX_DIRECTION_INERTIAL
+} PhlexDirectionFrame;
+PETSC_EXTERN const char *const PhlexDirectionFrames[];
+
+typedef struct {
+  PetscReal           force[3], moment[3]; /* amplitudes (SI) */
+  PetscBool           loaded;
+  PetscBool           traction_input; /* amplitude given as a traction [Pa] (flexible ports) */
+  PhlexDirectionFrame frame;
+  PhlexProfile        profile;
+} PhlexPortLoad;
+PETSC_INTERN PetscErrorCode PhlexPortLoadSetFromOptions(PhlexPart, const char[], PetscBool, PhlexPortLoad *);
+PETSC_INTERN PetscErrorCode PhlexPortLoadEvaluate(PhlexPortLoad *, PetscReal, const PhlexUnits *, const PetscReal *, PetscReal[6]);
+PETSC_INTERN PetscErrorCode PhlexPortLoadDerivativeR(PhlexPortLoad *, PetscReal, const PhlexUnits *, PetscInt, PetscReal[6]);
+PETSC_INTERN PetscErrorCode PhlexPortLoadDescribe(PhlexPortLoad *, char[], size_t);
+PETSC_INTERN PetscErrorCode PhlexPortLoadDestroy(PhlexPortLoad *);
+
+/* Initial placement and velocity of a moving frame (floating flexible body, rigid body). */
+typedef struct {
+  PetscReal position[3], rotation[9]; /* r_P [m], R */
+  PetscReal velocity[3], omega[3];    /* v_P [m/s], w [rad/s], body frame */
+  PetscBool position_given, orientation_given, velocity_given, omega_given;
+} PhlexPose;
+PETSC_INTERN PetscErrorCode PhlexPoseSetFromOptions(PetscOptionItems *, PhlexPart, PhlexPose *, const char **);
+
+/* the kinds (each one file) */
+PETSC_INTERN PetscErrorCode PhlexPartCreate_Flexible(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexPartCreate_Rigid(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexPartCreate_Lumped(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexPartCreate_Ground(PhlexPart);
+
+#endif

@@ -1,0 +1,96 @@
+/* The assembled system of a scene (system.c): the global unknowns, the index-2 pHDAE residual F(t, X, X') and its
+   Jacobian over all parts and joints, and the border data of PC phlexbordered. */
+#ifndef PHLEX_PRIVATE_SYSTEM_H
+#define PHLEX_PRIVATE_SYSTEM_H
+
+/* layout.c: named fields contiguous per rank, exposed as a DMShell for PCFIELDSPLIT */
+#define PHLEX_LAYOUT_MAX_FIELDS 8
+typedef struct _p_PhlexLayout *PhlexLayout;
+typedef PetscErrorCode (*PhlexLayoutPmatFn)(void *, PetscInt, const PetscInt[], Mat *);
+PETSC_INTERN PetscErrorCode PhlexLayoutCreateDM(MPI_Comm, PetscInt, const char *const[], const PetscInt[], const PetscInt[], PhlexLayoutPmatFn, void *, DM *);
+PETSC_INTERN PetscErrorCode PhlexLayoutGetFieldIS(DM, PetscInt, IS *);
+
+/* What PC phlexbordered needs of a bordered system [[A, B], [C, D]] with A block diagonal (one sparse block per
+   flexible body) and D dense (the discrete unknowns); composed on its preconditioning matrix as "phlex_border". */
+typedef struct {
+  PetscInt         nblocks;
+  Mat             *A;    /* the sparse blocks (condensed velocity operators) */
+  Mat             *W;    /* per block: basis of the state-independent border span (n_i x k_i dense), or NULL */
+  PetscInt        *off;  /* per block: first local row in the preconditioner's vector */
+  PetscInt        *n;    /* per block: local rows */
+  PetscInt         qoff; /* first local row of the discrete unknowns in the preconditioner's vector */
+  PetscInt         m;    /* discrete unknowns */
+  const PetscReal *D;    /* m x m, row-major, on every rank */
+  void            *ctx;
+  PetscErrorCode (*rows)(void *, PetscInt, Mat, PetscReal *);       /* C_i Y: m x k column-major */
+  PetscErrorCode (*coefficients)(void *, PetscInt, PetscReal *);    /* beta_i with B_i ~ W_i beta_i: k x m column-major */
+  PetscErrorCode (*rowsvec)(void *, PetscInt, Vec, PetscReal *);    /* y += C_i x (m values) */
+  PetscErrorCode (*blockprefix)(void *, PetscInt, const char **);  /* name used in the options of block i */
+} PhlexBorderedData;
+
+typedef struct _p_PhlexSystem *PhlexSystem;
+struct _p_PhlexSystem {
+  PhlexScene        scene;
+  MPI_Comm          comm;
+  const PhlexUnits *units;
+  PetscInt          nparts;
+  PhlexPart        *parts;  /* the scene's parts (the ground has no unknowns and is not listed) */
+  PetscInt          nfparts;
+  PhlexPart        *fparts; /* parts with field blocks */
+  PetscInt          njoints;
+  PhlexJoint       *joints;
+  PetscBool         nonlinear;
+
+  /* layout */
+  DM       dm, dm_aux; /* the layout; the same for auxiliary solvers */
+  PetscInt nfields;
+  PetscInt field[PHLEX_NUM_FIELDS]; /* index of each field in the layout (-1: absent) */
+  IS       is[PHLEX_NUM_FIELDS];
+  PetscInt nq;                      /* discrete unknowns (all on rank 0) */
+  PetscInt qlocal;
+  PhlexDofKind *qkind;              /* of every discrete unknown */
+
+  /* replicated discrete values: state, rate (SI time), residual; dense discrete Jacobian (row-major) */
+  PetscReal *q, *qd, *fq, *D;
+
+  /* Jacobian: a MATNEST of the field blocks (MATNEST over the flexible bodies when several), shells for the borders
+     and the dense discrete block */
+  PetscReal shift;
+  Mat       J, Jaij;
+  PetscBool use_aij;
+  Mat       Juu, Juv, Ms, Jss, Jsv, Jvs, Jvv, Jvu, Bvq, Cqu, Cqv, Dq;
+  Mat       Sv, Pvq, Ssv, Abd, Cpre;
+  IS       *fis[3]; /* per field part: its block in the numbering of the displacement, stress, velocity fields */
+  PhlexBorderedData border;
+  Vec       *xu, *xv; /* work: per field part */
+  PetscReal  fprev;    /* Newton: the previous residual norm (round-off floor test) */
+};
+
+PETSC_INTERN PetscErrorCode PhlexSystemCreate(PhlexScene, PhlexSystem *);
+PETSC_INTERN PetscErrorCode PhlexSystemDestroy(PhlexSystem *);
+PETSC_INTERN PetscErrorCode PhlexSystemIFunction(TS, PetscReal, Vec, Vec, Vec, void *);
+PETSC_INTERN PetscErrorCode PhlexSystemIJacobian(TS, PetscReal, Vec, Vec, PetscReal, Mat, Mat, void *);
+PETSC_INTERN PetscErrorCode PhlexSystemGather(PhlexSystem, Vec, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexSystemScatter(PhlexSystem, const PetscReal *, Vec);
+PETSC_INTERN PetscErrorCode PhlexSystemEvaluate(PhlexSystem, PetscReal, Vec, Vec);
+PETSC_INTERN PetscErrorCode PhlexSystemPartVec(PhlexSystem, PhlexPart, Vec, PetscReal *, PhlexPartVec *);
+PETSC_INTERN PetscErrorCode PhlexSystemPartVecRestore(PhlexSystem, PhlexPart, Vec, PhlexPartVec *);
+PETSC_INTERN PetscErrorCode PhlexSystemInitialState(PhlexSystem, Vec);
+PETSC_INTERN PetscErrorCode PhlexSystemPostStep(PhlexSystem, Vec, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
+PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
+PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
+
+/* border.c: the shells of the border blocks and the callbacks of PC phlexbordered */
+PETSC_INTERN PetscErrorCode PhlexBorderCreateShells(PhlexSystem);
+
+/* pcbordered.c */
+PETSC_INTERN PetscErrorCode PhlexPCRegister(void);
+
+/* assembly.c: consistent configuration and velocities, redundancy, drift */
+PETSC_INTERN PetscErrorCode PhlexAssemblyPlaceAttached(PhlexSystem, Vec);
+PETSC_INTERN PetscErrorCode PhlexAssemblyRedundancy(PhlexSystem, Vec, PetscInt *);
+PETSC_INTERN PetscErrorCode PhlexAssemblyClose(PhlexSystem, PetscReal, Vec, PetscBool, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem, TS, PetscReal, PetscReal, Vec, PetscReal *);
+
+#endif

@@ -1,0 +1,154 @@
+/* Modal analysis of a scene: the modes of each body that has them (part operation modes: a flexible body's free,
+   clamped or floating spectrum), their frequencies, residuals, self-checks, a convergence study under refinement and
+   the mode shapes for ParaView. The linearised modes of a whole mechanism are a separate analysis. */
+#include <phlex_impl.h>
+
+static PetscReal Frequency(PetscReal lambda, const PhlexUnits *u)
+{
+  const PetscReal f = PetscSqrtReal(PetscAbsReal(lambda)) / (2.0 * PETSC_PI * u->time);
+  return lambda < 0 ? -f : f;
+}
+
+/* -modes_convergence_refinements n: the elastic frequencies of a body on n further uniform refinements of its
+   discretisation, the observed order of the eigenvalues p = log2((l0 - l1)/(l1 - l2)) over the last three levels
+   (2k for P_k elements) and the Richardson-extrapolated frequencies. */
+static PetscErrorCode ConvergenceStudy(PhlexScene scene, PhlexPart part, PetscInt nlevels, PetscInt nmodes, const PetscReal *lambda0, PetscInt nrigid0)
+{
+  PetscReal *lam, order_expect = -1, order_tol = 0.25, worst = 0;
+  PetscInt   worst_mode = -1;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(scene->comm, NULL, "Convergence study options", NULL);
+  PetscCall(PetscOptionsReal("-expect_convergence_order", "Self-check: expected observed order of the eigenvalues", "PhlexSceneSolveModes", order_expect, &order_expect, NULL));
+  PetscCall(PetscOptionsReal("-expect_convergence_order_tol", "Tolerance of that check (absolute, on the order)", "PhlexSceneSolveModes", order_tol, &order_tol, NULL));
+  PetscOptionsEnd();
+  PetscCall(PetscCalloc1((nlevels + 1) * nmodes, &lam));
+  for (PetscInt m = 0; m < nmodes; m++) lam[m] = lambda0[nrigid0 + m];
+  for (PetscInt l = 1; l <= nlevels; l++) {
+    PhlexPart  r;
+    PetscInt   nconv, nrigid;
+    PetscReal *lr;
+    PetscCall((*part->ops.refine)(part, l, &r));
+    PetscCall((*r->ops.modes)(r, nmodes, &nconv, &nrigid, &lr, NULL, NULL, NULL));
+    PetscCheck(nconv - nrigid >= nmodes, scene->comm, PETSC_ERR_NOT_CONVERGED, "convergence study: only %" PetscInt_FMT " modes on refinement level %" PetscInt_FMT, nconv - nrigid, l);
+    for (PetscInt m = 0; m < nmodes; m++) lam[l * nmodes + m] = lr[nrigid + m];
+    PetscCall(PetscFree(lr));
+    PetscCall(PhlexPartDestroy(&r));
+  }
+  {
+    char what[128] = "";
+    if (part->ops.modesorder) PetscCall((*part->ops.modesorder)(part, what, sizeof(what)));
+    PetscCall(PetscPrintf(scene->comm, "Convergence under uniform refinement (%s):\n  mode", what));
+  }
+  for (PetscInt l = 0; l <= nlevels; l++) PetscCall(PetscPrintf(scene->comm, "   level %" PetscInt_FMT " [Hz]", l));
+  PetscCall(PetscPrintf(scene->comm, "   order   extrapolated [Hz]\n"));
+  for (PetscInt m = 0; m < nmodes; m++) {
+    PetscReal order = 0, ext;
+    PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT, m + 1));
+    for (PetscInt l = 0; l <= nlevels; l++) PetscCall(PetscPrintf(scene->comm, "  %13.8g", (double)Frequency(lam[l * nmodes + m], &scene->units)));
+    if (nlevels >= 2) {
+      const PetscReal l0 = lam[(nlevels - 2) * nmodes + m], l1 = lam[(nlevels - 1) * nmodes + m], l2 = lam[nlevels * nmodes + m];
+      order = PetscLog2Real((l0 - l1) / (l1 - l2));
+      ext   = l2 - (l1 - l2) / (PetscPowReal(2.0, order) - 1.0);
+      PetscCall(PetscPrintf(scene->comm, "  %6.2f  %13.8g\n", (double)order, (double)Frequency(ext, &scene->units)));
+      if (PetscAbsReal(order - order_expect) > worst) {
+        worst      = PetscAbsReal(order - order_expect);
+        worst_mode = m;
+      }
+    } else PetscCall(PetscPrintf(scene->comm, "\n"));
+  }
+  if (order_expect > 0) {
+    PetscCheck(nlevels >= 2, scene->comm, PETSC_ERR_USER_INPUT, "-expect_convergence_order needs -modes_convergence_refinements >= 2");
+    PetscCheck(worst <= order_tol, scene->comm, PETSC_ERR_USER, "convergence order: FAIL: mode %" PetscInt_FMT " has observed order differing from %g by %.3g > %g (-expect_convergence_order_tol)", worst_mode + 1, (double)order_expect, (double)worst, (double)order_tol);
+    PetscCall(PetscPrintf(scene->comm, "convergence order: PASS (%" PetscInt_FMT " modes within %g of %g)\n", nmodes, (double)order_tol, (double)order_expect));
+  }
+  PetscCall(PetscFree(lam));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSceneSolveModes - modal analysis: the modes of every body that has them; prints and writes frequencies,
+  residuals, mode shapes; self-checks
+
+  Collective
+
+  Options Database Keys:
++ -modes_nev <n>                        - elastic modes wanted (default 10)
+. -modes_convergence_refinements <n>    - also solve on n uniform refinements and report the observed order
+. -expect_convergence_order <p>         - self-check of that order (with -expect_convergence_order_tol)
+. -expect_frequencies f1,f2,...         - expected elastic frequencies [Hz] (self-check; one body)
+. -expect_frequencies_rtol <r>          - relative tolerance of that check (default 1e-6)
+- -expect_residual_max <r>              - bound on the relative eigenpair residuals
+
+  Notes:
+  modes.csv holds the modes of every body, one row per mode with the body's name in the column body.
+@*/
+PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
+{
+  PetscInt    nev = 10, nexp = 64, nrefine = 0, nbodies = 0, nfexp = 0;
+  PetscReal   expected[64], rtol = 1e-6, rmax = -1, worst = 0, *fexp = NULL;
+  PetscBool   has_exp;
+  PetscViewer csv;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(scene->comm, NULL, "Modal analysis options", NULL);
+  PetscCall(PetscOptionsInt("-modes_nev", "Number of elastic modes wanted", "PhlexSceneSolveModes", nev, &nev, NULL));
+  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", expected, &nexp, &has_exp));
+  PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveModes", rtol, &rtol, NULL));
+  PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveModes", rmax, &rmax, NULL));
+  PetscCall(PetscOptionsInt("-modes_convergence_refinements", "Also solve on this many uniform refinements and report the observed order", "PhlexSceneSolveModes", nrefine, &nrefine, NULL));
+  PetscOptionsEnd();
+  PetscCheck(nev >= 1, scene->comm, PETSC_ERR_USER_INPUT, "-modes_nev must be >= 1, got %" PetscInt_FMT, nev);
+  if (!has_exp) nexp = 0;
+  for (PetscInt k = 0; k < scene->nparts; k++)
+    if (scene->parts[k]->ops.modes) nbodies++;
+  PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible body)");
+  PetscCheck(!nexp || nbodies == 1, scene->comm, PETSC_ERR_USER_INPUT, "-expect_frequencies checks the modes of one body; the scene has %" PetscInt_FMT, nbodies);
+
+  PetscCall(PhlexOutputCSVOpen(scene->output, "modes.csv", "mode,frequency_hz,eigenvalue_rad2_s2,relative_residual,rigid,body", &csv));
+  for (PetscInt b = 0; b < scene->nparts; b++) {
+    PhlexPart  part = scene->parts[b];
+    PetscInt   nconv, nrigid, nrigid_expected;
+    PetscReal *lambda, *resid, *freq, *rigid;
+    Vec       *vecs;
+    char       kind[64];
+    if (!part->ops.modes) continue;
+    PetscCall(PetscLogStagePush(PHLEX_StageModes));
+    PetscCall((*part->ops.modes)(part, nev, &nconv, &nrigid, &lambda, &vecs, &rigid, &resid));
+    PetscCall(PetscLogStagePop());
+    PetscCall(PetscMalloc1(nconv, &freq));
+    for (PetscInt i = 0; i < nconv; i++) freq[i] = Frequency(lambda[i], &scene->units);
+    PetscCall((*part->ops.modeskind)(part, kind, sizeof(kind), &nrigid_expected));
+    PetscCall(PetscPrintf(scene->comm, "Modes of body %s (%s): %" PetscInt_FMT " computed", part->name, kind, nconv));
+    if (nrigid_expected >= 0) PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " rigid-body modes", nrigid));
+    PetscCall(PetscPrintf(scene->comm, "\n  mode  frequency [Hz]       kind     rel. residual\n"));
+    for (PetscInt i = 0; i < nconv; i++) {
+      PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-7s  %.1e\n", i + 1, (double)(i < nrigid ? 0.0 : freq[i]), i < nrigid ? "rigid" : "elastic", (double)resid[i]));
+      if (i >= nrigid) worst = PetscMax(worst, resid[i]); /* rigid modes: backward error, not checked */
+    }
+    PetscCheck(nrigid_expected < 0 || nrigid == nrigid_expected, scene->comm, PETSC_ERR_NOT_CONVERGED, "body %s is free but %" PetscInt_FMT " rigid-body modes were found instead of %" PetscInt_FMT, part->name, nrigid, nrigid_expected);
+    for (PetscInt i = 0; i < nconv; i++) {
+      const PetscReal lam = lambda[i] / PetscSqr(scene->units.time);
+      PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d,%s\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0, part->name));
+    }
+    if (scene->output->fields && part->ops.modesoutput) PetscCall((*part->ops.modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid));
+    if (nrefine > 0) PetscCall(ConvergenceStudy(scene, part, nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid));
+    if (nexp) {
+      nfexp = nconv - nrigid;
+      PetscCall(PetscMalloc1(PetscMax(nfexp, 1), &fexp));
+      PetscCall(PetscArraycpy(fexp, freq + nrigid, nfexp));
+    }
+    for (PetscInt i = 0; i < nconv; i++) PetscCall(VecDestroy(&vecs[i]));
+    PetscCall(PetscFree(vecs));
+    PetscCall(PetscFree(rigid));
+    PetscCall(PetscFree(lambda));
+    PetscCall(PetscFree(resid));
+    PetscCall(PetscFree(freq));
+  }
+  PetscCall(PetscViewerDestroy(&csv));
+  PetscCall(PhlexOutputCommit(scene->output));
+  if (rmax > 0) PetscCall(PhlexExpectMax(scene->comm, "eigenpair residuals (max relative)", "-expect_residual_max", worst, rmax, PETSC_TRUE));
+  if (nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nfexp, fexp, nexp, expected, rtol));
+  PetscCall(PetscFree(fexp));
+  PetscFunctionReturn(0);
+}

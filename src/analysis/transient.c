@@ -1,0 +1,540 @@
+/* Transient analysis: TS set-up (implicit midpoint by default), the consistent start of a mechanism, and the
+   energy / power-balance monitor that writes the CSV series and the fields and checks the -expect_* bounds.
+
+   Where the multipliers live: the joints' impulses Lambda are unknowns and the scheme sees only their rates. With a
+   one-step scheme the multiplier it uses over a step is (Lambda_{n+1} - Lambda_n)/dt: for the implicit midpoint rule
+   exactly the midpoint multiplier, for the others the step average of lambda (for BDF the average of the
+   backward-difference rate, converging to lambda(t_{n+1/2})). The joint series write this step average (time t_{n+1}),
+   which has no step-to-step oscillation; the power through a joint is lambda . (c + g) at the state where the scheme
+   enforces the constraints (its stage). */
+#include <phlex_impl.h>
+
+typedef struct {
+  PhlexScene  scene;
+  PhlexSystem sys;
+  Vec         Xprev, Xstage, Xmid;
+  PetscReal   tstage;
+  PetscBool   have_stage;
+  PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax;
+  PetscViewer energy_csv, monitor;
+  PetscInt    interval, last_written;
+  PetscBool   theta, endpoint;
+  PetscReal   theta_value;
+  PetscReal  *qprev, *lambda; /* discrete unknowns of the previous step, multipliers (step averages) */
+  /* momenta of a free system, rotations */
+  PetscBool   free_system;
+  PetscReal   P0[3], L0[3], Pscale, Lscale, max_dP, max_dL, max_orth, max_defect;
+  /* joints */
+  PetscReal   max_gap, project_dH;
+  PetscInt    nprojections;
+} MonitorContext;
+
+/* the part vectors of both sides of a joint at X (q: its replicated discrete values) */
+static PetscErrorCode JointSides(PhlexSystem sys, PhlexJoint j, Vec X, PetscReal *q, PhlexPartVec pv[2])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < 2; s++) {
+    PhlexPart p = j->side[s].part;
+    pv[s].u = pv[s].s = pv[s].v = NULL;
+    pv[s].q                     = NULL;
+    if (PhlexPartIsGround(p)) continue;
+    /* a joint between two ports of one body: take the views once */
+    if (s == 1 && p == j->side[0].part) {
+      pv[1] = pv[0];
+      continue;
+    }
+    PetscCall(PhlexPartGetVec(p, X, q, &pv[s]));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode JointSidesRestore(PhlexSystem sys, PhlexJoint j, Vec X, PhlexPartVec pv[2])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < 2; s++) {
+    PhlexPart p = j->side[s].part;
+    if (PhlexPartIsGround(p) || (s == 1 && p == j->side[0].part)) continue;
+    PetscCall(PhlexPartRestoreVec(p, X, &pv[s]));
+  }
+  PetscFunctionReturn(0);
+}
+
+/* ---------------------------------------------------------------------------------------------------------- */
+/* Energy and power-balance monitor                                                                            */
+
+/* the power of the inputs at (t, X): external inputs of every part and the drives of the joints (multipliers m->lambda) */
+static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscReal *P)
+{
+  PhlexSystem sys = m->sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
+  *P = 0.0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PetscReal p = 0.0;
+    if (sys->parts[i]->ops.inputpower) PetscCall((*sys->parts[i]->ops.inputpower)(sys->parts[i], &p));
+    *P += p;
+  }
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PetscReal p;
+    PetscCall(PhlexJointPower(sys->joints[k], m->lambda + sys->joints[k]->qoff, &p));
+    *P += p;
+  }
+  PetscFunctionReturn(0);
+}
+
+/* kinetic, strain and potential energy at (t, X), and the parts' output series; fields if asked */
+static PetscErrorCode EnergyAndOutputs(MonitorContext *m, PetscInt step, PetscReal t, Vec X, PetscBool fields, PetscReal *kin, PetscReal *strain, PetscReal *pot)
+{
+  PhlexSystem sys = m->sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
+  *kin = *strain = *pot = 0.0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart    p = sys->parts[i];
+    PhlexPartVec pv;
+    PetscReal    k, s, v;
+    PetscCall(PhlexPartGetVec(p, X, sys->q, &pv));
+    PetscCall((*p->ops.energy)(p, &pv, &k, &s, &v));
+    *kin += k, *strain += s, *pot += v;
+    PetscCall((*p->ops.outputstep)(p, step, t, &pv, fields));
+    PetscCall(PhlexPartRestoreVec(p, X, &pv));
+    if (p->frame.R >= 0) m->max_orth = PetscMax(m->max_orth, PhlexOrthogonalityError(sys->q + p->qoff + p->frame.R));
+  }
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PhlexJoint   j = sys->joints[k];
+    PhlexPartVec pv[2];
+    PetscReal    gmax;
+    PetscCall(JointSides(sys, j, X, sys->q, pv));
+    PetscCall(PhlexJointOutputStep(j, t, m->lambda + j->qoff, &pv[0], &pv[1], &gmax));
+    PetscCall(JointSidesRestore(sys, j, X, pv));
+    m->max_gap = PetscMax(m->max_gap, gmax);
+  }
+  if (m->free_system) {
+    PetscReal P[3] = {0, 0, 0}, L[3] = {0, 0, 0};
+    for (PetscInt i = 0; i < sys->nparts; i++) {
+      PetscReal Pi[3], Li[3];
+      PetscCall((*sys->parts[i]->ops.momenta)(sys->parts[i], Pi, Li));
+      for (PetscInt c = 0; c < 3; c++) P[c] += Pi[c], L[c] += Li[c];
+    }
+    if (step == 0) {
+      PetscReal m6[36], mass = 0, Jtr = 0;
+      for (PetscInt i = 0; i < sys->nparts; i++) {
+        PetscCall((*sys->parts[i]->ops.rigidmass)(sys->parts[i], m6));
+        mass += m6[0];
+        Jtr += m6[21] + m6[28] + m6[35];
+      }
+      for (PetscInt c = 0; c < 3; c++) m->P0[c] = P[c], m->L0[c] = L[c];
+      /* momentum scales: the momenta themselves, or those of the initial energy */
+      m->Pscale = PetscMax(PhlexNorm3(P), PetscSqrtReal(2.0 * mass * PetscAbsReal(*kin)));
+      m->Lscale = PetscMax(PhlexNorm3(L), PetscSqrtReal(2.0 * PetscAbsReal(*kin) * Jtr / 3.0));
+      if (m->Pscale == 0) m->Pscale = 1.0;
+      if (m->Lscale == 0) m->Lscale = 1.0;
+    }
+    for (PetscInt c = 0; c < 3; c++) {
+      m->max_dP = PetscMax(m->max_dP, PetscAbsReal(P[c] - m->P0[c]) / m->Pscale);
+      m->max_dL = PetscMax(m->max_dL, PetscAbsReal(L[c] - m->L0[c]) / m->Lscale);
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/* the stage of the step: the state at which the scheme enforces its equations (the constraints included) */
+static PetscErrorCode PostStage(TS ts, PetscReal t, PetscInt index, Vec *Y)
+{
+  MonitorContext *m;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetApplicationContext(ts, &m));
+  PetscCall(VecCopy(Y[0], m->Xstage));
+  m->tstage     = t;
+  m->have_stage = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/* After each step: every part's discrete unknowns cleaned (R back onto SO(3): the midpoint rule maps R by a
+   Cayley factor, so the defect is the Newton residual and round-off, which would otherwise accumulate); every
+   -joints_project_interval steps the positions are projected back onto the joints. */
+static PetscErrorCode PostStep(TS ts)
+{
+  MonitorContext *m;
+  Vec             X;
+  PetscReal       defect;
+  PetscInt        step;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetApplicationContext(ts, &m));
+  PetscCall(TSGetSolution(ts, &X));
+  PetscCall(PhlexSystemPostStep(m->sys, X, &defect));
+  m->max_defect = PetscMax(m->max_defect, defect);
+  PetscCall(TSGetStepNumber(ts, &step));
+  if (m->scene->project_interval > 0 && m->sys->njoints && step % m->scene->project_interval == 0) {
+    PetscReal t, dH;
+    PetscCall(TSGetTime(ts, &t));
+    PetscCall(PhlexAssemblyClose(m->sys, t, X, PETSC_FALSE, &dH));
+    m->project_dH += dH;
+    m->nprojections++;
+  }
+  PetscFunctionReturn(0);
+}
+
+/* After each step: H_{n+1}, the work supplied over the step with the scheme's own quadrature, the balance residual
+   H_{n+1} - H_n - W, the multipliers of the step, the series and fields:
+     theta (midpoint rule and others): W = dt P(t_n + theta dt, X_stage), exact for a quadratic H;
+     theta endpoint (Crank-Nicolson): W = dt (theta P(t_{n+1}) + (1 - theta) P(t_n)) at the midpoint velocities;
+     any other scheme (BDF, generalized-alpha): W = dt (P(t_n, X_n) + P(t_{n+1}, X_{n+1})) / 2, and the residual is
+     then the scheme's numerical dissipation (plus the O(dt^3) error of that quadrature). */
+static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, void *ctx)
+{
+  MonitorContext   *m   = (MonitorContext *)ctx;
+  PhlexSystem       sys = m->sys;
+  const PhlexUnits *u   = &m->scene->units;
+  PetscReal         kin = 0, strain = 0, pot = 0, H, dt = 0, power = 0, residual = 0;
+  PetscBool         fields;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_MonitorEnergy, 0, 0, 0, 0));
+  if (step > 0) {
+    dt = (t - m->tprev) / u->time;
+    /* the multipliers of the step: (Lambda_{n+1} - Lambda_n)/dt */
+    PetscCall(PhlexSystemGather(sys, X, sys->q));
+    for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dt : 0.0;
+    if (m->theta && !m->endpoint && m->have_stage) {
+      PetscCall(InputPower(m, m->tstage, m->Xstage, &power));
+    } else if (m->theta && m->endpoint) {
+      PetscReal P1, P0;
+      PetscCall(VecAXPBYPCZ(m->Xmid, 0.5, 0.5, 0.0, X, m->Xprev));
+      PetscCall(InputPower(m, t, m->Xmid, &P1));
+      PetscCall(InputPower(m, m->tprev, m->Xmid, &P0));
+      power = m->theta_value * P1 + (1.0 - m->theta_value) * P0;
+    } else {
+      PetscReal P1, P0;
+      PetscCall(InputPower(m, t, X, &P1));
+      PetscCall(InputPower(m, m->tprev, m->Xprev, &P0));
+      power = 0.5 * (P0 + P1);
+    }
+  }
+  fields = (step == 0 || (m->interval > 0 && step % m->interval == 0)) ? PETSC_TRUE : PETSC_FALSE;
+  PetscCall(EnergyAndOutputs(m, step, t, X, fields, &kin, &strain, &pot));
+  if (fields) m->last_written = step;
+  H = kin + strain + pot;
+  if (step == 0) {
+    m->H0 = m->Hprev = m->Hmax = H;
+  } else {
+    m->work_total += dt * power;
+    residual        = H - m->Hprev - dt * power;
+    m->max_residual = PetscMax(m->max_residual, PetscAbsReal(residual));
+    m->max_work     = PetscMax(m->max_work, PetscAbsReal(m->work_total));
+    m->max_drift    = PetscMax(m->max_drift, PetscAbsReal(H - m->H0));
+    m->Hmax         = PetscMax(m->Hmax, H);
+    m->Hprev        = H;
+  }
+  PetscCall(PetscViewerASCIIPrintf(m->energy_csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e\n", step, (double)t, (double)(kin * u->energy), (double)(strain * u->energy), (double)(pot * u->energy), (double)(H * u->energy), (double)(power * u->power), (double)(m->work_total * u->energy), (double)(residual * u->energy)));
+  if (m->monitor) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(residual * u->energy)));
+  PetscCall(VecCopy(X, m->Xprev));
+  PetscCall(PhlexSystemGather(sys, X, m->qprev));
+  m->tprev      = t;
+  m->have_stage = PETSC_FALSE;
+  PetscCall(PetscLogEventEnd(PHLEX_MonitorEnergy, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* The solver preset (-solver_options_file) goes under the scene and the command line: insert it, then insert the
+   command line again (with its -options_file scenes) so that they keep precedence. The default follows the
+   system: one fixed flexible body (no discrete unknowns): exact.opts; flexible bodies with discrete unknowns:
+   bordered.opts; no flexible body: rigid.opts. */
+static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys)
+{
+  char      file[PETSC_MAX_PATH_LEN];
+  PetscBool exists;
+  int       argc;
+  char    **argv;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrcpy(file, !sys->nfparts ? "options/solver/rigid.opts" : (sys->nq ? "options/solver/bordered.opts" : "options/solver/exact.opts")));
+  PetscOptionsBegin(comm, NULL, "Solver preset", NULL);
+  PetscCall(PetscOptionsString("-solver_options_file", "Solver preset (options file) under the scene and command-line options; empty for none", "PhlexSceneSolveTransient", file, file, sizeof(file), NULL));
+  PetscOptionsEnd();
+  if (!file[0]) PetscFunctionReturn(0);
+  PetscCall(PetscTestFile(file, 'r', &exists));
+  PetscCheck(exists, comm, PETSC_ERR_FILE_OPEN, "cannot read the solver preset '%s' (option -solver_options_file; presets are in options/solver/)", file);
+  PetscCall(PetscOptionsInsertFile(comm, NULL, file, PETSC_TRUE));
+  PetscCall(PetscGetArgs(&argc, &argv));
+  PetscCall(PetscOptionsInsert(NULL, &argc, &argv, NULL));
+  PetscFunctionReturn(0);
+}
+
+/* The system, its initial state and the joints' geometry at the drawn configuration; redundant constraint
+   components found (and dropped if asked: the layout changes, the initial state is carried over). */
+static PetscErrorCode CreateSystem(PhlexScene scene, PhlexSystem *sys, Vec *X)
+{
+  PetscInt ndropped = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemCreate(scene, sys));
+  PetscCall(DMCreateGlobalVector((*sys)->dm, X));
+  PetscCall(PetscObjectSetName((PetscObject)*X, "state"));
+  PetscCall(PhlexSystemInitialState(*sys, *X));
+  if (!(*sys)->njoints) PetscFunctionReturn(0);
+  PetscCall(PhlexAssemblyPlaceAttached(*sys, *X));
+  for (PetscInt k = 0; k < (*sys)->njoints; k++) {
+    PhlexJoint   j = (*sys)->joints[k];
+    PhlexPartVec pv[2];
+    PetscCall(JointSides(*sys, j, *X, (*sys)->q, pv));
+    PetscCall(PhlexJointSetUp(j, &pv[0], &pv[1]));
+    PetscCall(JointSidesRestore(*sys, j, *X, pv));
+  }
+  PetscCall(PhlexAssemblyRedundancy(*sys, *X, &ndropped));
+  if (ndropped) {
+    /* the joints lost rows: a new layout; the fields and the parts' discrete unknowns are carried over (they come
+       first among the discrete unknowns and keep their places), the impulses start at zero */
+    PhlexSystem old = *sys;
+    Vec         fields[3] = {NULL, NULL, NULL};
+    PetscReal  *q;
+    PetscCall(PetscMalloc1(PetscMax(old->nq, 1), &q));
+    PetscCall(PhlexSystemGather(old, *X, q));
+    for (PetscInt f = 0; f < 3 && old->nfparts; f++) {
+      Vec a;
+      PetscCall(VecGetSubVector(*X, old->is[f], &a));
+      PetscCall(VecDuplicate(a, &fields[f]));
+      PetscCall(VecCopy(a, fields[f]));
+      PetscCall(VecRestoreSubVector(*X, old->is[f], &a));
+    }
+    PetscCall(VecDestroy(X));
+    PetscCall(PhlexSystemDestroy(&old));
+    PetscCall(PhlexSystemCreate(scene, sys));
+    PetscCall(DMCreateGlobalVector((*sys)->dm, X));
+    PetscCall(PetscObjectSetName((PetscObject)*X, "state"));
+    PetscCall(VecSet(*X, 0.0));
+    for (PetscInt f = 0; f < 3 && fields[f]; f++) {
+      Vec b;
+      PetscCall(VecGetSubVector(*X, (*sys)->is[f], &b));
+      PetscCall(VecCopy(fields[f], b));
+      PetscCall(VecRestoreSubVector(*X, (*sys)->is[f], &b));
+      PetscCall(VecDestroy(&fields[f]));
+    }
+    for (PetscInt k = 0; k < (*sys)->nq; k++) (*sys)->q[k] = 0.0;
+    for (PetscInt i = 0; i < (*sys)->nparts; i++)
+      for (PetscInt k = 0; k < (*sys)->parts[i]->nq; k++) (*sys)->q[(*sys)->parts[i]->qoff + k] = q[(*sys)->parts[i]->qoff + k];
+    PetscCall(PhlexSystemScatter(*sys, (*sys)->q, *X));
+    PetscCall(PetscFree(q));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSceneSolveTransient - integrates the scene in time with TS and reports energy, power balance and joints
+
+  Collective
+
+  Options Database Keys:
++ -ts_dt <s>                        - time step (required)
+. -ts_max_time <s>, -ts_max_steps   - end of the run
+. -ts_type theta -ts_theta_theta 0.5 - implicit midpoint (default); cn, bdf, alpha, ... by option
+. -ts_monitor_energy [viewer]       - print energy, power and balance residual every step
+. -solver_options_file <file>       - solver preset, under scene and command line
+. -expect_energy_drift_max <r>      - self-check: max |H - H0| / H0 (lossless runs)
+. -expect_power_balance_rtol <r>    - self-check: max |H_{n+1} - H_n - W| / max |supplied work|
+. -expect_momentum_drift_max <r>    - self-check (free system): drift of the inertial momenta, relative to their scale
+. -expect_orthogonality_max <r>     - self-check: ||R^T R - I||_F of every frame, and the per-step defect
+- -expect_joint_drift_max <r>       - self-check: the largest position-level violation of the joints [m, rad]
+@*/
+PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
+{
+  PhlexSystem        sys;
+  TS                 ts;
+  Vec                X;
+  MonitorContext     m;
+  PetscReal          dt = -1, drift_max = -1, balance_rtol = -1, momentum_max = -1, linear_max = -1, angular_max = -1, orth_max = -1, gap_max = -1, tfinal;
+  PetscInt           nsteps;
+  PetscBool          flg;
+  const PhlexUnits  *u = &scene->units;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&m, sizeof(m)));
+  PetscOptionsBegin(scene->comm, NULL, "Transient analysis options", NULL);
+  PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", drift_max, &drift_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_power_balance_rtol", "Self-check: bound on max |H_{n+1} - H_n - W_step| / max |supplied work|", "PhlexSceneSolveTransient", balance_rtol, &balance_rtol, NULL));
+  PetscCall(PetscOptionsReal("-expect_momentum_drift_max", "Self-check (a free system, no loads): bound on the drift of the inertial linear and angular momenta, relative to their scale", "PhlexSceneSolveTransient", momentum_max, &momentum_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_linear_momentum_drift_max", "Self-check (a free system): bound on the drift of the inertial linear momentum alone, relative to its scale", "PhlexSceneSolveTransient", linear_max, &linear_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_angular_momentum_drift_max", "Self-check (a free system): bound on the drift of the inertial angular momentum alone, relative to its scale", "PhlexSceneSolveTransient", angular_max, &angular_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_orthogonality_max", "Self-check (moving frames): bound on max ||R^T R - I||_F", "PhlexSceneSolveTransient", orth_max, &orth_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_joint_drift_max", "Self-check (joints): bound on the largest position-level violation of any joint [m, rad]", "PhlexSceneSolveTransient", gap_max, &gap_max, NULL));
+  PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &m.monitor, NULL, &flg));
+  PetscOptionsEnd();
+
+  PetscCall(CreateSystem(scene, &sys, &X));
+  /* a free system: every part has momenta, none is held, no joint to the ground */
+  m.free_system = PETSC_TRUE;
+  for (PetscInt i = 0; i < sys->nparts; i++)
+    if (!sys->parts[i]->ops.momenta) m.free_system = PETSC_FALSE;
+  for (PetscInt k = 0; k < sys->njoints; k++)
+    if (PhlexPartIsGround(sys->joints[k]->side[0].part) || PhlexPartIsGround(sys->joints[k]->side[1].part)) m.free_system = PETSC_FALSE;
+  PetscCheck(m.free_system || (momentum_max < 0 && linear_max < 0 && angular_max < 0), scene->comm, PETSC_ERR_USER_INPUT, "-expect_*momentum_drift_max needs a free system: floating, rigid or lumped bodies only, none joined to the ground");
+  {
+    PetscBool frames = PETSC_FALSE;
+    for (PetscInt i = 0; i < sys->nparts; i++)
+      if (sys->parts[i]->frame.R >= 0) frames = PETSC_TRUE;
+    PetscCheck(frames || orth_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_orthogonality_max needs a moving frame (a floating or rigid body)");
+  }
+  PetscCheck(sys->njoints || gap_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_joint_drift_max needs joints");
+  PetscCall(InsertSolverPreset(scene->comm, sys));
+  PetscCall(TSCreate(scene->comm, &ts));
+  PetscCall(TSSetDM(ts, sys->dm));
+  /* linear fields (KSP only); moving frames and joints make it nonlinear (Newton) */
+  PetscCall(TSSetProblemType(ts, sys->nonlinear ? TS_NONLINEAR : TS_LINEAR));
+  PetscCall(TSSetIFunction(ts, NULL, PhlexSystemIFunction, sys));
+  PetscCall(TSSetIJacobian(ts, sys->J, sys->J, PhlexSystemIJacobian, sys));
+  /* the structure-preserving default: implicit midpoint */
+  PetscCall(TSSetType(ts, TSTHETA));
+  PetscCall(TSThetaSetTheta(ts, 0.5));
+  PetscCall(TSSetTimeStep(ts, -1.0));
+  PetscCall(TSSetMaxTime(ts, PETSC_MAX_REAL));
+  PetscCall(TSSetMaxSteps(ts, PETSC_MAX_INT));
+  PetscCall(TSSetExactFinalTime(ts, TS_EXACTFINALTIME_MATCHSTEP));
+  /* adaptive steppers: the unknowns are non-dimensional (velocities ~ 1e-4 of the wave speed), so PETSc's default
+     absolute tolerance 1e-4 would accept anything: a relative criterion; the impulses (whose rates are the
+     multipliers of an index-2 system) are left out of the error norm */
+  {
+    Vec vatol, vrtol;
+    PetscCall(VecDuplicate(X, &vatol));
+    PetscCall(VecDuplicate(X, &vrtol));
+    PetscCall(VecSet(vatol, 1e-12));
+    PetscCall(VecSet(vrtol, 1e-6));
+    if (sys->nq) {
+      PetscReal *a;
+      PetscCall(PetscMalloc1(sys->nq, &a));
+      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 1e300 : 1e-12;
+      PetscCall(PhlexSystemScatter(sys, a, vatol));
+      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 0.0 : 1e-6;
+      PetscCall(PhlexSystemScatter(sys, a, vrtol));
+      PetscCall(PetscFree(a));
+    }
+    PetscCall(TSSetTolerances(ts, 1e-12, vatol, 1e-6, vrtol));
+    PetscCall(VecDestroy(&vatol));
+    PetscCall(VecDestroy(&vrtol));
+  }
+  PetscCall(TSSetFromOptions(ts));
+  if (sys->nonlinear) {
+    SNES snes;
+    PetscCall(TSGetSNES(ts, &snes));
+    PetscCall(SNESSetConvergenceTest(snes, PhlexSystemSNESConverged, sys, NULL));
+  }
+  PetscCall(TSGetTimeStep(ts, &dt));
+  PetscCheck(dt > 0, scene->comm, PETSC_ERR_USER_INPUT, "transient analysis: set the time step with -ts_dt <s>");
+  {
+    PetscReal tmax;
+    PetscInt  smax;
+    PetscCall(TSGetMaxTime(ts, &tmax));
+    PetscCall(TSGetMaxSteps(ts, &smax));
+    PetscCheck(tmax < PETSC_MAX_REAL || smax < PETSC_MAX_INT, scene->comm, PETSC_ERR_USER_INPUT, "transient analysis: set the end of the run with -ts_max_time <s> or -ts_max_steps <n>");
+  }
+  PetscCall(PetscMalloc2(PetscMax(sys->nq, 1), &m.qprev, PetscMax(sys->nq, 1), &m.lambda));
+  for (PetscInt k = 0; k < sys->nq; k++) m.lambda[k] = 0.0;
+  /* a mechanism starts consistent: loops closed, velocities on the constraints, multipliers solved */
+  if (sys->njoints) PetscCall(PhlexAssemblyClose(sys, 0.0, X, PETSC_TRUE, NULL));
+  if (sys->nq) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
+  if (sys->use_aij) {
+    /* the assembled operator from a first evaluation at the initial state */
+    Vec Xdot;
+    PetscCall(VecDuplicate(X, &Xdot));
+    PetscCall(VecSet(Xdot, 0.0));
+    PetscCall(PhlexSystemIJacobian(ts, 0.0, X, Xdot, 1.0 / dt, sys->J, sys->J, sys));
+    PetscCall(VecDestroy(&Xdot));
+    PetscCall(TSSetIJacobian(ts, sys->Jaij, sys->Jaij, PhlexSystemIJacobian, sys));
+  }
+
+  /* monitor and outputs */
+  m.scene    = scene;
+  m.sys      = sys;
+  m.interval = scene->output->interval;
+  PetscCall(VecDuplicate(X, &m.Xprev));
+  PetscCall(VecDuplicate(X, &m.Xstage));
+  PetscCall(VecDuplicate(X, &m.Xmid));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)ts, &m.theta, TSTHETA, TSCN, TSBEULER, ""));
+  if (m.theta) {
+    PetscCall(TSThetaGetTheta(ts, &m.theta_value));
+    PetscCall(TSThetaGetEndpoint(ts, &m.endpoint));
+  }
+  PetscCall(PhlexOutputCSVOpen(scene->output, "energy.csv", "step,time,kinetic,strain,potential,total,input_power,supplied_work,balance_residual", &m.energy_csv));
+  for (PetscInt i = 0; i < sys->nparts; i++) PetscCall((*sys->parts[i]->ops.outputopen)(sys->parts[i], scene->output, scene->output->fields));
+  for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputOpen(sys->joints[k], scene->output));
+  PetscCall(TSMonitorSet(ts, MonitorEnergy, &m, NULL));
+  PetscCall(TSSetApplicationContext(ts, &m));
+  PetscCall(TSSetPostStep(ts, PostStep));
+  PetscCall(TSSetPostStage(ts, PostStage));
+
+  PetscCall(PetscLogStagePush(PHLEX_StageTransient));
+  PetscCall(TSSolve(ts, X));
+  PetscCall(PetscLogStagePop());
+  PetscCall(TSGetStepNumber(ts, &nsteps));
+  PetscCall(TSGetSolveTime(ts, &tfinal));
+  if (m.last_written != nsteps && scene->output->fields) {
+    /* the last state's fields (the monitor wrote its series) */
+    for (PetscInt i = 0; i < sys->nparts; i++) {
+      PhlexPart    p = sys->parts[i];
+      PhlexPartVec pv;
+      PetscCall(PhlexSystemEvaluate(sys, tfinal, X, NULL));
+      PetscCall(PhlexPartGetVec(p, X, sys->q, &pv));
+      PetscCall((*p->ops.outputstep)(p, -1, tfinal, &pv, PETSC_TRUE));
+      PetscCall(PhlexPartRestoreVec(p, X, &pv));
+    }
+  }
+
+  {
+    TSType type;
+    PetscCall(TSGetType(ts, &type));
+    PetscCall(PetscPrintf(scene->comm, "Transient: %" PetscInt_FMT " steps to t = %g s with TS %s", nsteps, (double)tfinal, type));
+    if (m.theta) PetscCall(PetscPrintf(scene->comm, " (theta %g%s)", (double)m.theta_value, m.endpoint ? ", endpoint" : ""));
+    PetscCall(PetscPrintf(scene->comm, "\n  energy: initial %.8e J, final %.8e J", (double)(m.H0 * u->energy), (double)(m.Hprev * u->energy)));
+    if (m.H0 > 0) PetscCall(PetscPrintf(scene->comm, ", max |H - H0| / H0 = %.3e\n", (double)(m.max_drift / m.H0)));
+    else PetscCall(PetscPrintf(scene->comm, "\n"));
+    PetscCall(PetscPrintf(scene->comm, "  supplied work: %.8e J, max power-balance residual %.3e J\n", (double)(m.work_total * u->energy), (double)(m.max_residual * u->energy)));
+    for (PetscInt i = 0; i < sys->nparts; i++)
+      if (sys->parts[i]->frame.R >= 0) {
+        PetscCall(PetscPrintf(scene->comm, "  rotations: max ||R^T R - I|| = %.3e (largest per-step defect removed %.3e)\n", (double)m.max_orth, (double)m.max_defect));
+        break;
+      }
+    if (m.free_system) PetscCall(PetscPrintf(scene->comm, "  momenta: max drift of P %.3e, of L %.3e (relative to %.6e kg m/s, %.6e kg m^2/s)\n", (double)m.max_dP, (double)m.max_dL, (double)(m.Pscale * u->mass * u->velocity), (double)(m.Lscale * u->mass * u->velocity * u->length)));
+    if (sys->njoints) {
+      PetscCall(PetscPrintf(scene->comm, "  joints: max position-level violation %.3e (m or rad)", (double)m.max_gap));
+      if (m.nprojections) PetscCall(PetscPrintf(scene->comm, "; %" PetscInt_FMT " projections changed the energy by %.3e J", m.nprojections, (double)(m.project_dH * u->energy)));
+      PetscCall(PetscPrintf(scene->comm, "\n"));
+    }
+  }
+  PetscCall(PetscViewerDestroy(&m.energy_csv));
+  for (PetscInt i = 0; i < sys->nparts; i++) PetscCall((*sys->parts[i]->ops.outputclose)(sys->parts[i]));
+  for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputClose(sys->joints[k]));
+  PetscCall(PhlexOutputCommit(scene->output));
+
+  if (drift_max >= 0) {
+    PetscCheck(m.H0 > 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_energy_drift_max needs a nonzero initial energy");
+    PetscCall(PhlexExpectMax(scene->comm, "energy drift (max |H - H0| / H0)", "-expect_energy_drift_max", m.max_drift / m.H0, drift_max, PETSC_TRUE));
+  }
+  if (balance_rtol >= 0) {
+    const PetscReal scale = m.max_work > 0 ? m.max_work : PetscMax(m.Hmax, PETSC_MACHINE_EPSILON);
+    PetscCall(PhlexExpectMax(scene->comm, "power balance (max |H_{n+1} - H_n - dt y^T u| / max |supplied work|)", "-expect_power_balance_rtol", m.max_residual / scale, balance_rtol, PETSC_TRUE));
+  }
+  if (momentum_max >= 0) {
+    PetscCall(PhlexExpectMax(scene->comm, "linear momentum drift (max |P - P0| / scale)", "-expect_momentum_drift_max", m.max_dP, momentum_max, PETSC_TRUE));
+    PetscCall(PhlexExpectMax(scene->comm, "angular momentum drift (max |L - L0| / scale)", "-expect_momentum_drift_max", m.max_dL, momentum_max, PETSC_TRUE));
+  }
+  if (linear_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "linear momentum drift (max |P - P0| / scale)", "-expect_linear_momentum_drift_max", m.max_dP, linear_max, PETSC_TRUE));
+  if (angular_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "angular momentum drift (max |L - L0| / scale)", "-expect_angular_momentum_drift_max", m.max_dL, angular_max, PETSC_TRUE));
+  if (orth_max >= 0) {
+    PetscCall(PhlexExpectMax(scene->comm, "rotation orthogonality (max ||R^T R - I||_F)", "-expect_orthogonality_max", m.max_orth, orth_max, PETSC_TRUE));
+    PetscCall(PhlexExpectMax(scene->comm, "per-step orthogonality defect of the integrator (max ||R^T R - I||_F after a step)", "-expect_orthogonality_max", m.max_defect, orth_max, PETSC_TRUE));
+  }
+  if (gap_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "joint drift (max position-level violation, m or rad)", "-expect_joint_drift_max", m.max_gap, gap_max, PETSC_TRUE));
+
+  PetscCall(PetscViewerDestroy(&m.monitor));
+  PetscCall(VecDestroy(&m.Xmid));
+  PetscCall(VecDestroy(&m.Xprev));
+  PetscCall(VecDestroy(&m.Xstage));
+  PetscCall(PetscFree2(m.qprev, m.lambda));
+  PetscCall(VecDestroy(&X));
+  PetscCall(TSDestroy(&ts));
+  PetscCall(PhlexSystemDestroy(&sys));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,169 @@
+/* Output of a run: one directory with the CSV series and, per flexible body, HDF5 fields plus an XDMF index for
+   ParaView (fields.c). Every file is written under a temporary name and renamed when the run completes, so an
+   error never leaves a half-written result under a final name. */
+#include <phlex_impl.h>
+#include <petscviewerhdf5.h>
+#include <sys/stat.h>
+#include <errno.h>
+
+/*@C
+  PhlexOutputCreate - creates the output manager of a run
+@*/
+PetscErrorCode PhlexOutputCreate(MPI_Comm comm, PhlexOutput *out)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(out));
+  (*out)->comm     = comm;
+  (*out)->interval = 0;
+  (*out)->fields   = PETSC_TRUE;
+  PetscCall(PetscStrcpy((*out)->dir, "output"));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputSetFromOptions - reads the output options
+
+  Options Database Keys:
++ -output_dir <dir>        - directory of the run's results (created if missing)
+. -output_interval <n>     - write fields every n time steps (0: first and last step only)
+- -output_fields <bool>    - write HDF5/XDMF fields
+@*/
+PetscErrorCode PhlexOutputSetFromOptions(PhlexOutput out)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(out->comm, NULL, "Output options", NULL);
+  PetscCall(PetscOptionsString("-output_dir", "Directory of the run's results (created if missing)", "PhlexOutputSetFromOptions", out->dir, out->dir, sizeof(out->dir), NULL));
+  PetscCall(PetscOptionsInt("-output_interval", "Write fields every n time steps (0: first and last step only)", "PhlexOutputSetFromOptions", out->interval, &out->interval, NULL));
+  PetscCall(PetscOptionsBool("-output_fields", "Write HDF5/XDMF fields for ParaView", "PhlexOutputSetFromOptions", out->fields, &out->fields, NULL));
+  PetscOptionsEnd();
+  PetscCheck(out->interval >= 0, out->comm, PETSC_ERR_USER_INPUT, "-output_interval must be >= 0, got %" PetscInt_FMT, out->interval);
+  PetscCheck(out->dir[0], out->comm, PETSC_ERR_USER_INPUT, "-output_dir must not be empty");
+  PetscFunctionReturn(0);
+}
+
+/* mkdir -p on rank 0 */
+static PetscErrorCode MakeDirectory(MPI_Comm comm, const char dir[])
+{
+  PetscMPIInt rank;
+  int         err = 0;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    char path[PETSC_MAX_PATH_LEN];
+    PetscCall(PetscStrncpy(path, dir, sizeof(path)));
+    for (char *p = path + 1; *p && !err; p++)
+      if (*p == '/') {
+        *p = 0;
+        if (mkdir(path, 0775) && errno != EEXIST) err = errno;
+        *p = '/';
+      }
+    if (!err && mkdir(path, 0775) && errno != EEXIST) err = errno;
+  }
+  PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));
+  PetscCheck(!err, comm, PETSC_ERR_FILE_OPEN, "cannot create output directory '%s' (option -output_dir): %s", dir, strerror(err));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputFile - registers an output file and returns the temporary path to write it to
+
+  Collective
+
+  Input Parameters:
++ out  - output manager
+- name - file name inside the output directory
+
+  Output Parameter:
+. tmp - temporary path (renamed to the final name by PhlexOutputCommit)
+@*/
+PetscErrorCode PhlexOutputFile(PhlexOutput out, const char name[], char tmp[])
+{
+  PetscInt k = out->nfiles;
+
+  PetscFunctionBeginUser;
+  if (k == 0) PetscCall(MakeDirectory(out->comm, out->dir));
+  if (k == out->maxfiles) {
+    char(*tmp)[PETSC_MAX_PATH_LEN], (*fin)[PETSC_MAX_PATH_LEN];
+    const PetscInt n = PetscMax(16, 2 * out->maxfiles);
+    PetscCall(PetscMalloc2(n, &tmp, n, &fin));
+    if (k) {
+      PetscCall(PetscArraycpy(tmp, out->tmp, k));
+      PetscCall(PetscArraycpy(fin, out->final, k));
+    }
+    PetscCall(PetscFree2(out->tmp, out->final));
+    out->tmp      = tmp;
+    out->final    = fin;
+    out->maxfiles = n;
+  }
+  PetscCall(PetscSNPrintf(out->final[k], PETSC_MAX_PATH_LEN, "%s/%s", out->dir, name));
+  PetscCall(PetscSNPrintf(out->tmp[k], PETSC_MAX_PATH_LEN, "%s/.%s.tmp", out->dir, name));
+  PetscCall(PetscStrcpy(tmp, out->tmp[k]));
+  out->nfiles++;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputCommit - renames every completed output file to its final name
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputCommit(PhlexOutput out)
+{
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
+  PetscCallMPI(MPI_Barrier(out->comm));
+  if (rank == 0)
+    for (PetscInt k = 0; k < out->nfiles; k++) PetscCheck(!rename(out->tmp[k], out->final[k]), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot rename '%s' to '%s': %s", out->tmp[k], out->final[k], strerror(errno));
+  out->nfiles = 0;
+  PetscCallMPI(MPI_Barrier(out->comm));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputAbort - removes the temporary files of an unfinished run (called on error)
+
+  Not collective: each rank removes nothing but rank 0's files; safe to call after an error
+@*/
+PetscErrorCode PhlexOutputAbort(PhlexOutput out)
+{
+  PetscMPIInt rank;
+
+  if (!out) return 0;
+  MPI_Comm_rank(out->comm, &rank);
+  if (rank == 0)
+    for (PetscInt k = 0; k < out->nfiles; k++) (void)remove(out->tmp[k]);
+  out->nfiles = 0;
+  return 0;
+}
+
+/*@C
+  PhlexOutputCSVOpen - opens a CSV series in the output directory and writes its header line
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputCSVOpen(PhlexOutput out, const char name[], const char header[], PetscViewer *viewer)
+{
+  char tmp[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexOutputFile(out, name, tmp));
+  PetscCall(PetscViewerASCIIOpen(out->comm, tmp, viewer));
+  PetscCall(PetscViewerPushFormat(*viewer, PETSC_VIEWER_ASCII_CSV));
+  PetscCall(PetscViewerASCIIPrintf(*viewer, "%s\n", header));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputDestroy - destroys the output manager
+@*/
+PetscErrorCode PhlexOutputDestroy(PhlexOutput *out)
+{
+  PetscFunctionBeginUser;
+  if (!*out) PetscFunctionReturn(0);
+  PetscCall(PetscFree2((*out)->tmp, (*out)->final));
+  PetscCall(PetscFree(*out));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,509 @@
+/* The flexible body as a part (part kind "flexible"): options, set-up, summary, energy and outputs. Its equations
+   (residual, Jacobian, ports) are in flexible_dynamics.c, its spaces and operators in flexible_fe.c. */
+#include <phlex_impl.h>
+
+const char *const PhlexICTypes[]         = {"zero", "uniform", "rigid", "beam", "mode", "PhlexICType", "PHLEX_IC_", NULL};
+const char *const PhlexFrameConditions[] = {"patch", "mean_axes", "PhlexFrameCondition", "PHLEX_FRAME_", NULL};
+static const char *const PhlexMotionTypes[]  = {"fixed", "floating", "PhlexMotion", "PHLEX_MOTION_", NULL};
+static const char *const PhlexInertiaTypes[] = {"full", "frozen", "PhlexInertia", "PHLEX_INERTIA_", NULL};
+
+PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart);
+
+static PetscErrorCode MaterialCheck(PhlexFlexible b, const PhlexMaterial *m, const char prefix[])
+{
+  PetscFunctionBeginUser;
+  PetscCheck(m->youngs_modulus > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: Young's modulus must be positive: -%syoungs_modulus %g", b->name, prefix, (double)m->youngs_modulus);
+  PetscCheck(m->poissons_ratio > -1.0 && m->poissons_ratio < 0.5, b->comm, PETSC_ERR_USER_INPUT, "body %s: Poisson's ratio must lie in (-1, 0.5): -%spoissons_ratio %g", b->name, prefix, (double)m->poissons_ratio);
+  PetscCheck(m->density > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: density must be positive: -%sdensity %g", b->name, prefix, (double)m->density);
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MaterialSetFromOptions(PhlexFlexible b, PhlexMaterial *m, const char prefix[])
+{
+  PetscBool fE = PETSC_FALSE, fn = PETSC_FALSE, fr = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(b->comm, prefix, "Material options", NULL);
+  PetscCall(PetscOptionsReal("-youngs_modulus", "Young's modulus E [Pa]", "PhlexFlexibleSetFromOptions", m->youngs_modulus, &m->youngs_modulus, &fE));
+  PetscCall(PetscOptionsReal("-poissons_ratio", "Poisson's ratio nu [-]", "PhlexFlexibleSetFromOptions", m->poissons_ratio, &m->poissons_ratio, &fn));
+  PetscCall(PetscOptionsReal("-density", "Mass density rho [kg/m^3]", "PhlexFlexibleSetFromOptions", m->density, &m->density, &fr));
+  PetscOptionsEnd();
+  PetscCheck(fE, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%syoungs_modulus [Pa]", b->name, prefix);
+  PetscCheck(fn, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%spoissons_ratio [-]", b->name, prefix);
+  PetscCheck(fr, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%sdensity [kg/m^3]", b->name, prefix);
+  PetscCall(MaterialCheck(b, m, prefix));
+  PetscFunctionReturn(0);
+}
+
+/* Options of a flexible body (prefix body<k>_):
+   -dm_plex_filename <file>  gmsh mesh (.msh 2.2 or 4.1, ASCII or binary)
+   -petscspace_degree <k>    velocity degree k (1 or 2); the stress is discontinuous of degree k-1
+   -motion fixed|floating    the frame is held (clamped on the frame patch) or moves
+   -frame patch|mean_axes    how the frame of a floating body is fixed to it
+   -frame_patch <group>      physical surface where u_f = v_f = 0 (fixed: the clamp; floating: the frame)
+   -frame_origin x,y,z       mean axes: the frame origin P (default: the centre of mass)
+   -inertia full|frozen      floating: inertia of x + u_f, or at u_f = 0
+   -youngs_modulus, -poissons_ratio, -density, -regions, -ports, -body_force, -ic_*: see README */
+static PetscErrorCode FlexSetFromOptions(PhlexPart part)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  char         *rptr[PHLEX_MAX_MATERIALS], **pptr;
+  PetscInt      nregions = PHLEX_MAX_MATERIALS, nports = 256;
+  PetscBool     flg, flg_mesh = PETSC_FALSE, has_body_material, fcond = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE;
+  PetscInt      motion = 0, inertia = 0, cond = PHLEX_FRAME_PATCH;
+  const char   *given = NULL;
+  char          who[PHLEX_NAME_LEN + 8];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(nports, &pptr));
+  for (PetscInt i = 0; i < PHLEX_MAX_MATERIALS; i++) rptr[i] = NULL;
+  for (PetscInt i = 0; i < nports; i++) pptr[i] = NULL;
+  PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
+  PetscOptionsBegin(b->comm, b->prefix, "Flexible body options", NULL);
+  PetscCall(PetscOptionsString("-dm_plex_filename", "gmsh mesh file of the body (.msh 2.2 or 4.1)", "PhlexFlexibleSetFromOptions", b->mesh_file, b->mesh_file, sizeof(b->mesh_file), &flg_mesh));
+  PetscCall(PetscOptionsInt("-petscspace_degree", "Velocity degree k (1 or 2); stress: discontinuous degree k-1", "PhlexFlexibleSetFromOptions", b->degree, &b->degree, NULL));
+  PetscCall(PetscOptionsEList("-motion", "Rigid motion of the body frame: fixed (clamped patch held) or floating (the frame moves)", "PhlexFlexibleSetFromOptions", PhlexMotionTypes, 2, PhlexMotionTypes[motion], &motion, NULL));
+  PetscCall(PetscOptionsString("-frame_patch", "Physical surface where u_f = v_f = 0: the clamp of a fixed body, the frame patch of a floating one", "PhlexFlexibleSetFromOptions", b->frame_patch, b->frame_patch, sizeof(b->frame_patch), NULL));
+  PetscCall(PetscOptionsEList("-frame", "Floating body: frame fixed by a patch (-frame_patch, a rigid inclusion) or by mean axes (Tisserand: int rho u_f = 0, int rho x x u_f = 0)", "PhlexFlexibleSetFromOptions", PhlexFrameConditions, 2, PhlexFrameConditions[cond], &cond, &fcond));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_origin", "Floating body with mean axes: frame origin P (default: the centre of mass) [m]", "PhlexFlexibleSetFromOptions", 3, b->origin, &b->origin_given));
+  PetscCall(PetscOptionsEList("-inertia", "Floating body: inertia with x + u_f (full) or at u_f = 0 (frozen, quadratic Hamiltonian)", "PhlexFlexibleSetFromOptions", PhlexInertiaTypes, 2, PhlexInertiaTypes[inertia], &inertia, NULL));
+  PetscCall(PetscOptionsStringArray("-regions", "Physical volumes with their own material (-region_<name>_youngs_modulus ...)", "PhlexFlexibleSetFromOptions", rptr, &nregions, &flg));
+  if (!flg) nregions = 0;
+  PetscCall(PetscOptionsStringArray("-ports", "Physical surfaces: ports carrying wrench inputs or joints (-port_<name>_force ...)", "PhlexFlexibleSetFromOptions", pptr, &nports, &flg));
+  if (!flg) nports = 0;
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-body_force", "Uniform body force density (body frame) [N/m^3]", "PhlexFlexibleSetFromOptions", 3, b->body_force, &b->has_body_force));
+  PetscCall(PhlexPoseSetFromOptions(PetscOptionsObject, part, &b->pose, &given));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_force", "Floating body: force on the frame origin P (body frame) [N]", "PhlexFlexibleSetFromOptions", 3, b->frame_force, &ff));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_moment", "Floating body: moment about the frame origin P (body frame) [N m]", "PhlexFlexibleSetFromOptions", 3, b->frame_moment, &fm));
+  PetscOptionsEnd();
+  b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
+  b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
+  b->frame_loaded   = (ff || fm) ? PETSC_TRUE : PETSC_FALSE;
+  /* a fixed body has no rigid state: its rigid options would be silently ignored */
+  if (!b->floating) {
+    if (!given) given = ff ? "frame_force" : fm ? "frame_moment" : fcond ? "frame" : b->origin_given ? "frame_origin" : NULL;
+    PetscCheck(!given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%s%s describes the rigid motion of a floating frame; the body is fixed (-%smotion fixed): add -%smotion floating or remove the option", b->name, b->prefix, given, b->prefix, b->prefix);
+  } else {
+    /* the frame condition: as given, else the frame patch if there is one, else mean axes */
+    b->frame_condition = fcond ? (PhlexFrameCondition)cond : (b->frame_patch[0] ? PHLEX_FRAME_PATCH : PHLEX_FRAME_MEAN_AXES);
+    PetscCheck(b->frame_condition != PHLEX_FRAME_PATCH || b->frame_patch[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sframe patch needs a frame patch (-%sframe_patch <surface>): its centroid is the frame origin", b->name, b->prefix, b->prefix);
+    PetscCheck(b->frame_condition != PHLEX_FRAME_MEAN_AXES || !b->frame_patch[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sframe mean_axes fixes the frame without a patch; remove -%sframe_patch %s (or use -%sframe patch)", b->name, b->prefix, b->prefix, b->frame_patch, b->prefix);
+    PetscCheck(b->frame_condition == PHLEX_FRAME_MEAN_AXES || !b->origin_given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sframe_origin is for mean axes; with a frame patch the origin is the patch's centroid", b->name, b->prefix);
+  }
+  if (b->frame_loaded) {
+    char prefix[256], what[256];
+    PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sframe_", b->prefix));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s, frame wrench", b->name));
+    PetscCall(PhlexProfileCreate(b->comm, prefix, what, &b->frame_profile));
+    PetscCall(PhlexProfileSetFromOptions(b->frame_profile));
+  }
+
+  PetscCheck(flg_mesh && b->mesh_file[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: no mesh: set -%sdm_plex_filename <file.msh>", b->name, b->prefix);
+  PetscCheck(b->degree == 1 || b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%spetscspace_degree must be 1 or 2, got %" PetscInt_FMT, b->name, b->prefix, b->degree);
+
+  /* materials: either one for the whole body, or one per listed region */
+  b->nmaterials = nregions ? nregions : 1;
+  PetscCall(PetscOptionsHasName(NULL, b->prefix, "-youngs_modulus", &has_body_material));
+  if (!nregions) {
+    PetscCall(PetscStrcpy(b->materials[0].region, ""));
+    b->materials[0].tag = -1;
+    PetscCall(MaterialSetFromOptions(b, &b->materials[0], b->prefix));
+  } else {
+    PetscCheck(!has_body_material, b->comm, PETSC_ERR_USER_INPUT, "body %s: give the material either for the whole body (-%syoungs_modulus ...) or per region (-%sregions), not both", b->name, b->prefix, b->prefix);
+    for (PetscInt r = 0; r < nregions; r++) {
+      char prefix[256];
+      PetscCall(PetscStrncpy(b->materials[r].region, rptr[r], PHLEX_NAME_LEN));
+      b->materials[r].tag = -1;
+      PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sregion_%s_", b->prefix, rptr[r]));
+      PetscCall(MaterialSetFromOptions(b, &b->materials[r], prefix));
+    }
+  }
+  for (PetscInt r = 0; r < nregions; r++) PetscCall(PetscFree(rptr[r]));
+
+  b->nports = nports;
+  PetscCall(PetscCalloc1(PetscMax(nports, 1), &b->ports));
+  for (PetscInt p = 0; p < nports; p++) {
+    PetscCall(PetscStrncpy(b->ports[p].name, pptr[p], PHLEX_NAME_LEN));
+    for (PetscInt q = 0; q < p; q++) {
+      PetscCall(PetscStrcmp(b->ports[q].name, pptr[p], &flg));
+      PetscCheck(!flg, b->comm, PETSC_ERR_USER_INPUT, "body %s: port '%s' is listed twice in -%sports", b->name, pptr[p], b->prefix);
+    }
+    PetscCall(PetscStrcmp(b->frame_patch, pptr[p], &flg));
+    PetscCheck(!flg || !b->floating, b->comm, PETSC_ERR_USER_INPUT, "body %s: the frame patch %s is already a port of the floating body (its wrench acts on the frame: -%sframe_force); remove it from -%sports", b->name, pptr[p], b->prefix, b->prefix);
+    PetscCall(PetscFree(pptr[p]));
+    PetscCall(PhlexPortLoadSetFromOptions(part, b->ports[p].name, PETSC_TRUE, &b->ports[p].load));
+  }
+  PetscCall(PetscFree(pptr));
+  if (b->has_body_force) {
+    char prefix[256], what[256];
+    PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sbody_force_", b->prefix));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s, body force", b->name));
+    PetscCall(PhlexProfileCreate(b->comm, prefix, what, &b->body_force_profile));
+    PetscCall(PhlexProfileSetFromOptions(b->body_force_profile));
+  }
+  PetscCall(PhlexFlexibleICSetFromOptions(b, &b->ic_velocity, "velocity", 3));
+  PetscCall(PhlexFlexibleICSetFromOptions(b, &b->ic_displacement, "displacement", 3));
+  PetscCall(PhlexFlexibleICSetFromOptions(b, &b->ic_stress, "stress", 6));
+  if (b->floating) {
+    /* a rigid or uniform velocity field is the frame's velocity: it is mapped to v_P and w (flexible_ic.c) */
+    const PetscBool rigid_v = (b->ic_velocity.type == PHLEX_IC_UNIFORM || b->ic_velocity.type == PHLEX_IC_RIGID) ? PETSC_TRUE : PETSC_FALSE;
+    PetscCheck(!rigid_v || !(b->pose.velocity_given || b->pose.omega_given), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_velocity_type %s describes the rigid motion of the floating frame, and so do -%svelocity/-%sangular_velocity: give one of them", b->name, b->prefix, PhlexICTypes[b->ic_velocity.type], b->prefix, b->prefix);
+    PetscCheck(b->ic_displacement.type != PHLEX_IC_UNIFORM && b->ic_displacement.type != PHLEX_IC_RIGID, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_displacement_type %s moves a floating body rigidly: place it with -%sposition and -%sorientation_* instead", b->name, b->prefix, PhlexICTypes[b->ic_displacement.type], b->prefix, b->prefix);
+  }
+  PetscFunctionReturn(0);
+}
+
+/* the mesh, its checks and the scales it suggests */
+static PetscErrorCode FlexGeometry(PhlexPart part, PhlexScaleHints *h)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  if (!b->dm) {
+    PetscCall(PhlexMeshLoad(b));
+    PetscCall(PhlexMeshCheckGeometry(b));
+  }
+  h->extent = h->density = h->modulus = h->mass = 0;
+  for (PetscInt d = 0; d < 3; d++) h->extent = PetscMax(h->extent, b->bbox_max[d] - b->bbox_min[d]);
+  for (PetscInt m = 0; m < b->nmaterials; m++) {
+    h->density = PetscMax(h->density, b->materials[m].density);
+    h->modulus = PetscMax(h->modulus, b->materials[m].youngs_modulus);
+  }
+  PetscFunctionReturn(0);
+}
+
+/* The discrete unknowns of a floating body: its frame (r, R, v_P, w) and, with mean axes, the impulses of the six
+   mean-axes multipliers. */
+static PetscErrorCode SetUpLayout(PhlexPart part)
+{
+  PhlexFlexible     b  = (PhlexFlexible)part->data;
+  const char *const rn[18] = {"rx", "ry", "rz", "R11", "R12", "R13", "R21", "R22", "R23", "R31", "R32", "R33", "vPx", "vPy", "vPz", "wx", "wy", "wz"};
+  const char *const mn[6]  = {"mean_tx", "mean_ty", "mean_tz", "mean_rx", "mean_ry", "mean_rz"};
+  PetscInt          nq     = 0;
+
+  PetscFunctionBeginUser;
+  if (b->floating) nq = 18 + (b->frame_condition == PHLEX_FRAME_MEAN_AXES ? 6 : 0);
+  PetscCall(PhlexPartSetUpLayout(part, b->nv_local, b->nv_global, b->ns_local, b->ns_global, nq));
+  if (b->floating) {
+    for (PetscInt k = 0; k < 18; k++) PetscCall(PhlexPartSetDof(part, k, k < 12 ? PHLEX_DOF_CONFIGURATION : PHLEX_DOF_VELOCITY, rn[k]));
+    for (PetscInt k = 18; k < nq; k++) PetscCall(PhlexPartSetDof(part, k, PHLEX_DOF_IMPULSE, mn[k - 18]));
+    part->frame     = (PhlexFrameIndex){0, 3, 12, 15};
+    part->nonlinear = PETSC_TRUE;
+  }
+  PetscFunctionReturn(0);
+}
+
+/* The ports: the listed surfaces, and for a floating body with a frame patch the frame patch (its output is the
+   frame's motion (v_P, w); its wrench acts on the frame). */
+static PetscErrorCode SetUpPorts(PhlexPart part)
+{
+  PhlexFlexible     b = (PhlexFlexible)part->data;
+  const PhlexUnits *u = part->units;
+  const PetscBool   frame_port = (b->floating && b->frame_condition == PHLEX_FRAME_PATCH) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscInt    n = b->nports + (frame_port ? 1 : 0);
+
+  PetscFunctionBeginUser;
+  for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexFlexPortSetUp(b, &b->ports[p], u));
+  PetscCall(PhlexPartSetPorts(part, n));
+  for (PetscInt p = 0; p < b->nports; p++) {
+    PetscCall(PetscStrcpy(part->ports[p].name, b->ports[p].name));
+    part->ports[p].dim = 6;
+    for (PetscInt d = 0; d < 3; d++) part->ports[p].point[d] = (b->ports[p].centroid[d] - b->origin[d]) / u->length;
+  }
+  if (frame_port) {
+    PetscCall(PetscStrcpy(part->ports[n - 1].name, b->frame_patch));
+    part->ports[n - 1].dim = 6;
+  }
+  PetscCall(PetscCalloc3(PetscMax(n, 1), &b->port_ext, PetscMax(n, 1), &b->port_y, PetscMax(n, 1), &b->port_arm));
+  PetscCall(PetscCalloc1(PetscMax(n, 1), &b->port_basis_col));
+  for (PetscInt p = 0; p < n; p++) b->port_basis_col[p] = -1;
+  PetscFunctionReturn(0);
+}
+
+/* set-up: spaces, constant operators, ports, inertia, layout */
+static PetscErrorCode FlexSetUp(PhlexPart part)
+{
+  PhlexFlexible     b = (PhlexFlexible)part->data;
+  const PhlexUnits *u = part->units;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFlexibleSetUpFE(b, u));
+  if (!b->floating) PetscCall(PhlexFlexibleSetUpInertia(b, u)); /* nodal int rho phi: gravity on a fixed body */
+  PetscCall(SetUpPorts(part));
+  PetscCall(SetUpLayout(part));
+  b->frame.comm    = b->comm;
+  b->frame.frozen  = b->frozen_inertia;
+  b->frame.inertia = (PhlexInertia){0};
+  if (b->floating) {
+    b->frame.inertia = b->inertia;
+    b->frame.tnode   = b->tnode;
+    b->frame.wnode   = b->wnode;
+    b->frame.Mv      = b->Mv;
+  }
+  b->frame.gravity = part->gravity;
+  if (!b->floating) {
+    part->ops.momenta   = NULL; /* held: no momentum of its own, no frame to move */
+    part->ops.rigidmass = NULL;
+  }
+  PetscCall(DMCreateGlobalVector(b->dm, &b->load));
+  PetscCall(VecDuplicate(b->load, &b->work));
+  if (!b->floating && (part->gravity[0] != 0 || part->gravity[1] != 0 || part->gravity[2] != 0)) {
+    /* the weight of a fixed body as a nodal load: t(l) g_c on component c (gravity is a potential: no input power) */
+    PetscScalar       *ga;
+    const PetscScalar *ta;
+    PetscCall(VecDuplicate(b->load, &b->bgrav));
+    PetscCall(VecGetArrayWrite(b->bgrav, &ga));
+    PetscCall(VecGetArrayRead(b->tnode, &ta));
+    for (PetscInt i = 0; i < b->nv_local; i++) ga[i] = ta[i] * part->gravity[i % 3];
+    PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+    PetscCall(VecRestoreArrayWrite(b->bgrav, &ga));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexView(PhlexPart part, PetscViewer viewer)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscInt      ncells, gcells;
+
+  PetscFunctionBeginUser;
+  ncells = b->cEnd - b->cStart;
+  PetscCallMPI(MPI_Allreduce(&ncells, &gcells, 1, MPIU_INT, MPI_SUM, b->comm));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: mesh %s, %" PetscInt_FMT " tetrahedra, velocity P%" PetscInt_FMT " (%" PetscInt_FMT " dofs), stress P%" PetscInt_FMT " discontinuous (%" PetscInt_FMT " dofs)\n", b->name, b->mesh_file, gcells, b->degree, b->nv_global, b->degree - 1, b->ns_global));
+  PetscCall(PetscViewerASCIIPushTab(viewer));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "volume %.6g m^3, mass %.6g kg, centre of mass (%.6g, %.6g, %.6g) m\n", (double)b->volume, (double)b->mass, (double)b->center_of_mass[0], (double)b->center_of_mass[1], (double)b->center_of_mass[2]));
+  if (b->floating) {
+    PetscReal q[4];
+    if (b->frame_condition == PHLEX_FRAME_PATCH) PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on patch %s (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", b->frame_patch, (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
+    else PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on mean axes (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
+    PhlexRotationToQuaternion(b->pose.rotation, q);
+    PetscCall(PetscViewerASCIIPrintf(viewer, "initial r_P (%.6g, %.6g, %.6g) m, orientation quaternion (%.6g, %.6g, %.6g, %.6g), v_P (%.6g, %.6g, %.6g) m/s, w_P (%.6g, %.6g, %.6g) rad/s (body frame)\n", (double)b->pose.position[0], (double)b->pose.position[1], (double)b->pose.position[2], (double)q[0], (double)q[1], (double)q[2], (double)q[3], (double)b->pose.velocity[0], (double)b->pose.velocity[1], (double)b->pose.velocity[2], (double)b->pose.omega[0], (double)b->pose.omega[1], (double)b->pose.omega[2]));
+    if (b->frame_loaded) {
+      char prof[256];
+      PetscCall(PhlexProfileDescribe(b->frame_profile, prof, sizeof(prof)));
+      PetscCall(PetscViewerASCIIPrintf(viewer, "frame wrench at P: force (%g, %g, %g) N, moment (%g, %g, %g) N m (body frame), profile %s\n", (double)b->frame_force[0], (double)b->frame_force[1], (double)b->frame_force[2], (double)b->frame_moment[0], (double)b->frame_moment[1], (double)b->frame_moment[2], prof));
+    }
+  } else if (b->frame_patch[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "clamped patch (frame patch): %s\n", b->frame_patch));
+  else PetscCall(PetscViewerASCIIPrintf(viewer, "no clamped patch: free body\n"));
+  for (PetscInt m = 0; m < b->nmaterials; m++) {
+    const PhlexMaterial *mat = &b->materials[m];
+    PetscCall(PetscViewerASCIIPrintf(viewer, "material %s: E = %g Pa, nu = %g, rho = %g kg/m^3\n", mat->region[0] ? mat->region : "(whole body)", (double)mat->youngs_modulus, (double)mat->poissons_ratio, (double)mat->density));
+  }
+  for (PetscInt p = 0; p < b->nports; p++) {
+    const PhlexFlexPort *port = &b->ports[p];
+    char                 load[512];
+    PetscCall(PhlexPortLoadDescribe((PhlexPortLoad *)&port->load, load, sizeof(load)));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "port %s: area %.6g m^2, centroid (%.6g, %.6g, %.6g) m%s\n", port->name, (double)port->area, (double)port->centroid[0], (double)port->centroid[1], (double)port->centroid[2], load));
+  }
+  PetscCall(PetscViewerASCIIPopTab(viewer));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexDestroy(PhlexPart part)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexFlexPortDestroy(&b->ports[p]));
+  PetscCall(PetscFree(b->ports));
+  PetscCall(PhlexProfileDestroy(&b->body_force_profile));
+  PetscCall(PhlexProfileDestroy(&b->frame_profile));
+  PetscCall(PhlexFrameStateDestroy(&b->fs));
+  PetscCall(MatDestroy(&b->Gt));
+  PetscCall(MatDestroy(&b->Mvaij));
+  PetscCall(MatDestroy(&b->Kaij));
+  PetscCall(MatDestroy(&b->Jvv));
+  PetscCall(MatDestroy(&b->Jvu));
+  PetscCall(MatDestroy(&b->Sv));
+  PetscCall(MatDestroy(&b->W));
+  PetscCall(PetscFree4(b->Bc, b->Cu, b->Cv, b->Cpre));
+  PetscCall(PetscFree2(b->gram, b->gram_piv));
+  PetscCall(VecDestroy(&b->load));
+  PetscCall(VecDestroy(&b->work));
+  PetscCall(VecDestroy(&b->ud));
+  PetscCall(VecDestroy(&b->vd));
+  PetscCall(VecDestroy(&b->bgrav));
+  PetscCall(PetscFree3(b->port_ext, b->port_y, b->port_arm));
+  PetscCall(PetscFree(b->port_basis_col));
+  PetscCall(PhlexFlexibleDestroyFE(b));
+  PetscCall(PetscFree(part->data));
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Energy and outputs                                                                                             */
+
+/* kinetic, strain and gravity energy at the evaluated state X (non-dimensional) */
+static PetscErrorCode FlexEnergy(PhlexPart part, const PhlexPartVec *X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFlexibleEnergy(b, X->v, X->s, kin, strain));
+  *pot = 0.0;
+  if (b->floating) PetscCall(PhlexFrameEnergy(&b->frame, &b->fs, X->v, kin, pot));
+  else if (b->bgrav) {
+    /* V = -g . int rho (x + u) */
+    PetscScalar gu;
+    PetscCall(VecDot(b->bgrav, X->u, &gu));
+    *pot = -(PhlexDot3(part->gravity, b->inertia.s0) + PetscRealPart(gu));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexInputPower(PhlexPart part, PetscReal *P)
+{
+  PetscFunctionBeginUser;
+  *P = ((PhlexFlexible)part->data)->power_ext;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexMomenta(PhlexPart part, PetscReal P[3], PetscReal L[3])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFrameMomenta(&b->fs, P, L));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexRigidMass(PhlexPart part, PetscReal M[36])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFrameRigidMass(&((PhlexFlexible)part->data)->frame.inertia, M));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool fields)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  char          name[PHLEX_NAME_LEN + 16], header[4096] = "time";
+
+  PetscFunctionBeginUser;
+  if (fields) {
+    PetscCall(PhlexFieldWriterCreate(out, b, b->name, (PhlexFieldWriter *)&b->writer));
+    if (b->floating) PetscCall(PhlexFieldWriterSetGeometryField((PhlexFieldWriter)b->writer, "inertial_position"));
+  }
+  if (b->nports || b->floating) {
+    /* the frame of a floating body first (its patch, or "frame" with mean axes), then the ports */
+    for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
+      const char *n = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
+      char        cols[1024];
+      PetscCall(PetscSNPrintf(cols, sizeof(cols), ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
+      PetscCall(PetscStrlcat(header, cols, sizeof(header)));
+    }
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", b->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, header, (PetscViewer *)&b->ports_csv));
+  }
+  if (b->floating) {
+    PetscCall(PhlexFrameWriteHeader(header, sizeof(header)));
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_rigid.csv", b->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, header, (PetscViewer *)&b->rigid_csv));
+  }
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode PhlexFlexiblePortOutputsAll(PhlexPart, const PhlexPartVec *);
+
+/* one output step at the evaluated state X: port series, rigid series, fields */
+static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t, const PhlexPartVec *X, PetscBool fields)
+{
+  PhlexFlexible     b = (PhlexFlexible)part->data;
+  const PhlexUnits *u = part->units;
+
+  PetscFunctionBeginUser;
+  if (b->ports_csv && step >= 0) {
+    PetscViewer csv = (PetscViewer)b->ports_csv;
+    PetscReal   fr  = 0.0;
+    PetscCall(PhlexFlexiblePortOutputsAll(part, X));
+    PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
+    if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+    if (b->floating) {
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_force[c])));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_moment[c])));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->fs.vP[c] * u->velocity)));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->fs.w[c] / u->time)));
+    }
+    for (PetscInt p = 0; p < b->nports; p++) {
+      PetscReal in[6];
+      PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, NULL, in));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force)));
+      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force * u->length)));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->port_y[p][c] * u->velocity)));
+      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->port_y[p][c] / u->time)));
+    }
+    PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
+  }
+  if (b->rigid_csv && step >= 0) {
+    PetscReal P[3], L[3];
+    PetscCall(PhlexFrameWriteRow((PetscViewer)b->rigid_csv, t, &b->fs, u, P, L));
+  }
+  if (fields && b->writer) {
+    PhlexFieldWriter w = (PhlexFieldWriter)b->writer;
+    PetscCall(PhlexFieldWriterBeginStep(w, t));
+    /* displacement first: ParaView makes the first vector the active one ("Warp By Vector") */
+    PetscCall(PhlexFieldWriterVertexField(w, "displacement", X->u, u->length, NULL, NULL, PETSC_FALSE));
+    if (b->floating) {
+      /* x_inertial = r_P + R (x - P + u_f): the XDMF geometry of the step, so ParaView shows the motion */
+      PetscReal rp[3], RP[3];
+      PhlexMatVec3(b->fs.R, b->origin, RP);
+      for (PetscInt k = 0; k < 3; k++) rp[k] = b->fs.r[k] * u->length - RP[k];
+      PetscCall(PhlexFieldWriterVertexField(w, "inertial_position", X->u, u->length, b->fs.R, rp, PETSC_TRUE));
+    }
+    PetscCall(PhlexFieldWriterVertexField(w, "velocity", X->v, u->velocity, NULL, NULL, PETSC_FALSE));
+    PetscCall(PhlexFieldWriterStress(w, X->s, u->modulus));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexOutputClose(PhlexPart part)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFieldWriterDestroy((PhlexFieldWriter *)&b->writer));
+  PetscCall(PetscViewerDestroy((PetscViewer *)&b->ports_csv));
+  PetscCall(PetscViewerDestroy((PetscViewer *)&b->rigid_csv));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPartCreate_Flexible - a flexible FE body (part kind "flexible", the default)
+@*/
+PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
+{
+  PhlexFlexible b;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&b));
+  part->data   = b;
+  b->comm      = part->comm;
+  b->part      = part;
+  b->name      = part->name;
+  b->prefix    = part->prefix;
+  b->degree    = 2;
+  b->frame_tag = -1;
+  b->ic_velocity.amplitude = b->ic_displacement.amplitude = b->ic_stress.amplitude = 1.0;
+  b->ic_velocity.mode = b->ic_displacement.mode = b->ic_stress.mode = 1;
+  b->pose.rotation[0] = b->pose.rotation[4] = b->pose.rotation[8] = 1.0;
+  part->ops.setfromoptions = FlexSetFromOptions;
+  part->ops.geometry       = FlexGeometry;
+  part->ops.setup          = FlexSetUp;
+  part->ops.view           = FlexView;
+  part->ops.destroy        = FlexDestroy;
+  part->ops.initialstate   = PhlexFlexibleInitialState;
+  part->ops.energy         = FlexEnergy;
+  part->ops.inputpower     = FlexInputPower;
+  part->ops.momenta        = FlexMomenta;
+  part->ops.rigidmass      = FlexRigidMass;
+  part->ops.outputopen     = FlexOutputOpen;
+  part->ops.outputstep     = FlexOutputStep;
+  part->ops.outputclose    = FlexOutputClose;
+  part->ops.modes          = PhlexFlexibleComputeModes;
+  part->ops.modesoutput    = PhlexFlexibleModesOutput;
+  part->ops.refine         = PhlexFlexibleRefine;
+  part->ops.modesorder     = PhlexFlexibleModesOrder;
+  part->ops.modeskind      = PhlexFlexibleModesKind;
+  PetscCall(PhlexFlexibleSetDynamicsOps(part));
+  PetscFunctionReturn(0);
+}

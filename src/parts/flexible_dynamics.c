@@ -1,0 +1,822 @@
+/* The equations of a flexible body as a part of the index-2 pHDAE (paper Sections 4 and 5), non-dimensional, with
+   unknowns u, Sigma, v (fields) and, floating, q = [r | R | v_P | w] (+ six mean-axes impulses):
+
+     F_u     = u' - v                          (kinematics u_f' = v_f)
+     F_Sigma = G v - Ms Sigma'                 (compatibility; rows negated so that the (Sigma, v) block is symmetric)
+     F_v     = Mv v' + G^T Sigma - b           (momentum balance; b: port wrenches (inputs and joints), body force)
+               [+ the moving-frame terms of frame.c]  [- T mu' (mean axes)]
+     F_q     = rigid kinematics and Hamel equations of the frame (frame.c); mean axes: T^T v = 0
+
+   The operators Mv, Ms, G are constant in the body frame and assembled once (flexible_fe.c); the residual is a few
+   sparse mat-vecs. Time derivatives arrive in SI time (X'_nondim = T X'_SI).
+
+   Port p: output y = B_p^T (v [+ w x u]) (+ (v_P + w x (c - P), w) floating), wrench distribution B_p w on the
+   elastic rows and (F, (c - P) x F + T [+ sum_l u(l) x (B_p w)(l)]) on the frame rows: the transposes of each other,
+   so that the port power is w . y. The u terms appear in the full-inertia model only (as the inertia terms). */
+#include <phlex_impl.h>
+#include <petsc/private/petscimpl.h> /* PetscObjectStateIncrease: blocks changed in place */
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Loads                                                                                                          */
+
+/* the port wrenches of the scene's inputs at t and the external loads on the body: the elastic load vector, and for
+   a floating body the resultant force and moment about P (frame.c adds the u arms), and their power */
+static PetscErrorCode ExternalLoads(PhlexPart part, PetscReal t, const PhlexPartVec *X)
+{
+  PhlexFlexible     b = (PhlexFlexible)part->data;
+  const PhlexUnits *u = part->units;
+  PhlexFrameState  *f = &b->fs;
+  Vec               bext = b->floating ? f->bext : b->load;
+  PetscScalar       p;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(bext, 0.0));
+  for (PetscInt k = 0; k < 3; k++) f->Fext[k] = f->Mext[k] = 0.0;
+  for (PetscInt q = 0; q < b->nports; q++) {
+    PetscReal *w = b->port_ext[q];
+    PetscCall(PhlexPortLoadEvaluate(&b->ports[q].load, t, u, b->floating ? f->R : NULL, w));
+    if (!b->ports[q].load.loaded) continue;
+    for (PetscInt k = 0; k < 6; k++)
+      if (w[k] != 0.0) PetscCall(VecAXPY(bext, w[k], b->ports[q].dist[k]));
+    if (b->floating) {
+      PetscReal a[3];
+      PhlexCross(part->ports[q].point, w, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        f->Fext[k] += w[k];
+        f->Mext[k] += a[k] + w[3 + k];
+      }
+    }
+  }
+  if (b->floating && b->frame_loaded) {
+    PetscReal fr;
+    PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+    for (PetscInt k = 0; k < 3; k++) {
+      f->Fext[k] += fr * b->frame_force[k] / u->force;
+      f->Mext[k] += fr * b->frame_moment[k] / (u->force * u->length);
+    }
+  }
+  if (b->has_body_force) {
+    PetscReal fr, beta[3];
+    PetscCall(PhlexProfileEvaluate(b->body_force_profile, t, &fr));
+    /* force density scale: force / length^3 = E_ref / L */
+    for (PetscInt c = 0; c < 3; c++) beta[c] = fr * b->body_force[c] * u->length / u->modulus;
+    for (PetscInt c = 0; c < 3; c++)
+      if (beta[c] != 0.0) PetscCall(VecAXPY(bext, beta[c], b->fvol[c]));
+    if (b->floating) {
+      PetscReal a[3];
+      PhlexCross(b->inertia.svol, beta, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        f->Fext[k] += b->inertia.vol * beta[k];
+        f->Mext[k] += a[k];
+      }
+    }
+  }
+  if (b->floating) {
+    PetscCall(PhlexFrameAddLoadArms(&b->frame, X->u, f));
+    /* power of the inputs: b . v + F . v_P + M . w (M with the u arms: b . (w x u) in the full model) */
+    PetscCall(VecDot(X->v, bext, &p));
+    b->power_ext = PetscRealPart(p) + PhlexDot3(f->Fext, f->vP) + PhlexDot3(f->Mext, f->w);
+  } else {
+    PetscCall(VecDot(X->v, bext, &p));
+    b->power_ext = PetscRealPart(p);
+    /* the weight is a potential (energy), not an input */
+    if (b->bgrav) PetscCall(VecAXPY(bext, 1.0, b->bgrav));
+  }
+  PetscFunctionReturn(0);
+}
+
+/* the joint wrenches on the ports join the loads (once per evaluation) */
+static PetscErrorCode AddJointLoads(PhlexPart part)
+{
+  PhlexFlexible    b = (PhlexFlexible)part->data;
+  PhlexFrameState *f = &b->fs;
+  Vec              bext = b->floating ? f->bext : b->load;
+
+  PetscFunctionBeginUser;
+  if (b->joints_added) PetscFunctionReturn(0);
+  b->joints_added = PETSC_TRUE;
+  for (PetscInt q = 0; q < part->nports; q++) {
+    const PetscReal *w = part->wrench[q];
+    PetscBool        zero = PETSC_TRUE;
+    for (PetscInt k = 0; k < 6; k++)
+      if (w[k] != 0.0) zero = PETSC_FALSE;
+    if (zero) continue;
+    if (q < b->nports)
+      for (PetscInt k = 0; k < 6; k++)
+        if (w[k] != 0.0) PetscCall(VecAXPY(bext, w[k], b->ports[q].dist[k]));
+    if (b->floating) {
+      PetscReal a[3];
+      PhlexCross(part->ports[q].point, w, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        f->Fext[k] += w[k];
+        f->Mext[k] += a[k] + w[3 + k];
+      }
+      if (!b->frozen_inertia && q < b->nports)
+        for (PetscInt a3 = 0; a3 < 3; a3++)
+          for (PetscInt k = 0; k < 6; k++) f->Mext[a3] += b->port_arm[q][6 * a3 + k] * w[k];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Ports                                                                                                          */
+
+/* the velocity field whose port averages are the elastic part of the outputs: v (+ w x u, full model) */
+static PetscErrorCode OutputField(PhlexFlexible b, Vec u, PetscReal au, Vec v, const PetscReal w[3], Vec out)
+{
+  PetscFunctionBeginUser;
+  if (v) PetscCall(VecCopy(v, out));
+  else PetscCall(VecSet(out, 0.0));
+  if (u && b->floating && !b->frozen_inertia && au != 0.0) {
+    const PetscScalar *ua;
+    PetscScalar       *oa;
+    PetscInt           n;
+    PetscCall(VecGetLocalSize(u, &n));
+    PetscCall(VecGetArrayRead(u, &ua));
+    PetscCall(VecGetArray(out, &oa));
+    for (PetscInt l = 0; l < n / 3; l++) {
+      PetscReal x[3], a[3];
+      for (PetscInt k = 0; k < 3; k++) x[k] = au * PetscRealPart(ua[3 * l + k]);
+      PhlexCross(w, x, a);
+      for (PetscInt k = 0; k < 3; k++) oa[3 * l + k] += a[k];
+    }
+    PetscCall(VecRestoreArrayRead(u, &ua));
+    PetscCall(VecRestoreArray(out, &oa));
+  }
+  PetscFunctionReturn(0);
+}
+
+/* outputs of the ports (all, or those a joint uses) at the evaluated state; the moment-arm matrices of the full
+   model, A_p[a][k] = sum_l (u(l) x dist_k(l))_a, with one reduction */
+static PetscErrorCode PortOutputs(PhlexPart part, const PhlexPartVec *X, PetscBool all)
+{
+  PhlexFlexible b    = (PhlexFlexible)part->data;
+  PetscBool     full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE, any = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  for (PetscInt q = 0; q < part->nports; q++)
+    if (all || part->port_used[q]) any = PETSC_TRUE;
+  if (!any) PetscFunctionReturn(0);
+  PetscCall(OutputField(b, X->u, 1.0, X->v, b->fs.w, b->work));
+  for (PetscInt q = 0; q < part->nports; q++) {
+    PetscScalar d[6] = {0, 0, 0, 0, 0, 0};
+    if (!(all || part->port_used[q])) continue;
+    if (q < b->nports) PetscCall(VecMDot(b->work, 6, b->ports[q].dist, d));
+    for (PetscInt k = 0; k < 6; k++) b->port_y[q][k] = PetscRealPart(d[k]);
+    if (b->floating) {
+      PetscReal a[3];
+      PhlexCross(b->fs.w, part->ports[q].point, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        b->port_y[q][k] += b->fs.vP[k] + a[k];
+        b->port_y[q][3 + k] += b->fs.w[k];
+      }
+    }
+  }
+  if (full && !all) {
+    PetscReal         *loc, *glob;
+    const PetscScalar *ua;
+    PetscInt           n, np = b->nports;
+    PetscCall(PetscCalloc2(18 * PetscMax(np, 1), &loc, 18 * PetscMax(np, 1), &glob));
+    PetscCall(VecGetLocalSize(X->u, &n));
+    PetscCall(VecGetArrayRead(X->u, &ua));
+    for (PetscInt q = 0; q < np; q++) {
+      if (!part->port_used[q]) continue;
+      for (PetscInt k = 0; k < 6; k++) {
+        const PetscScalar *da;
+        PetscCall(VecGetArrayRead(b->ports[q].dist[k], &da));
+        for (PetscInt l = 0; l < n / 3; l++) {
+          PetscReal x[3], y[3], a[3];
+          for (PetscInt c = 0; c < 3; c++) {
+            x[c] = PetscRealPart(ua[3 * l + c]);
+            y[c] = PetscRealPart(da[3 * l + c]);
+          }
+          PhlexCross(x, y, a);
+          for (PetscInt c = 0; c < 3; c++) loc[18 * q + 6 * c + k] += a[c];
+        }
+        PetscCall(VecRestoreArrayRead(b->ports[q].dist[k], &da));
+      }
+    }
+    PetscCall(VecRestoreArrayRead(X->u, &ua));
+    PetscCall(MPIU_Allreduce(loc, glob, 18 * np, MPIU_REAL, MPI_SUM, b->comm));
+    for (PetscInt q = 0; q < np; q++)
+      for (PetscInt k = 0; k < 18; k++) b->port_arm[q][k] = glob[18 * q + k];
+    PetscCall(PetscFree2(loc, glob));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexiblePortOutputsAll - the outputs of every port at the evaluated state X (for the output series)
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexiblePortOutputsAll(PhlexPart part, const PhlexPartVec *X)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PortOutputs(part, X, PETSC_TRUE));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexPortOutput(PhlexPart part, PetscInt q, PetscReal y[6])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 6; k++) y[k] = b->port_y[q][k];
+  PetscFunctionReturn(0);
+}
+
+/* dy = d y_q for a change (a du, dv, dq) of the state */
+static PetscErrorCode FlexPortLinear(PhlexPart part, PetscInt q, Vec du, PetscReal au, Vec dv, const PetscReal *dq, PetscReal dy[6])
+{
+  PhlexFlexible b    = (PhlexFlexible)part->data;
+  PetscBool     full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 6; k++) dy[k] = 0.0;
+  if (q < b->nports && (dv || (du && full))) {
+    PetscScalar d[6];
+    if (du && full) {
+      PetscCall(OutputField(b, du, au, dv, b->fs.w, b->work));
+      PetscCall(VecMDot(b->work, 6, b->ports[q].dist, d));
+    } else PetscCall(VecMDot(dv, 6, b->ports[q].dist, d));
+    for (PetscInt k = 0; k < 6; k++) dy[k] = PetscRealPart(d[k]);
+  }
+  if (b->floating && dq) {
+    const PetscReal *dvP = dq + 12, *dw = dq + 15;
+    PetscReal        a[3];
+    PhlexCross(dw, part->ports[q].point, a);
+    for (PetscInt k = 0; k < 3; k++) {
+      dy[k] += dvP[k] + a[k];
+      dy[3 + k] += dw[k];
+    }
+    /* d/dw of B^T (w x u) = w . sum_l u(l) x dist_k(l) */
+    if (full && q < b->nports)
+      for (PetscInt k = 0; k < 6; k++) dy[k] += dw[0] * b->port_arm[q][k] + dw[1] * b->port_arm[q][6 + k] + dw[2] * b->port_arm[q][12 + k];
+  }
+  PetscFunctionReturn(0);
+}
+
+/* dy for the columns of Y as velocity changes with du = Y/shift (the displacement eliminated): 6 x k */
+static PetscErrorCode FlexPortLinearBlock(PhlexPart part, PetscInt q, Mat Y, PetscReal ainv, PetscReal *out)
+{
+  PhlexFlexible      b    = (PhlexFlexible)part->data;
+  PetscBool          full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscScalar *Ya, *da[6];
+  PetscReal         *loc;
+  PetscInt           n, k, ld;
+  const PetscReal   *w = b->fs.w;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetSize(Y, NULL, &k));
+  PetscCall(PetscCalloc1(6 * k, &loc));
+  if (q < b->nports) {
+    PetscCall(MatGetLocalSize(Y, &n, NULL));
+    PetscCall(MatDenseGetLDA(Y, &ld));
+    PetscCall(MatDenseGetArrayRead(Y, &Ya));
+    for (PetscInt c = 0; c < 6; c++) PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da[c]));
+    for (PetscInt j = 0; j < k; j++) {
+      const PetscScalar *y = Ya + j * ld;
+      for (PetscInt l = 0; l < n / 3; l++) {
+        PetscReal z[3];
+        for (PetscInt c = 0; c < 3; c++) z[c] = PetscRealPart(y[3 * l + c]);
+        if (full) {
+          PetscReal a[3];
+          PhlexCross(w, z, a);
+          for (PetscInt c = 0; c < 3; c++) z[c] += ainv * a[c];
+        }
+        for (PetscInt c = 0; c < 6; c++) loc[6 * j + c] += PetscRealPart(da[c][3 * l]) * z[0] + PetscRealPart(da[c][3 * l + 1]) * z[1] + PetscRealPart(da[c][3 * l + 2]) * z[2];
+      }
+    }
+    for (PetscInt c = 0; c < 6; c++) PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da[c]));
+    PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
+  }
+  PetscCall(MPIU_Allreduce(loc, out, 6 * k, MPIU_REAL, MPI_SUM, b->comm));
+  PetscCall(PetscFree(loc));
+  PetscFunctionReturn(0);
+}
+
+/* += generalized force of a wrench w on port q: B_q w on the elastic rows, (F, (c - P) x F + T [+ arms]) on the frame */
+static PetscErrorCode FlexPortForce(PhlexPart part, PetscInt q, const PetscReal w[6], Vec fv, PetscReal *fq)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  if (fv && q < b->nports)
+    for (PetscInt k = 0; k < 6; k++)
+      if (w[k] != 0.0) PetscCall(VecAXPY(fv, w[k], b->ports[q].dist[k]));
+  if (b->floating && fq) {
+    PetscReal a[3];
+    PhlexCross(part->ports[q].point, w, a);
+    for (PetscInt k = 0; k < 3; k++) {
+      fq[12 + k] += w[k];
+      fq[15 + k] += a[k] + w[3 + k];
+    }
+    if (!b->frozen_inertia && q < b->nports)
+      for (PetscInt c = 0; c < 3; c++)
+        for (PetscInt k = 0; k < 6; k++) fq[15 + c] += b->port_arm[q][6 * c + k] * w[k];
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexPortBasisColumn(PhlexPart part, PetscInt q, PetscInt *col)
+{
+  PetscFunctionBeginUser;
+  *col = ((PhlexFlexible)part->data)->port_basis_col[q];
+  PetscFunctionReturn(0);
+}
+
+/* inertial position and orientation of port q at the state X: r + R (c - P + u_avg), R exp([theta_avg]x) */
+static PetscErrorCode FlexPortPlacement(PhlexPart part, PetscInt q, const PhlexPartVec *X, PetscReal x[3], PetscReal Rp[9])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscReal     R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, r[3] = {0, 0, 0}, ub[6] = {0, 0, 0, 0, 0, 0}, c[3], E[9], n;
+
+  PetscFunctionBeginUser;
+  if (q < b->nports) {
+    PetscScalar d[6];
+    PetscCall(VecMDot(X->u, 6, b->ports[q].dist, d));
+    for (PetscInt k = 0; k < 6; k++) ub[k] = PetscRealPart(d[k]);
+  }
+  if (b->floating)
+    for (PetscInt k = 0; k < 3; k++) {
+      r[k] = X->q[k];
+      for (PetscInt j = 0; j < 3; j++) R[3 * k + j] = X->q[3 + 3 * k + j];
+    }
+  for (PetscInt k = 0; k < 3; k++) c[k] = part->ports[q].point[k] + ub[k];
+  PhlexMatVec3(R, c, x);
+  for (PetscInt k = 0; k < 3; k++) x[k] += r[k];
+  n = PhlexNorm3(ub + 3);
+  PhlexAxisAngleToRotation(n > 0 ? ub + 3 : (PetscReal[3]){1, 0, 0}, n, E);
+  PhlexMatMat3(R, E, Rp);
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* State, residual                                                                                                */
+
+static PetscErrorCode FlexEvaluate(PhlexPart part, PetscReal t, const PhlexPartVec *X, const PhlexPartVec *Xdot)
+{
+  PhlexFlexible   b = (PhlexFlexible)part->data;
+  const PetscReal T = part->units->time;
+
+  PetscFunctionBeginUser;
+  b->t_eval       = t;
+  b->joints_added = PETSC_FALSE;
+  if (b->floating) {
+    PetscReal qd[18];
+    for (PetscInt k = 0; k < 18; k++) qd[k] = Xdot ? T * Xdot->q[k] : 0.0;
+    if (Xdot) {
+      PetscCall(VecAXPBY(b->ud, T, 0.0, Xdot->u));
+      PetscCall(VecAXPBY(b->vd, T, 0.0, Xdot->v));
+    }
+    PetscCall(PhlexFrameEvaluate(&b->frame, X->u, X->v, Xdot ? b->ud : NULL, Xdot ? b->vd : NULL, X->q, qd, &b->fs));
+  }
+  PetscCall(ExternalLoads(part, t, X));
+  PetscCall(PortOutputs(part, X, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartVec *X, const PhlexPartVec *Xdot, PhlexPartVec *F)
+{
+  PhlexFlexible   b = (PhlexFlexible)part->data;
+  const PetscReal T = part->units->time;
+
+  PetscFunctionBeginUser;
+  PetscCall(AddJointLoads(part));
+  /* F_u = T u' - v */
+  PetscCall(VecAXPBYPCZ(F->u, T, -1.0, 0.0, Xdot->u, X->v));
+  /* F_Sigma = G v - T Ms Sigma' */
+  PetscCall(MatMult(b->Ms, Xdot->s, F->s));
+  PetscCall(VecScale(F->s, -T));
+  PetscCall(MatMultAdd(b->G, X->v, F->s, F->s));
+  /* F_v = T Mv v' + G^T Sigma - b */
+  PetscCall(MatMultTranspose(b->G, X->s, F->v));
+  PetscCall(VecScale(F->v, 1.0 / T));
+  PetscCall(MatMultAdd(b->Mv, Xdot->v, F->v, F->v));
+  PetscCall(VecScale(F->v, T));
+  if (!b->floating) {
+    PetscCall(VecAXPY(F->v, -1.0, b->load));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscLogEventBegin(PHLEX_FloatResidual, 0, 0, 0, 0));
+  PetscCall(VecAXPY(F->v, -1.0, b->fs.bext));
+  PetscCall(PhlexFrameResidual(&b->frame, &b->fs, X->u, X->v, b->ud, F->v, F->q));
+  if (b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
+    /* the multipliers of int rho v = 0, int rho (x - P) x v = 0 enter through the transposed map (paper Section 5:
+       a power-preserving interconnection with the ground of the elastic field's rigid content) */
+    const PetscScalar *ta, *wa;
+    PetscScalar       *fa;
+    PetscReal          mt[3], mr[3];
+    PetscInt           n;
+    for (PetscInt k = 0; k < 3; k++) {
+      mt[k] = T * Xdot->q[18 + k];
+      mr[k] = T * Xdot->q[21 + k];
+    }
+    PetscCall(VecGetLocalSize(F->v, &n));
+    PetscCall(VecGetArray(F->v, &fa));
+    PetscCall(VecGetArrayRead(b->tnode, &ta));
+    PetscCall(VecGetArrayRead(b->wnode, &wa));
+    for (PetscInt l = 0; l < n / 3; l++) {
+      PetscReal wl[3], a[3];
+      for (PetscInt k = 0; k < 3; k++) wl[k] = PetscRealPart(wa[3 * l + k]);
+      PhlexCross(mr, wl, a);
+      for (PetscInt k = 0; k < 3; k++) fa[3 * l + k] -= PetscRealPart(ta[3 * l]) * mt[k] + a[k];
+    }
+    PetscCall(VecRestoreArray(F->v, &fa));
+    PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+    PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+    for (PetscInt k = 0; k < 3; k++) {
+      F->q[18 + k] = b->fs.Vf[k];
+      F->q[21 + k] = b->fs.Lx[k];
+    }
+  }
+  PetscCall(PetscLogEventEnd(PHLEX_FloatResidual, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexPostStep(PhlexPart part, PetscReal *q, PetscReal *defect)
+{
+  PetscFunctionBeginUser;
+  *defect = 0.0;
+  if (!((PhlexFlexible)part->data)->floating) PetscFunctionReturn(0);
+  *defect = PhlexOrthogonalityError(q + 3);
+  PhlexOrthonormalize(q + 3);
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Jacobian                                                                                                       */
+
+/* y = (a I + B) Mv x with B a node-wise 3x3 matrix: the elastic blocks of the moving frame */
+static PetscErrorCode NodeMassMult(PhlexFlexible b, PetscReal a, const PetscReal B[9], Vec x, Vec y)
+{
+  PetscScalar *ya;
+  PetscInt     n;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatMult(b->Mv, x, y));
+  PetscCall(VecGetLocalSize(y, &n));
+  PetscCall(VecGetArray(y, &ya));
+  for (PetscInt l = 0; l < n / 3; l++) {
+    PetscReal z[3], r[3];
+    for (PetscInt k = 0; k < 3; k++) z[k] = PetscRealPart(ya[3 * l + k]);
+    PhlexMatVec3(B, z, r);
+    for (PetscInt k = 0; k < 3; k++) ya[3 * l + k] = a * z[k] + r[k];
+  }
+  PetscCall(VecRestoreArray(y, &ya));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatMult_Avv(Mat A, Vec x, Vec y)
+{
+  PhlexFlexible b;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &b));
+  PetscCall(NodeMassMult(b, b->shift, b->Bvv, x, y));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatMult_Avu(Mat A, Vec x, Vec y)
+{
+  PhlexFlexible b;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &b));
+  PetscCall(NodeMassMult(b, 0.0, b->Bvu, x, y));
+  PetscFunctionReturn(0);
+}
+
+/* the matrices of the field blocks, built at the first request (a modal analysis never needs them) */
+static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *ops)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  if (!b->Sv) {
+    MatNullSpace   nsp;
+    const PetscInt n = b->nv_local, N = b->nv_global;
+    PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
+    PetscCall(MatTranspose(b->G, MAT_INITIAL_MATRIX, &b->Gt));
+    PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv */
+    PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
+    PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
+    PetscCall(MatAXPY(b->Sv, 1.0, b->Mvaij, DIFFERENT_NONZERO_PATTERN));
+    PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_TRUE));
+    PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
+    PetscCall(MatSetNearNullSpace(b->Sv, nsp));
+    PetscCall(MatNullSpaceDestroy(&nsp));
+    PetscCall(PetscObjectSetName((PetscObject)b->Sv, "condensed velocity operator"));
+    if (!b->floating) {
+      PetscCall(MatDuplicate(b->Mvaij, MAT_COPY_VALUES, &b->Jvv));
+    } else {
+      PetscCall(MatCreateShell(b->comm, n, n, N, N, b, &b->Jvv));
+      PetscCall(MatShellSetOperation(b->Jvv, MATOP_MULT, (void (*)(void))MatMult_Avv));
+      PetscCall(MatCreateShell(b->comm, n, n, N, N, b, &b->Jvu));
+      PetscCall(MatShellSetOperation(b->Jvu, MATOP_MULT, (void (*)(void))MatMult_Avu));
+      PetscCall(VecDuplicate(b->load, &b->ud));
+      PetscCall(VecDuplicate(b->load, &b->vd));
+      PetscCall(PetscCalloc4(PetscMax(n * part->nq, 1), &b->Bc, PetscMax(n * part->nq, 1), &b->Cu, PetscMax(n * part->nq, 1), &b->Cv, PetscMax(n * part->nq, 1), &b->Cpre));
+    }
+  }
+  ops->G         = b->G;
+  ops->Gt        = b->Gt;
+  ops->Ms        = b->Ms;
+  ops->stress_bs = b->nb_s;
+  ops->Jvv       = b->Jvv;
+  ops->Jvu       = b->Jvu;
+  ops->Sv        = b->Sv;
+  PetscFunctionReturn(0);
+}
+
+/* the derivatives of the inputs with directions fixed in the inertial frame with respect to R (own columns) */
+static PetscErrorCode InertialLoadsJacobian(PhlexPart part, PetscReal Arr[324])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  const PetscInt n = b->nv_local;
+
+  PetscFunctionBeginUser;
+  for (PetscInt q = 0; q < b->nports; q++) {
+    if (!b->ports[q].load.loaded || b->ports[q].load.frame != PHLEX_DIRECTION_INERTIAL) continue;
+    for (PetscInt k = 0; k < 9; k++) {
+      PetscReal          dw[6], fq[18] = {0};
+      const PetscScalar *da;
+      PetscCall(PhlexPortLoadDerivativeR(&b->ports[q].load, b->t_eval, part->units, k, dw));
+      /* F_v = ... - B w, F_q = ... - (F, M): the derivative enters with a minus sign */
+      for (PetscInt c = 0; c < 6; c++) {
+        if (dw[c] == 0.0) continue;
+        PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da));
+        for (PetscInt i = 0; i < n; i++) b->Bc[(3 + k) * n + i] -= dw[c] * PetscRealPart(da[i]);
+        PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da));
+      }
+      PetscCall(FlexPortForce(part, q, dw, NULL, fq));
+      for (PetscInt i = 12; i < 18; i++) Arr[18 * i + 3 + k] -= fq[i];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexPartVec *X, PetscReal *D, PetscInt ldD)
+{
+  PhlexFlexible  b = (PhlexFlexible)part->data;
+  const PetscInt n = b->nv_local, nq = part->nq;
+  PetscReal      Arr[324];
+
+  PetscFunctionBeginUser;
+  if (PetscAbsReal(shift - b->shift) > 1e-12 * shift) {
+    b->shift = shift;
+    if (!b->floating) {
+      PetscCall(MatCopy(b->Mvaij, b->Jvv, SAME_NONZERO_PATTERN));
+      PetscCall(MatScale(b->Jvv, shift));
+      PetscCall(MatAssemblyBegin(b->Jvv, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(b->Jvv, MAT_FINAL_ASSEMBLY));
+    }
+    /* the preconditioner's condensed operator shift Mv + K/shift */
+    PetscCall(MatCopy(b->Kaij, b->Sv, SUBSET_NONZERO_PATTERN));
+    PetscCall(MatScale(b->Sv, 1.0 / shift));
+    PetscCall(MatAXPY(b->Sv, shift, b->Mvaij, SUBSET_NONZERO_PATTERN));
+  }
+  if (!b->floating) PetscFunctionReturn(0);
+  PetscCall(PetscLogEventBegin(PHLEX_FloatJacobian, 0, 0, 0, 0));
+  PetscCall(AddJointLoads(part));
+  PetscCall(PhlexFrameJacobian(&b->frame, &b->fs, shift, X->u, X->v, b->Bc, b->Cu, b->Cv, n, b->Bvv, b->Bvu, Arr));
+  PetscCall(InertialLoadsJacobian(part, Arr));
+  if (b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
+    /* rows T^T v and the force -T mu': column c (translation) t(l) e_c, column a (rotation) e_a x w(l) */
+    const PetscScalar *ta, *wa;
+    PetscCall(VecGetArrayRead(b->tnode, &ta));
+    PetscCall(VecGetArrayRead(b->wnode, &wa));
+    for (PetscInt col = 18; col < 24; col++)
+      for (PetscInt i = 0; i < n; i++) b->Cu[col * n + i] = 0.0;
+    for (PetscInt l = 0; l < n / 3; l++) {
+      PetscReal wl[3];
+      for (PetscInt k = 0; k < 3; k++) wl[k] = PetscRealPart(wa[3 * l + k]);
+      for (PetscInt c = 0; c < 3; c++) {
+        PetscReal ec[3] = {0, 0, 0}, a[3];
+        ec[c] = 1.0;
+        for (PetscInt k = 0; k < 3; k++) b->Cv[(18 + c) * n + 3 * l + k] = k == c ? PetscRealPart(ta[3 * l]) : 0.0;
+        PhlexCross(ec, wl, a);
+        for (PetscInt k = 0; k < 3; k++) b->Cv[(21 + c) * n + 3 * l + k] = a[k];
+      }
+    }
+    for (PetscInt col = 18; col < 24; col++)
+      for (PetscInt i = 0; i < n; i++) b->Bc[col * n + i] = -shift * b->Cv[col * n + i];
+    PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+    PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  }
+  for (PetscInt i = 0; i < 18; i++)
+    for (PetscInt j = 0; j < 18; j++) D[ldD * i + j] = Arr[18 * i + j];
+  for (PetscInt i = 18; i < nq; i++)
+    for (PetscInt j = 0; j < nq; j++) D[ldD * i + j] = D[ldD * j + i] = 0.0;
+  /* the border of the preconditioner: rigid rows after eliminating u (u = v / shift) */
+  for (PetscInt i = 0; i < n * nq; i++) b->Cpre[i] = b->Cv[i] + b->Cu[i] / shift;
+  PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvv));
+  PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvu));
+  PetscCall(PetscLogEventEnd(PHLEX_FloatJacobian, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Borders between the field and the body's own discrete unknowns                                                 */
+
+static PetscErrorCode FlexBorderMult(PhlexPart part, const PetscReal *x, Vec y)
+{
+  PhlexFlexible  b = (PhlexFlexible)part->data;
+  const PetscInt n = b->nv_local;
+  PetscScalar   *ya;
+
+  PetscFunctionBeginUser;
+  if (!part->nq) PetscFunctionReturn(0);
+  PetscCall(VecGetArray(y, &ya));
+  for (PetscInt j = 0; j < part->nq; j++) {
+    if (x[j] == 0.0) continue;
+    for (PetscInt i = 0; i < n; i++) ya[i] += b->Bc[j * n + i] * x[j];
+  }
+  PetscCall(VecRestoreArray(y, &ya));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *y)
+{
+  PhlexFlexible      b = (PhlexFlexible)part->data;
+  const PetscInt     n = b->nv_local, nq = part->nq;
+  const PetscScalar *ua = NULL, *va = NULL;
+  PetscReal          loc[24], glob[24];
+
+  PetscFunctionBeginUser;
+  if (!nq) PetscFunctionReturn(0);
+  if (xu) PetscCall(VecGetArrayRead(xu, &ua));
+  if (xv) PetscCall(VecGetArrayRead(xv, &va));
+  for (PetscInt j = 0; j < nq; j++) {
+    PetscReal s = 0;
+    if (ua)
+      for (PetscInt i = 0; i < n; i++) s += au * b->Cu[j * n + i] * PetscRealPart(ua[i]);
+    if (va)
+      for (PetscInt i = 0; i < n; i++) s += b->Cv[j * n + i] * PetscRealPart(va[i]);
+    loc[j] = s;
+  }
+  if (xu) PetscCall(VecRestoreArrayRead(xu, &ua));
+  if (xv) PetscCall(VecRestoreArrayRead(xv, &va));
+  PetscCall(MPIU_Allreduce(loc, glob, nq, MPIU_REAL, MPI_SUM, b->comm));
+  for (PetscInt j = 0; j < nq; j++) y[j] += glob[j];
+  PetscFunctionReturn(0);
+}
+
+/* W: the state-independent span of the borders: the frame's 12 nodal fields t e_c and w_b e_c (floating; with frozen
+   inertia every frame border lies in their span, gravity too) and the force distributions of the ports with joints */
+static PetscErrorCode FlexBorderBasis(PhlexPart part, Mat *W)
+{
+  PhlexFlexible  b = (PhlexFlexible)part->data;
+  const PetscInt n = b->nv_local;
+  PetscInt       k = b->floating ? 12 : 0, ld;
+  PetscScalar   *Wa;
+
+  PetscFunctionBeginUser;
+  if (!b->W) {
+    for (PetscInt q = 0; q < b->nports; q++)
+      if (part->port_used[q]) {
+        b->port_basis_col[q] = k;
+        k += 6;
+      }
+    b->kW = k;
+    if (k) {
+      PetscCall(MatCreateDense(b->comm, n, PETSC_DECIDE, PETSC_DETERMINE, k, NULL, &b->W));
+      PetscCall(MatDenseGetLDA(b->W, &ld));
+      PetscCall(MatDenseGetArrayWrite(b->W, &Wa));
+      for (PetscInt col = 0; col < k; col++)
+        for (PetscInt i = 0; i < n; i++) Wa[col * ld + i] = 0.0;
+      if (b->floating) {
+        const PetscScalar *ta, *wa;
+        PetscCall(VecGetArrayRead(b->tnode, &ta));
+        PetscCall(VecGetArrayRead(b->wnode, &wa));
+        for (PetscInt l = 0; l < n / 3; l++)
+          for (PetscInt c = 0; c < 3; c++) {
+            Wa[c * ld + 3 * l + c] = ta[3 * l + c];
+            for (PetscInt bb = 0; bb < 3; bb++) Wa[(3 + 3 * c + bb) * ld + 3 * l + c] = wa[3 * l + bb];
+          }
+        PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+        PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+      }
+      for (PetscInt q = 0; q < b->nports; q++) {
+        if (b->port_basis_col[q] < 0) continue;
+        for (PetscInt c = 0; c < 6; c++) {
+          const PetscScalar *da;
+          PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da));
+          for (PetscInt i = 0; i < n; i++) Wa[(b->port_basis_col[q] + c) * ld + i] = da[i];
+          PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da));
+        }
+      }
+      PetscCall(MatDenseRestoreArrayWrite(b->W, &Wa));
+      PetscCall(MatAssemblyBegin(b->W, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(b->W, MAT_FINAL_ASSEMBLY));
+      PetscCall(PetscObjectSetName((PetscObject)b->W, "border basis"));
+      if (b->floating) {
+        /* LU of the Gram matrix W^T W, for the projection of the body's own borders */
+        const PetscScalar *Wr;
+        PetscScalar       *loc;
+        PetscBLASInt       kb, info;
+        PetscCall(PetscMalloc2(k * k, &b->gram, k, &b->gram_piv));
+        PetscCall(PetscCalloc1(k * k, &loc));
+        PetscCall(MatDenseGetArrayRead(b->W, &Wr));
+        for (PetscInt i = 0; i < k; i++)
+          for (PetscInt j = 0; j < k; j++)
+            for (PetscInt r = 0; r < n; r++) loc[i + k * j] += Wr[i * ld + r] * Wr[j * ld + r];
+        PetscCall(MatDenseRestoreArrayRead(b->W, &Wr));
+        PetscCall(MPIU_Allreduce(loc, b->gram, k * k, MPIU_SCALAR, MPIU_SUM, b->comm));
+        PetscCall(PetscFree(loc));
+        PetscCall(PetscBLASIntCast(k, &kb));
+        PetscCallBLAS("LAPACKgetrf", LAPACKgetrf_(&kb, &kb, b->gram, &kb, b->gram_piv, &info));
+        PetscCheck(!info, b->comm, PETSC_ERR_PLIB, "body %s: the border basis is rank deficient (LAPACK getrf info %d): two ports with joints share their surface?", b->name, (int)info);
+      }
+    }
+  }
+  *W = b->W;
+  PetscFunctionReturn(0);
+}
+
+/* (Cv + Cu/shift)^T Y for the body's own rows: nq x k, column-major */
+static PetscErrorCode FlexBorderRows(PhlexPart part, Mat Y, PetscReal *out, PetscInt ld)
+{
+  PhlexFlexible      b = (PhlexFlexible)part->data;
+  const PetscInt     n = b->nv_local, nq = part->nq;
+  const PetscScalar *Ya;
+  PetscInt           k, ldy;
+  PetscReal         *loc, *glob;
+
+  PetscFunctionBeginUser;
+  if (!nq) PetscFunctionReturn(0);
+  PetscCall(MatGetSize(Y, NULL, &k));
+  PetscCall(MatDenseGetLDA(Y, &ldy));
+  PetscCall(PetscCalloc2(nq * k, &loc, nq * k, &glob));
+  PetscCall(MatDenseGetArrayRead(Y, &Ya));
+  for (PetscInt j = 0; j < k; j++)
+    for (PetscInt i = 0; i < nq; i++) {
+      PetscReal s = 0;
+      for (PetscInt r = 0; r < n; r++) s += b->Cpre[i * n + r] * PetscRealPart(Ya[j * ldy + r]);
+      loc[i + nq * j] = s;
+    }
+  PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
+  PetscCall(MPIU_Allreduce(loc, glob, nq * k, MPIU_REAL, MPI_SUM, b->comm));
+  for (PetscInt j = 0; j < k; j++)
+    for (PetscInt i = 0; i < nq; i++) out[i + ld * j] = glob[i + nq * j];
+  PetscCall(PetscFree2(loc, glob));
+  PetscFunctionReturn(0);
+}
+
+/* beta with the body's own border columns ~ W beta: (W^T W)^{-1} W^T Bc, k x nq column-major (exact for frozen
+   inertia; otherwise the projection used by the preconditioner) */
+static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, PetscInt ld)
+{
+  PhlexFlexible      b = (PhlexFlexible)part->data;
+  const PetscInt     n = b->nv_local, nq = part->nq, k = b->kW;
+  const PetscScalar *Wa;
+  PetscInt           ldw;
+  PetscScalar       *loc, *glob;
+  PetscBLASInt       kb, nrhs, info;
+
+  PetscFunctionBeginUser;
+  if (!nq || !k) PetscFunctionReturn(0);
+  PetscCall(MatDenseGetLDA(b->W, &ldw));
+  PetscCall(PetscCalloc2(k * nq, &loc, k * nq, &glob));
+  PetscCall(MatDenseGetArrayRead(b->W, &Wa));
+  for (PetscInt j = 0; j < nq; j++)
+    for (PetscInt i = 0; i < k; i++) {
+      PetscScalar s = 0;
+      for (PetscInt r = 0; r < n; r++) s += Wa[i * ldw + r] * b->Bc[j * n + r];
+      loc[i + k * j] = s;
+    }
+  PetscCall(MatDenseRestoreArrayRead(b->W, &Wa));
+  PetscCall(MPIU_Allreduce(loc, glob, k * nq, MPIU_SCALAR, MPIU_SUM, b->comm));
+  PetscCall(PetscBLASIntCast(k, &kb));
+  PetscCall(PetscBLASIntCast(nq, &nrhs));
+  PetscCallBLAS("LAPACKgetrs", LAPACKgetrs_("N", &kb, &nrhs, b->gram, &kb, b->gram_piv, glob, &kb, &info));
+  for (PetscInt j = 0; j < nq; j++)
+    for (PetscInt i = 0; i < k; i++) beta[i + ld * j] = PetscRealPart(glob[i + k * j]);
+  PetscCall(PetscFree2(loc, glob));
+  PetscFunctionReturn(0);
+}
+
+PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
+{
+  PetscFunctionBeginUser;
+  part->ops.evaluate            = FlexEvaluate;
+  part->ops.residual            = FlexResidual;
+  part->ops.jacobian            = FlexJacobian;
+  part->ops.poststep            = FlexPostStep;
+  part->ops.fieldoperators      = FlexFieldOperators;
+  part->ops.bordermult          = FlexBorderMult;
+  part->ops.bordermulttranspose = FlexBorderMultTranspose;
+  part->ops.borderbasis         = FlexBorderBasis;
+  part->ops.borderrows          = FlexBorderRows;
+  part->ops.bordercoefficients  = FlexBorderCoefficients;
+  part->ops.portoutput          = FlexPortOutput;
+  part->ops.portlinear          = FlexPortLinear;
+  part->ops.portlinearblock     = FlexPortLinearBlock;
+  part->ops.portforce           = FlexPortForce;
+  part->ops.portbasiscolumn     = FlexPortBasisColumn;
+  part->ops.portplacement       = FlexPortPlacement;
+  PetscFunctionReturn(0);
+}

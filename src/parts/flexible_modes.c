@@ -1,0 +1,502 @@
+/* Modal analysis of one flexible body with SLEPc: the symmetric-definite pencil (K, Mv) of the velocity after exact
+   stress elimination (K = G^T Ms^{-1} G element by element), shift-and-invert, EPS options under the prefix modes_.
+   A floating body is solved on the pencil of its linearisation at rest (the kinetic energy of v_P + w x x + v):
+   with a frame patch directly; with mean axes as a constrained pencil (a saddle point shift-and-invert). */
+#include <phlex_impl.h>
+
+/* Modal analysis with SLEPc: the symmetric-definite pencil (K, Mv) of the velocity after exact stress elimination
+   (K = G^T Ms^{-1} G element by element), shift-and-invert, EPS options under the prefix modes_. */
+#include <phlex_impl.h>
+
+/* Lowest free-free bending frequency of a beam with the body's bounding box (non-dimensional, rad per unit time):
+   a scale for the shift of free bodies and for telling rigid modes from elastic ones. */
+static PetscReal FrequencyScale(PhlexFlexible b, const PhlexUnits *u)
+{
+  PetscReal L = 0, t = PETSC_MAX_REAL, c = PETSC_MAX_REAL;
+
+  for (PetscInt d = 0; d < 3; d++) {
+    L = PetscMax(L, b->bbox_max[d] - b->bbox_min[d]);
+    t = PetscMin(t, b->bbox_max[d] - b->bbox_min[d]);
+  }
+  for (PetscInt m = 0; m < b->nmaterials; m++) c = PetscMin(c, PetscSqrtReal(b->materials[m].youngs_modulus / b->materials[m].density));
+  /* (4.730)^2 t / (sqrt(12) L^2) c, in units of 1/T */
+  return 22.373 * t / (PetscSqrtReal(12.0) * L * L) * c * u->time;
+}
+
+/* The pencil of a floating body linearised at rest (paper: the mass operator of eq. momenta at u_f = 0, w = 0):
+   unknowns [v | v_P, w_P] (the six rigid ones on rank 0),
+     A = [[K, 0], [0, 0]],   B = [[Mv, Bm], [Bm^T, M6]],   M6 = [[m I, -[s0]x], [[s0]x, J0]],
+   Bm = [t e_c | e_a x w] (nodal t = int rho phi, w = int rho x phi): the kinetic energy of v_P + w x x + v. The
+   rigid unknowns make six zero eigenvalues; the others are the free-free modes with the frame patch moving
+   rigidly. Assembled as AIJ (six dense rows and columns) so that any shift and factorisation apply. */
+static PetscErrorCode FloatingPencil(PhlexFlexible b, Mat *A, Mat *B, IS is[2])
+{
+  MPI_Comm           comm = b->comm;
+  PetscMPIInt        rank;
+  PetscInt           n = b->nv_local, q, ld;
+  Mat                blocks[4], Kaij, Maij, Bm, BmT, M6, Z6, N;
+  const PetscScalar *ta, *wa;
+  PetscScalar       *ba;
+  const PhlexInertia *in = &b->inertia;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  q = rank == 0 ? 6 : 0;
+  PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &Kaij));
+  PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &Maij));
+  PetscCall(MatCreateDense(comm, n, q, PETSC_DETERMINE, 6, NULL, &Bm));
+  PetscCall(MatDenseGetLDA(Bm, &ld));
+  PetscCall(MatDenseGetArrayWrite(Bm, &ba));
+  PetscCall(VecGetArrayRead(b->tnode, &ta));
+  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  for (PetscInt l = 0; l < n / 3; l++) {
+    const PetscReal *w = (const PetscReal *)&wa[3 * l]; /* real build */
+    for (PetscInt c = 0; c < 3; c++) {
+      for (PetscInt j = 0; j < 3; j++) ba[j * ld + 3 * l + c] = c == j ? ta[3 * l + c] : 0.0;
+      /* (e_a x w)_c */
+      ba[3 * ld + 3 * l + c] = c == 0 ? 0.0 : (c == 1 ? -w[2] : w[1]);
+      ba[4 * ld + 3 * l + c] = c == 0 ? w[2] : (c == 1 ? 0.0 : -w[0]);
+      ba[5 * ld + 3 * l + c] = c == 0 ? -w[1] : (c == 1 ? w[0] : 0.0);
+    }
+  }
+  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(MatDenseRestoreArrayWrite(Bm, &ba));
+  PetscCall(MatAssemblyBegin(Bm, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Bm, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatTranspose(Bm, MAT_INITIAL_MATRIX, &BmT));
+  PetscCall(MatCreateAIJ(comm, q, q, 6, 6, 6, NULL, 0, NULL, &M6));
+  PetscCall(MatCreateAIJ(comm, q, q, 6, 6, 0, NULL, 0, NULL, &Z6));
+  if (rank == 0) {
+    PetscReal m6[36], S[9], J[9];
+    PetscInt  idx[6] = {0, 1, 2, 3, 4, 5};
+    const PetscReal tr = in->E0[0] + in->E0[4] + in->E0[8];
+    PhlexSkew(in->s0, S);
+    for (PetscInt k = 0; k < 9; k++) J[k] = (k % 4 == 0 ? tr : 0.0) - in->E0[k];
+    for (PetscInt i = 0; i < 3; i++)
+      for (PetscInt j = 0; j < 3; j++) {
+        m6[6 * i + j]           = i == j ? in->m : 0.0;
+        m6[6 * i + 3 + j]       = -S[3 * i + j];
+        m6[6 * (3 + i) + j]     = S[3 * i + j];
+        m6[6 * (3 + i) + 3 + j] = J[3 * i + j];
+      }
+    PetscCall(MatSetValues(M6, 6, idx, 6, idx, m6, INSERT_VALUES));
+  }
+  PetscCall(MatAssemblyBegin(M6, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(M6, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(Z6, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Z6, MAT_FINAL_ASSEMBLY));
+  blocks[0] = Kaij, blocks[1] = NULL, blocks[2] = NULL, blocks[3] = Z6;
+  PetscCall(MatCreateNest(comm, 2, NULL, 2, NULL, blocks, &N));
+  PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, A));
+  PetscCall(MatNestGetISs(N, is, NULL));
+  PetscCall(PetscObjectReference((PetscObject)is[0]));
+  PetscCall(PetscObjectReference((PetscObject)is[1]));
+  PetscCall(MatDestroy(&N));
+  blocks[0] = Maij, blocks[1] = Bm, blocks[2] = BmT, blocks[3] = M6;
+  PetscCall(MatCreateNest(comm, 2, NULL, 2, NULL, blocks, &N));
+  PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, B));
+  PetscCall(MatDestroy(&N));
+  PetscCall(MatSetOption(*A, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatSetOption(*B, MAT_SPD, PETSC_TRUE));
+  PetscCall(MatDestroy(&Kaij));
+  PetscCall(MatDestroy(&Maij));
+  PetscCall(MatDestroy(&Bm));
+  PetscCall(MatDestroy(&BmT));
+  PetscCall(MatDestroy(&M6));
+  PetscCall(MatDestroy(&Z6));
+  PetscFunctionReturn(0);
+}
+
+/* Mean axes: the constraint T^T v = 0 (T = Bm: int rho v = 0, int rho (x - P) x v = 0) removes the rigid motion of
+   the elastic field, which the frame carries (without it B is singular: the field's rigid modes and the frame's
+   motion are the same velocities). The eigenproblem A x = lambda B x on {C^T x = 0}, C = [T; 0], is solved by
+   shift-and-invert on the saddle point: OP x = y with [[A - sigma B, C], [C^T, 0]] [y; mu] = [B x; 0], whose
+   range is the constraint space (STSHELL; the saddle matrix is factored once, LU). */
+typedef struct {
+  KSP       ksp;            /* the saddle matrix */
+  Mat       B;              /* [v | q] kinetic matrix */
+  IS        isx[2], isk[3]; /* blocks of the [v | q] and [v | q | mu] layouts */
+  Vec       Bx, rhs, sol;
+  PetscReal sigma;
+} MeanAxesST;
+
+static PetscErrorCode MeanAxesApply(ST st, Vec x, Vec y)
+{
+  MeanAxesST *c;
+  Vec         a, b;
+
+  PetscFunctionBeginUser;
+  PetscCall(STShellGetContext(st, &c));
+  PetscCall(MatMult(c->B, x, c->Bx));
+  PetscCall(VecSet(c->rhs, 0.0));
+  for (PetscInt k = 0; k < 2; k++) {
+    PetscCall(VecGetSubVector(c->Bx, c->isx[k], &a));
+    PetscCall(VecGetSubVector(c->rhs, c->isk[k], &b));
+    PetscCall(VecCopy(a, b));
+    PetscCall(VecRestoreSubVector(c->Bx, c->isx[k], &a));
+    PetscCall(VecRestoreSubVector(c->rhs, c->isk[k], &b));
+  }
+  PetscCall(KSPSolve(c->ksp, c->rhs, c->sol));
+  for (PetscInt k = 0; k < 2; k++) {
+    PetscCall(VecGetSubVector(y, c->isx[k], &a));
+    PetscCall(VecGetSubVector(c->sol, c->isk[k], &b));
+    PetscCall(VecCopy(b, a));
+    PetscCall(VecRestoreSubVector(y, c->isx[k], &a));
+    PetscCall(VecRestoreSubVector(c->sol, c->isk[k], &b));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MeanAxesBackTransform(ST st, PetscInt n, PetscScalar *eigr, PetscScalar *eigi)
+{
+  MeanAxesST *c;
+
+  PetscFunctionBeginUser;
+  PetscCall(STShellGetContext(st, &c));
+  for (PetscInt i = 0; i < n; i++) eigr[i] = c->sigma + 1.0 / eigr[i];
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MeanAxesSetUp(PhlexFlexible b, Mat A, Mat B, IS is[2], PetscReal sigma, MeanAxesST *c)
+{
+  MPI_Comm    comm = b->comm;
+  PetscMPIInt rank;
+  Mat         S, C, Z6, N, blocks[4];
+  PetscInt    m, q, ld;
+  PetscScalar *ca;
+  const PetscScalar *ta, *wa;
+  PC          pc;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  q = rank == 0 ? 6 : 0;
+  c->sigma = sigma;
+  c->B     = B;
+  c->isx[0] = is[0];
+  c->isx[1] = is[1];
+  /* A - sigma B */
+  PetscCall(MatDuplicate(A, MAT_COPY_VALUES, &S));
+  PetscCall(MatAXPY(S, -sigma, B, DIFFERENT_NONZERO_PATTERN));
+  /* C = [T; 0]: the columns t e_c and e_a x w on the velocity rows */
+  PetscCall(MatGetLocalSize(A, &m, NULL));
+  PetscCall(MatCreateDense(comm, m, q, PETSC_DETERMINE, 6, NULL, &C));
+  PetscCall(MatDenseGetLDA(C, &ld));
+  PetscCall(MatDenseGetArrayWrite(C, &ca));
+  for (PetscInt j = 0; j < 6; j++)
+    for (PetscInt i = 0; i < m; i++) ca[j * ld + i] = 0.0;
+  PetscCall(VecGetArrayRead(b->tnode, &ta));
+  PetscCall(VecGetArrayRead(b->wnode, &wa));
+  {
+    PetscInt rstart, vstart;
+    PetscCall(MatGetOwnershipRange(A, &rstart, NULL));
+    PetscCall(ISGetMinMax(is[0], &vstart, NULL));
+    (void)vstart;
+    /* the velocity rows come first on every rank in the [v | q] layout of FloatingPencil */
+    for (PetscInt l = 0; l < b->nv_local / 3; l++) {
+      const PetscReal w[3] = {PetscRealPart(wa[3 * l]), PetscRealPart(wa[3 * l + 1]), PetscRealPart(wa[3 * l + 2])};
+      for (PetscInt cc = 0; cc < 3; cc++) {
+        PetscReal e[3] = {0, 0, 0}, a[3];
+        e[cc]                       = 1.0;
+        ca[cc * ld + 3 * l + cc]     = ta[3 * l];
+        PhlexCross(e, w, a);
+        for (PetscInt k = 0; k < 3; k++) ca[(3 + cc) * ld + 3 * l + k] = a[k];
+      }
+    }
+  }
+  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
+  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+  PetscCall(MatDenseRestoreArrayWrite(C, &ca));
+  PetscCall(MatAssemblyBegin(C, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(C, MAT_FINAL_ASSEMBLY));
+  {
+    Mat Ct;
+    PetscCall(MatTranspose(C, MAT_INITIAL_MATRIX, &Ct));
+    PetscCall(MatCreateAIJ(comm, q, q, 6, 6, 0, NULL, 0, NULL, &Z6));
+    PetscCall(MatAssemblyBegin(Z6, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(Z6, MAT_FINAL_ASSEMBLY));
+    blocks[0] = S, blocks[1] = C, blocks[2] = Ct, blocks[3] = Z6;
+    PetscCall(MatCreateNest(comm, 2, NULL, 2, NULL, blocks, &N));
+    PetscCall(MatDestroy(&Ct));
+  }
+  {
+    Mat K;
+    IS  isn[2];
+    PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &K));
+    PetscCall(MatNestGetISs(N, isn, NULL));
+    /* the saddle layout [v | q | mu]: [v | q] is the nest's first block */
+    {
+      const PetscInt *idx;
+      PetscInt        n0, n1, off0 = 0, off1 = 0, kstart;
+      PetscCall(MatGetOwnershipRange(K, &kstart, NULL));
+      PetscCall(ISGetLocalSize(is[0], &n0));
+      PetscCall(ISGetLocalSize(is[1], &n1));
+      PetscCall(ISGetIndices(isn[0], &idx));
+      (void)idx;
+      PetscCall(ISRestoreIndices(isn[0], &idx));
+      off0 = kstart;
+      off1 = kstart + n0;
+      PetscCall(ISCreateStride(comm, n0, off0, 1, &c->isk[0]));
+      PetscCall(ISCreateStride(comm, n1, off1, 1, &c->isk[1]));
+      PetscCall(ISCreateStride(comm, q, off1 + n1, 1, &c->isk[2]));
+    }
+    PetscCall(KSPCreate(comm, &c->ksp));
+    PetscCall(KSPSetOptionsPrefix(c->ksp, "modes_saddle_"));
+    PetscCall(KSPSetOperators(c->ksp, K, K));
+    PetscCall(KSPSetType(c->ksp, KSPPREONLY));
+    PetscCall(KSPGetPC(c->ksp, &pc));
+    PetscCall(PCSetType(pc, PCLU));
+    if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    PetscCall(KSPSetFromOptions(c->ksp));
+    PetscCall(KSPSetUp(c->ksp));
+    PetscCall(MatCreateVecs(K, &c->rhs, &c->sol));
+    PetscCall(MatCreateVecs(B, &c->Bx, NULL));
+    PetscCall(MatDestroy(&K));
+  }
+  PetscCall(MatDestroy(&N));
+  PetscCall(MatDestroy(&S));
+  PetscCall(MatDestroy(&C));
+  PetscCall(MatDestroy(&Z6));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MeanAxesDestroy(MeanAxesST *c)
+{
+  PetscFunctionBeginUser;
+  PetscCall(KSPDestroy(&c->ksp));
+  PetscCall(VecDestroy(&c->Bx));
+  PetscCall(VecDestroy(&c->rhs));
+  PetscCall(VecDestroy(&c->sol));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(ISDestroy(&c->isk[k]));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleComputeModes - lowest eigenpairs of K x = lambda Mv x of a flexible body (non-dimensional lambda = omega^2)
+
+  Collective
+
+  Input Parameters:
++ part  - the body
+- nev   - number of elastic modes wanted (the six rigid modes of a free body come on top)
+
+  Output Parameters:
++ nconv  - number of eigenpairs returned
+. nrigid - how many of them are rigid-body modes (|lambda| below 1e-6 of the elastic frequency scale squared)
+. lambda - eigenvalues (ascending)
+. vecs   - eigenvectors (Mv-normalised; the elastic part of a floating body's), may be NULL
+. rigid  - floating body: the rigid part (v_P, w_P) of each eigenvector, 6 per mode, on every rank; may be NULL
+- resid  - relative residual norms ||K x - lambda Mv x|| / (|lambda| ||x||) (rigid modes: the backward error
+           ||K x - lambda Mv x|| / ((||K|| + |lambda| ||Mv||) ||x||)), may be NULL
+
+  Notes:
+  A floating body is solved on the pencil of its linearisation at rest (FloatingPencil): six rigid modes, then the
+  free-free modes; with mean axes on the constrained pencil (MeanAxesSetUp), whose elastic modes are those of the
+  unconstrained free body.
+
+  Options Database Keys:
++ -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)
+. -modes_target_frequency <Hz>    - look for modes nearest this frequency (default: lowest)
+- -modes_eps_*, -modes_st_*       - any SLEPc EPS/ST option; defaults: Krylov-Schur, shift-and-invert, Cholesky (MUMPS)
+@*/
+PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
+{
+  PhlexFlexible     b     = (PhlexFlexible)part->data;
+  const PhlexUnits *units = part->units;
+  MeanAxesST        ma;
+  PetscBool         mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
+  EPS       eps;
+  ST        st;
+  KSP       ksp;
+  PC        pc;
+  PetscReal omega = FrequencyScale(b, units), sigma, ftarget = -1;
+  PetscBool free_body = (!b->frame_patch[0] || b->floating) ? PETSC_TRUE : PETSC_FALSE, flg;
+  PetscInt  n, want;
+  Mat       A = b->K, B = b->Mv;
+  IS        is[2] = {NULL, NULL};
+  Vec       x = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&ma, sizeof(ma)));
+  PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
+  want  = nev + (free_body ? 6 : 0);
+  sigma = free_body ? -PetscSqr(1e-2 * omega) : 0.0;
+  PetscCall(PetscOptionsGetReal(NULL, "modes_", "-target_frequency", &ftarget, &flg));
+  if (flg) {
+    PetscCheck(ftarget >= 0, b->comm, PETSC_ERR_USER_INPUT, "-modes_target_frequency must be >= 0 Hz, got %g", (double)ftarget);
+    sigma = PetscSqr(2.0 * PETSC_PI * ftarget * units->time);
+    if (sigma == 0 && free_body) sigma = -PetscSqr(1e-2 * omega);
+  }
+  PetscCall(EPSCreate(b->comm, &eps));
+  PetscCall(EPSSetOptionsPrefix(eps, "modes_"));
+  if (b->floating) PetscCall(FloatingPencil(b, &A, &B, is));
+  PetscCall(EPSSetOperators(eps, A, B));
+  PetscCall(EPSSetProblemType(eps, EPS_GHEP));
+  PetscCall(EPSSetType(eps, EPSKRYLOVSCHUR));
+  PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+  PetscCall(EPSSetTarget(eps, sigma));
+  PetscCall(EPSSetTolerances(eps, 1e-12, PETSC_DEFAULT));
+  /* B (the velocity mass, or the body's whole kinetic-energy matrix when floating) is positive definite, so the
+     shift-and-invert eigenvectors carry no null-space component to purify; purification costs one more solve per
+     eigenvector (a fifth of the run at 2.2e5 dofs, BENCHMARKS.md) and changed no digit. -modes_eps_purify 1 restores it. */
+  PetscCall(EPSSetPurify(eps, PETSC_FALSE));
+  PetscCall(EPSGetST(eps, &st));
+  if (mean_axes) {
+    /* the saddle-point shift-and-invert of the constrained pencil; B is singular off the constraint space, and
+       purification keeps the eigenvectors in it */
+    PetscCall(MeanAxesSetUp(b, A, B, is, sigma, &ma));
+    PetscCall(STSetType(st, STSHELL));
+    PetscCall(STShellSetContext(st, &ma));
+    PetscCall(STShellSetApply(st, MeanAxesApply));
+    PetscCall(STShellSetBackTransform(st, MeanAxesBackTransform));
+    PetscCall(EPSSetWhichEigenpairs(eps, EPS_LARGEST_MAGNITUDE));
+    PetscCall(EPSSetPurify(eps, PETSC_TRUE));
+  } else {
+    PetscCall(STSetType(st, STSINVERT));
+    PetscCall(STGetKSP(st, &ksp));
+    PetscCall(KSPSetType(ksp, KSPPREONLY));
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PCSetType(pc, PCCHOLESKY));
+    if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  }
+  PetscCall(EPSSetFromOptions(eps));
+  PetscCall(EPSSolve(eps));
+  PetscCall(EPSGetDimensions(eps, &want, NULL, NULL));
+  PetscCall(EPSGetConverged(eps, &n));
+  n = PetscMin(n, want);
+  PetscCall(PetscMalloc1(n, lambda));
+  if (resid) PetscCall(PetscMalloc1(n, resid));
+  if (vecs) PetscCall(PetscMalloc1(n, vecs));
+  if (rigid) PetscCall(PetscCalloc1(6 * n, rigid));
+  PetscCall(MatCreateVecs(A, &x, NULL));
+  *nrigid = 0;
+  for (PetscInt i = 0; i < n; i++) {
+    PetscScalar kr, ki;
+    PetscCall(EPSGetEigenpair(eps, i, &kr, &ki, x, NULL));
+    (*lambda)[i] = PetscRealPart(kr);
+    if (PetscAbsReal((*lambda)[i]) < 1e-6 * omega * omega) {
+      (*nrigid)++;
+      /* lambda ~ 0: the relative residual divides by |lambda|; report the backward error instead */
+      if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_BACKWARD, &(*resid)[i]));
+    } else if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_RELATIVE, &(*resid)[i]));
+    if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
+    if (!b->floating) {
+      if (vecs) PetscCall(VecCopy(x, (*vecs)[i]));
+    } else {
+      Vec                xv, xq;
+      const PetscScalar *qa;
+      PetscReal          q6[6] = {0, 0, 0, 0, 0, 0};
+      PetscInt           nq;
+      PetscCall(VecGetSubVector(x, is[0], &xv));
+      if (vecs) PetscCall(VecCopy(xv, (*vecs)[i]));
+      PetscCall(VecRestoreSubVector(x, is[0], &xv));
+      PetscCall(VecGetSubVector(x, is[1], &xq));
+      PetscCall(VecGetLocalSize(xq, &nq));
+      PetscCall(VecGetArrayRead(xq, &qa));
+      for (PetscInt k = 0; k < nq; k++) q6[k] = PetscRealPart(qa[k]);
+      PetscCall(VecRestoreArrayRead(xq, &qa));
+      PetscCall(VecRestoreSubVector(x, is[1], &xq));
+      PetscCallMPI(MPI_Bcast(q6, 6, MPIU_REAL, 0, b->comm));
+      if (rigid) PetscCall(PetscArraycpy(&(*rigid)[6 * i], q6, 6));
+    }
+  }
+  PetscCall(VecDestroy(&x));
+  if (b->floating) {
+    PetscCall(MatDestroy(&A));
+    PetscCall(MatDestroy(&B));
+    PetscCall(ISDestroy(&is[0]));
+    PetscCall(ISDestroy(&is[1]));
+  }
+  *nconv = n;
+  PetscCall(EPSDestroy(&eps));
+  if (mean_axes) PetscCall(MeanAxesDestroy(&ma));
+  PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleModesOutput - writes the mode shapes of a flexible body to <name>_modes.h5/.xmf (normalised to 1; a
+  floating body's include the rigid part v_P + w x (x - P), so that the frame patch moves rigidly)
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleModesOutput(PhlexPart part, PhlexOutput out, PetscInt nconv, PetscInt nrigid, const PetscReal *lambda, Vec *vecs, const PetscReal *rigid)
+{
+  PhlexFlexible     b = (PhlexFlexible)part->data;
+  const PhlexUnits *un = part->units;
+  PhlexFieldWriter  fw;
+  char              name[PHLEX_NAME_LEN + 8];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(name, sizeof(name), "%s_modes", b->name));
+  PetscCall(PhlexFieldWriterCreate(out, b, name, &fw));
+  for (PetscInt i = 0; i < nconv; i++) {
+    PetscReal vmax, A[9] = {0}, r[3] = {0}, *Ap = NULL, *rp = NULL;
+    if (b->floating) {
+      /* the whole velocity field v_P + w x (x - P) + v */
+      const PetscReal *q = &rigid[6 * i];
+      PetscReal        wP[3];
+      PhlexSkew(&q[3], A);
+      for (PetscInt k = 0; k < 9; k++) A[k] /= un->length;
+      PhlexMatVec3(A, b->origin, wP);
+      for (PetscInt k = 0; k < 3; k++) r[k] = q[k] - wP[k];
+      Ap = A, rp = r;
+    }
+    PetscCall(PhlexFieldWriterVertexMax(fw, vecs[i], 1.0, Ap, rp, PETSC_FALSE, &vmax));
+    if (vmax > 0) {
+      for (PetscInt k = 0; k < 9; k++) A[k] /= vmax;
+      for (PetscInt k = 0; k < 3; k++) r[k] /= vmax;
+    }
+    PetscCall(PhlexFieldWriterBeginStep(fw, (PetscReal)(i + 1)));
+    PetscCall(PhlexFieldWriterVertexField(fw, "mode_shape", vecs[i], vmax > 0 ? 1.0 / vmax : 1.0, Ap, rp, PETSC_FALSE));
+  }
+  PetscCall(PhlexFieldWriterDestroy(&fw));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleRefine - the same body on a mesh refined 'level' more times (convergence studies)
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleRefine(PhlexPart part, PetscInt level, PhlexPart *fine)
+{
+  PhlexScaleHints h;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexPartCreate(part->comm, part->index, fine));
+  PetscCall(PhlexPartSetFromOptions(*fine));
+  ((PhlexFlexible)(*fine)->data)->extra_refinements = level;
+  (*fine)->units = part->units;
+  for (PetscInt k = 0; k < 3; k++) (*fine)->gravity[k] = part->gravity[k];
+  PetscCall((*(*fine)->ops.geometry)(*fine, &h));
+  PetscCall((*(*fine)->ops.setup)(*fine));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleModesOrder - "P<k> velocity; eigenvalue order expected <2k>" (convergence studies)
+@*/
+PetscErrorCode PhlexFlexibleModesOrder(PhlexPart part, char buf[], size_t len)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(buf, len, "P%" PetscInt_FMT " velocity; eigenvalue order expected %" PetscInt_FMT, b->degree, 2 * b->degree));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleModesKind - "floating", "clamped" or "free", and the number of rigid-body modes (6 for a free or
+  floating body, -1 for a clamped one: not counted)
+@*/
+PetscErrorCode PhlexFlexibleModesKind(PhlexPart part, char buf[], size_t len, PetscInt *nrigid)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(buf, b->floating ? "floating" : (b->frame_patch[0] ? "clamped" : "free"), len));
+  *nrigid = (b->frame_patch[0] && !b->floating) ? -1 : 6;
+  PetscFunctionReturn(0);
+}

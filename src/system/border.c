@@ -1,0 +1,328 @@
+/* The borders of the system's Jacobian between the field unknowns of the flexible bodies and the discrete unknowns
+   (rigid states, impulses): never one dense global block (DESIGN section 4), but per body its own dense border (its
+   frame) and the joints' port maps applied on the fly. Shells for the Jacobian, and the callbacks of PC
+   phlexbordered, which eliminates the fields body by body (one sparse solve each) and the discrete unknowns through
+   a small dense Schur complement. Also the preconditioning matrices of the field splits. */
+#include <phlex_impl.h>
+
+/* a part's block of a field vector (the velocity or displacement field numbering) */
+static PetscErrorCode FieldBlock(PhlexSystem sys, PhlexField f, PetscInt i, Vec x, Vec *xi)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecGetSubVector(x, sys->fis[f][i], xi));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FieldBlockRestore(PhlexSystem sys, PhlexField f, PetscInt i, Vec x, Vec *xi)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecRestoreSubVector(x, sys->fis[f][i], xi));
+  PetscFunctionReturn(0);
+}
+
+/* the discrete part of a vector of the discrete field, on every rank */
+static PetscErrorCode GatherQ(PhlexSystem sys, Vec x, PetscReal *q)
+{
+  const PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetArrayRead(x, &a));
+  for (PetscInt k = 0; k < sys->qlocal; k++) q[k] = PetscRealPart(a[k]);
+  PetscCall(VecRestoreArrayRead(x, &a));
+  PetscCallMPI(MPI_Bcast(q, (PetscMPIInt)sys->nq, MPIU_REAL, 0, sys->comm));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ScatterQ(PhlexSystem sys, const PetscReal *q, Vec y)
+{
+  PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetArrayWrite(y, &a));
+  for (PetscInt k = 0; k < sys->qlocal; k++) a[k] = q[k];
+  PetscCall(VecRestoreArrayWrite(y, &a));
+  PetscFunctionReturn(0);
+}
+
+/* y_V = B x_Q: each body's own border columns and the field forces of the joints on its ports */
+static PetscErrorCode MatMult_Bvq(Mat A, Vec x, Vec y)
+{
+  PhlexSystem sys;
+  PetscReal  *xq;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sys));
+  PetscCall(PetscMalloc1(PetscMax(sys->nq, 1), &xq));
+  PetscCall(GatherQ(sys, x, xq));
+  PetscCall(VecSet(y, 0.0));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexPart p = sys->fparts[i];
+    Vec       yi;
+    PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, y, &yi));
+    PetscCall((*p->ops.bordermult)(p, xq + p->qoff, yi));
+    for (PetscInt k = 0; k < sys->njoints; k++)
+      if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMult(sys->joints[k], sys->shift, xq, p, yi));
+    PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, y, &yi));
+  }
+  PetscCall(PetscFree(xq));
+  PetscFunctionReturn(0);
+}
+
+/* y_Q = a Cu^T x_U + Cv^T x_V (x_U or x_V NULL: zero): the discrete rows applied to field vectors */
+static PetscErrorCode BorderRowsApply(PhlexSystem sys, Vec xU, PetscReal au, Vec xV, Vec y)
+{
+  PetscReal *yq;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(PetscMax(sys->nq, 1), &yq));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexPart p  = sys->fparts[i];
+    Vec       ui = NULL, vi = NULL;
+    if (xU) PetscCall(FieldBlock(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui));
+    if (xV && xV != xU) PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi));
+    if (xV == xU) vi = ui;
+    PetscCall((*p->ops.bordermulttranspose)(p, ui, au, vi, yq + p->qoff));
+    for (PetscInt k = 0; k < sys->njoints; k++)
+      if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMultTranspose(sys->joints[k], p, ui, au, vi, yq));
+    if (xU) PetscCall(FieldBlockRestore(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui));
+    if (xV && xV != xU) PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi));
+  }
+  PetscCall(ScatterQ(sys, yq, y));
+  PetscCall(PetscFree(yq));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatMult_Cqu(Mat A, Vec x, Vec y)
+{
+  PhlexSystem sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sys));
+  PetscCall(BorderRowsApply(sys, x, 1.0, NULL, y));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode MatMult_Cqv(Mat A, Vec x, Vec y)
+{
+  PhlexSystem sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sys));
+  PetscCall(BorderRowsApply(sys, NULL, 0.0, x, y));
+  PetscFunctionReturn(0);
+}
+
+/* the discrete rows after eliminating the displacement (u = v / shift): Cv^T + Cu^T / shift */
+static PetscErrorCode MatMult_Cpre(Mat A, Vec x, Vec y)
+{
+  PhlexSystem sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &sys));
+  PetscCall(BorderRowsApply(sys, x, 1.0 / sys->shift, x, y));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode CreateShell(PhlexSystem sys, PetscInt m, PetscInt n, PetscInt M, PetscInt N, PetscErrorCode (*mult)(Mat, Vec, Vec), const char name[], Mat *A)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateShell(sys->comm, m, n, M, N, sys, A));
+  PetscCall(MatShellSetOperation(*A, MATOP_MULT, (void (*)(void))mult));
+  PetscCall(PetscObjectSetName((PetscObject)*A, name));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexBorderCreateShells - the border blocks of the Jacobian: [V, Q], [Q, U], [Q, V] (and the preconditioner's)
+
+  Collective
+@*/
+PetscErrorCode PhlexBorderCreateShells(PhlexSystem sys)
+{
+  PetscInt nv = 0, Nv = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    nv += sys->fparts[i]->nv;
+    Nv += sys->fparts[i]->Nv;
+  }
+  PetscCall(CreateShell(sys, nv, sys->qlocal, Nv, sys->nq, MatMult_Bvq, "border (velocity rows)", &sys->Bvq));
+  PetscCall(CreateShell(sys, sys->qlocal, nv, sys->nq, Nv, MatMult_Cqu, "border (displacement columns)", &sys->Cqu));
+  PetscCall(CreateShell(sys, sys->qlocal, nv, sys->nq, Nv, MatMult_Cqv, "border (velocity columns)", &sys->Cqv));
+  PetscCall(CreateShell(sys, sys->qlocal, nv, sys->nq, Nv, MatMult_Cpre, "border (condensed)", &sys->Cpre));
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* PC phlexbordered callbacks                                                                                    */
+
+/* C_i Y: every discrete row applied to the columns of Y (a field block of body i): m x k, column-major */
+static PetscErrorCode BorderRows(void *ctx, PetscInt i, Mat Y, PetscReal *out)
+{
+  PhlexSystem sys = (PhlexSystem)ctx;
+  PhlexPart   p   = sys->fparts[i];
+  PetscInt    k;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetSize(Y, NULL, &k));
+  for (PetscInt r = 0; r < sys->nq * k; r++) out[r] = 0.0;
+  PetscCall((*p->ops.borderrows)(p, Y, out + p->qoff, sys->nq));
+  for (PetscInt j = 0; j < sys->njoints; j++)
+    if (PhlexJointTouches(sys->joints[j], p)) PetscCall(PhlexJointBorderRows(sys->joints[j], p, Y, 1.0 / sys->shift, out, sys->nq));
+  PetscFunctionReturn(0);
+}
+
+/* beta_i: the coefficients of body i's border columns on its basis W_i (k x m, column-major) */
+static PetscErrorCode BorderCoefficients(void *ctx, PetscInt i, PetscReal *beta)
+{
+  PhlexSystem sys = (PhlexSystem)ctx;
+  PhlexPart   p   = sys->fparts[i];
+  PetscInt    k;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetSize(sys->border.W[i], NULL, &k));
+  for (PetscInt r = 0; r < sys->nq * k; r++) beta[r] = 0.0;
+  PetscCall((*p->ops.bordercoefficients)(p, beta + k * p->qoff, k));
+  for (PetscInt j = 0; j < sys->njoints; j++)
+    if (PhlexJointTouches(sys->joints[j], p)) PetscCall(PhlexJointBorderCoefficients(sys->joints[j], p, sys->shift, beta, k));
+  PetscFunctionReturn(0);
+}
+
+/* y += C_i x for a field vector x of body i (m values on every rank) */
+static PetscErrorCode BorderRowsVec(void *ctx, PetscInt i, Vec x, PetscReal *y)
+{
+  PhlexSystem sys = (PhlexSystem)ctx;
+  PhlexPart   p   = sys->fparts[i];
+
+  PetscFunctionBeginUser;
+  PetscCall((*p->ops.bordermulttranspose)(p, x, 1.0 / sys->shift, x, y + p->qoff));
+  for (PetscInt j = 0; j < sys->njoints; j++)
+    if (PhlexJointTouches(sys->joints[j], p)) PetscCall(PhlexJointBorderMultTranspose(sys->joints[j], p, x, 1.0 / sys->shift, x, y));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode BlockPrefix(void *ctx, PetscInt i, const char **name)
+{
+  PetscFunctionBeginUser;
+  *name = ((PhlexSystem)ctx)->fparts[i]->name;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemSetUpBorder - the data of PC phlexbordered: the sparse blocks (condensed velocity operators), their
+  border bases, the dense discrete block and the callbacks
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem sys)
+{
+  PhlexBorderedData *bd = &sys->border;
+  PetscInt           off = 0;
+
+  PetscFunctionBeginUser;
+  bd->nblocks = sys->nfparts;
+  bd->m       = sys->nq;
+  bd->D       = sys->D;
+  bd->ctx     = sys;
+  bd->rows         = BorderRows;
+  bd->coefficients = BorderCoefficients;
+  bd->rowsvec      = BorderRowsVec;
+  bd->blockprefix  = BlockPrefix;
+  PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &bd->A));
+  PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &bd->W));
+  PetscCall(PetscCalloc2(PetscMax(sys->nfparts, 1), &bd->off, PetscMax(sys->nfparts, 1), &bd->n));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexPart           p = sys->fparts[i];
+    PhlexFieldOperators ops;
+    PetscCall((*p->ops.fieldoperators)(p, &ops));
+    bd->A[i]   = ops.Sv;
+    bd->off[i] = off;
+    bd->n[i]   = p->nv;
+    off += p->nv;
+    PetscCall((*p->ops.borderbasis)(p, &bd->W[i]));
+  }
+  bd->qoff = off;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ComposeBorder(PhlexSystem sys, Mat P)
+{
+  PetscContainer c;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscContainerCreate(sys->comm, &c));
+  PetscCall(PetscContainerSetPointer(c, &sys->border));
+  PetscCall(PetscObjectCompose((PetscObject)P, "phlex_border", (PetscObject)c));
+  PetscCall(PetscContainerDestroy(&c));
+  PetscFunctionReturn(0);
+}
+
+/* the condensed velocity operators of all bodies: the body's own, or the block diagonal assembled */
+static PetscErrorCode VelocityPmat(PhlexSystem sys)
+{
+  Mat *m, N;
+
+  PetscFunctionBeginUser;
+  if (sys->Sv) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc1(sys->nfparts, &m));
+  for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = sys->border.A[i];
+  PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &N));
+  if (sys->nfparts == 1) sys->Sv = N;
+  else {
+    PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &sys->Sv));
+    PetscCall(MatDestroy(&N));
+  }
+  PetscCall(PetscFree(m));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemPmat - the preconditioning matrix of a set of fields, assembled when PCFIELDSPLIT asks for a split
+  (layout.c): {velocity}: the condensed velocity operators shift Mv + K/shift (the exact Schur complement of the
+  displacement and stress of a fixed body; of a floating one up to its node-wise inertial terms); {velocity,
+  discrete}: [[A, B], [C, D]] for PC phlexbordered, with its data composed; {stress, velocity}: the assembled
+  (Sigma, v) block of one body (LDL^T preset); {discrete} alone (no flexible body): the dense block
+@*/
+PetscErrorCode PhlexSystemPmat(void *ctx, PetscInt n, const PetscInt fields[], Mat *P)
+{
+  PhlexSystem sys = (PhlexSystem)ctx;
+  PhlexField  f[PHLEX_NUM_FIELDS];
+
+  PetscFunctionBeginUser;
+  *P = NULL;
+  PetscCheck(sys->shift > 0, sys->comm, PETSC_ERR_ORDER, "preconditioner requested before the Jacobian");
+  for (PetscInt k = 0; k < n; k++)
+    for (PetscInt g = 0; g < PHLEX_NUM_FIELDS; g++)
+      if (sys->field[g] == fields[k]) f[k] = (PhlexField)g;
+  if (n == 1 && f[0] == PHLEX_FIELD_VELOCITY) {
+    PetscCall(VelocityPmat(sys));
+    *P = sys->Sv;
+  } else if (n == 2 && f[0] == PHLEX_FIELD_VELOCITY && f[1] == PHLEX_FIELD_DISCRETE) {
+    if (!sys->Pvq) {
+      Mat blocks[4], *m;
+      PetscCall(PetscMalloc1(sys->nfparts, &m));
+      for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = sys->border.A[i];
+      PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Abd));
+      PetscCall(PetscFree(m));
+      blocks[0] = sys->Abd, blocks[1] = sys->Bvq, blocks[2] = sys->Cpre, blocks[3] = sys->Dq;
+      PetscCall(MatCreateNest(sys->comm, 2, NULL, 2, NULL, blocks, &sys->Pvq));
+      PetscCall(PetscObjectSetName((PetscObject)sys->Pvq, "condensed velocity-discrete operator"));
+      PetscCall(ComposeBorder(sys, sys->Pvq));
+    }
+    *P = sys->Pvq;
+  } else if (n == 1 && f[0] == PHLEX_FIELD_DISCRETE && !sys->nfparts) {
+    PetscCall(ComposeBorder(sys, sys->Dq));
+    *P = sys->Dq;
+  } else if (n == 2 && f[0] == PHLEX_FIELD_STRESS && f[1] == PHLEX_FIELD_VELOCITY && sys->nfparts == 1 && !sys->nq) {
+    if (!sys->Ssv) {
+      Mat blocks[4] = {sys->Jss, sys->Jsv, sys->Jvs, sys->Jvv}, N;
+      PetscCall(MatCreateNest(sys->comm, 2, NULL, 2, NULL, blocks, &N));
+      PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &sys->Ssv));
+      PetscCall(MatDestroy(&N));
+      PetscCall(MatSetOption(sys->Ssv, MAT_SYMMETRIC, PETSC_TRUE));
+      PetscCall(PetscObjectSetName((PetscObject)sys->Ssv, "stress-velocity operator"));
+    }
+    *P = sys->Ssv;
+  }
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,287 @@
+/* PC "phlexbordered": the preconditioner of the {velocity, discrete} block of a mechanism (DESIGN section 4: the
+   rigid unknowns and multipliers must not spoil the sparse solvers):
+
+       [ A_1          B_1 ] [x_1]   [f_1]      A_i  the condensed velocity operator of body i, factored by its own KSP
+       [      ...     ... ] [...] = [...]      B_i  body i's rows x the discrete columns (its frame, its joints)
+       [ C_1  ...     D   ] [ y ]   [ g ]      D    m x m dense (the discrete unknowns: frames, impulses)
+
+   Each border B_i is replaced by its projection on a state-independent basis W_i (the frame's nodal fields and the
+   force distributions of the ports with joints): B_i ~ W_i beta_i. Y_i = A_i^{-1} W_i is computed once per factorisation
+   (KSPMatSolve), so a new state costs only small dense products:
+
+       S  = D - sum_i (C_i Y_i) beta_i                                         (m x m, LU)
+       x0_i = A_i^{-1} f_i,  y = S^{-1} (g - sum_i C_i x0_i),  x_i = x0_i - Y_i (beta_i y)   (one solve per body)
+
+   This is the exact inverse when every border lies in its basis (frozen inertia: the joints' and the frames' forces);
+   with full inertia (u-dependent borders, node-wise gyroscopic terms) it preconditions an outer Krylov method.
+   The system composes what the PC needs on the preconditioning matrix ("phlex_border", system.h). Options of the
+   solves with A_i: -<prefix>bordered_ksp_type, -<prefix>bordered_pc_type, ... (default preonly + Cholesky), and
+   per body -<prefix>bordered_<body>_ksp_type ... */
+#include <phlex_impl.h>
+#include <petsc/private/pcimpl.h>
+
+typedef struct {
+  PhlexBorderedData *bd;
+  PetscInt           nb, m;
+  KSP               *ksp;    /* per block */
+  Mat               *Y;      /* per block: A_i^{-1} W_i */
+  PetscObjectState  *Astate, *Wstate;
+  PetscReal        **beta;   /* per block: k_i x m, column-major */
+  PetscScalar       *S;      /* LU of the Schur complement, m x m column-major */
+  PetscBLASInt      *S_piv;
+  IS                *is;     /* per block: its rows in the PC's vector */
+  PetscInt           nfactor;
+} PC_Bordered;
+
+static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
+{
+  PhlexBorderedData *bd = pb->bd;
+  const char        *prefix;
+  PetscInt           rstart;
+
+  PetscFunctionBeginUser;
+  pb->nb = bd->nblocks;
+  pb->m  = bd->m;
+  PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->ksp, PetscMax(pb->nb, 1), &pb->Y, PetscMax(pb->nb, 1), &pb->Astate, PetscMax(pb->nb, 1), &pb->Wstate, PetscMax(pb->nb, 1), &pb->beta));
+  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
+  PetscCall(PetscMalloc2(PetscMax(pb->m * pb->m, 1), &pb->S, PetscMax(pb->m, 1), &pb->S_piv));
+  PetscCall(MatGetOwnershipRange(pc->pmat, &rstart, NULL));
+  PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  for (PetscInt i = 0; i < pb->nb; i++) {
+    const char *name;
+    char        bprefix[256];
+    PC          inner;
+    PetscCall(ISCreateStride(PetscObjectComm((PetscObject)pc), bd->n[i], rstart + bd->off[i], 1, &pb->is[i]));
+    PetscCall(KSPCreate(PetscObjectComm((PetscObject)pc), &pb->ksp[i]));
+    PetscCall(PetscObjectIncrementTabLevel((PetscObject)pb->ksp[i], (PetscObject)pc, 1));
+    PetscCall(KSPSetType(pb->ksp[i], KSPPREONLY));
+    PetscCall(KSPGetPC(pb->ksp[i], &inner));
+    PetscCall(PCSetType(inner, PCCHOLESKY));
+    /* the options common to every body, then those of this body */
+    PetscCall(KSPSetOptionsPrefix(pb->ksp[i], prefix));
+    PetscCall(KSPAppendOptionsPrefix(pb->ksp[i], "bordered_"));
+    PetscCall(KSPSetFromOptions(pb->ksp[i]));
+    PetscCall((*bd->blockprefix)(bd->ctx, i, &name));
+    PetscCall(PetscSNPrintf(bprefix, sizeof(bprefix), "%s_", name));
+    PetscCall(KSPAppendOptionsPrefix(pb->ksp[i], bprefix));
+    PetscCall(KSPSetFromOptions(pb->ksp[i]));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode PCSetUp_Bordered(PC pc)
+{
+  PC_Bordered       *pb = (PC_Bordered *)pc->data;
+  PhlexBorderedData *bd;
+  PetscContainer     c;
+  PetscReal         *CtY;
+  PetscBLASInt       mb, info;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectQuery((PetscObject)pc->pmat, "phlex_border", (PetscObject *)&c));
+  PetscCheck(c, PetscObjectComm((PetscObject)pc), PETSC_ERR_ARG_WRONG, "PC phlexbordered works on phlex's {velocity, discrete} split (or the whole system without a flexible body); this preconditioning matrix carries no border data");
+  PetscCall(PetscContainerGetPointer(c, (void **)&bd));
+  if (!pb->bd) {
+    pb->bd = bd;
+    PetscCall(BorderedSetUpBlocks(pc, pb));
+  }
+  /* Y_i = A_i^{-1} W_i: only when A_i or W_i changed */
+  for (PetscInt i = 0; i < pb->nb; i++) {
+    PetscObjectState sa, sw = 0;
+    PetscCall(PetscObjectStateGet((PetscObject)bd->A[i], &sa));
+    if (bd->W[i]) PetscCall(PetscObjectStateGet((PetscObject)bd->W[i], &sw));
+    if (pb->Astate[i] == sa && pb->Wstate[i] == sw && (pb->Y[i] || !bd->W[i])) continue;
+    PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pc, 0, 0, 0));
+    PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
+    PetscCall(KSPSetUp(pb->ksp[i]));
+    PetscCall(MatDestroy(&pb->Y[i]));
+    if (bd->W[i]) {
+      PetscInt k;
+      PetscCall(MatDuplicate(bd->W[i], MAT_DO_NOT_COPY_VALUES, &pb->Y[i]));
+      PetscCall(KSPMatSolve(pb->ksp[i], bd->W[i], pb->Y[i]));
+      PetscCall(MatGetSize(bd->W[i], NULL, &k));
+      PetscCall(PetscFree(pb->beta[i]));
+      PetscCall(PetscMalloc1(PetscMax(k * pb->m, 1), &pb->beta[i]));
+    }
+    pb->Astate[i] = sa;
+    pb->Wstate[i] = sw;
+    pb->nfactor++;
+    PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pc, 0, 0, 0));
+  }
+  if (!pb->m) PetscFunctionReturn(0);
+  /* S = D - sum_i (C_i Y_i) beta_i */
+  PetscCall(PetscLogEventBegin(PHLEX_BorderedSetUp, pc, 0, 0, 0));
+  for (PetscInt i = 0; i < pb->m; i++)
+    for (PetscInt j = 0; j < pb->m; j++) pb->S[i + pb->m * j] = bd->D[pb->m * i + j];
+  for (PetscInt b = 0; b < pb->nb; b++) {
+    PetscInt k;
+    if (!bd->W[b]) continue;
+    PetscCall(MatGetSize(bd->W[b], NULL, &k));
+    PetscCall(PetscMalloc1(pb->m * k, &CtY));
+    PetscCall((*bd->rows)(bd->ctx, b, pb->Y[b], CtY));
+    PetscCall((*bd->coefficients)(bd->ctx, b, pb->beta[b]));
+    for (PetscInt i = 0; i < pb->m; i++)
+      for (PetscInt j = 0; j < pb->m; j++) {
+        PetscScalar s = 0;
+        for (PetscInt l = 0; l < k; l++) s += CtY[i + pb->m * l] * pb->beta[b][l + k * j];
+        pb->S[i + pb->m * j] -= s;
+      }
+    PetscCall(PetscFree(CtY));
+  }
+  PetscCall(PetscBLASIntCast(pb->m, &mb));
+  PetscCallBLAS("LAPACKgetrf", LAPACKgetrf_(&mb, &mb, pb->S, &mb, pb->S_piv, &info));
+  PetscCheck(!info, PetscObjectComm((PetscObject)pc), PETSC_ERR_NOT_CONVERGED, "PC phlexbordered: the discrete Schur complement is singular (LAPACK getrf info %d): dependent constraints (redundant joint components?) or a body free to move in a constrained direction", (int)info);
+  PetscCall(PetscLogEventEnd(PHLEX_BorderedSetUp, pc, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode PCApply_Bordered(PC pc, Vec r, Vec z)
+{
+  PC_Bordered       *pb = (PC_Bordered *)pc->data;
+  PhlexBorderedData *bd = pb->bd;
+  PetscReal         *h;
+  PetscBLASInt       mb, one = 1, info;
+  PetscMPIInt        rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)pc), &rank));
+  PetscCall(PetscCalloc1(PetscMax(pb->m, 1), &h));
+  /* x0_i = A_i^{-1} f_i, into z */
+  for (PetscInt i = 0; i < pb->nb; i++) {
+    Vec f, x;
+    PetscCall(VecGetSubVector(r, pb->is[i], &f));
+    PetscCall(VecGetSubVector(z, pb->is[i], &x));
+    PetscCall(KSPSolve(pb->ksp[i], f, x));
+    PetscCall(KSPCheckSolve(pb->ksp[i], pc, x));
+    PetscCall(VecRestoreSubVector(r, pb->is[i], &f));
+    PetscCall(VecRestoreSubVector(z, pb->is[i], &x));
+  }
+  if (pb->m) {
+    const PetscScalar *ra;
+    PetscScalar       *za;
+    PetscReal         *c;
+    /* h = g - sum_i C_i x0_i */
+    for (PetscInt i = 0; i < pb->nb; i++) {
+      Vec x;
+      PetscCall(VecGetSubVector(z, pb->is[i], &x));
+      PetscCall((*bd->rowsvec)(bd->ctx, i, x, h));
+      PetscCall(VecRestoreSubVector(z, pb->is[i], &x));
+    }
+    PetscCall(VecGetArrayRead(r, &ra));
+    {
+      PetscReal *g;
+      PetscCall(PetscCalloc1(pb->m, &g));
+      if (rank == 0)
+        for (PetscInt k = 0; k < pb->m; k++) g[k] = PetscRealPart(ra[bd->qoff + k]);
+      PetscCallMPI(MPI_Bcast(g, (PetscMPIInt)pb->m, MPIU_REAL, 0, PetscObjectComm((PetscObject)pc)));
+      for (PetscInt k = 0; k < pb->m; k++) h[k] = g[k] - h[k];
+      PetscCall(PetscFree(g));
+    }
+    PetscCall(VecRestoreArrayRead(r, &ra));
+    /* y = S^{-1} h */
+    PetscCall(PetscBLASIntCast(pb->m, &mb));
+    PetscCallBLAS("LAPACKgetrs", LAPACKgetrs_("N", &mb, &one, pb->S, &mb, pb->S_piv, h, &mb, &info));
+    PetscCall(VecGetArray(z, &za));
+    if (rank == 0)
+      for (PetscInt k = 0; k < pb->m; k++) za[bd->qoff + k] = h[k];
+    PetscCall(VecRestoreArray(z, &za));
+    /* x_i = x0_i - Y_i (beta_i y) */
+    for (PetscInt i = 0; i < pb->nb; i++) {
+      const PetscScalar *Ya;
+      PetscScalar       *xa;
+      PetscInt           k, nloc, ld;
+      Vec                x;
+      if (!pb->Y[i]) continue;
+      PetscCall(MatGetSize(pb->Y[i], NULL, &k));
+      PetscCall(PetscCalloc1(k, &c));
+      for (PetscInt l = 0; l < k; l++)
+        for (PetscInt j = 0; j < pb->m; j++) c[l] -= pb->beta[i][l + k * j] * h[j];
+      PetscCall(VecGetSubVector(z, pb->is[i], &x));
+      PetscCall(VecGetLocalSize(x, &nloc));
+      PetscCall(MatDenseGetLDA(pb->Y[i], &ld));
+      PetscCall(MatDenseGetArrayRead(pb->Y[i], &Ya));
+      PetscCall(VecGetArray(x, &xa));
+      for (PetscInt l = 0; l < k; l++)
+        if (c[l] != 0.0)
+          for (PetscInt n = 0; n < nloc; n++) xa[n] += c[l] * Ya[l * ld + n];
+      PetscCall(VecRestoreArray(x, &xa));
+      PetscCall(MatDenseRestoreArrayRead(pb->Y[i], &Ya));
+      PetscCall(VecRestoreSubVector(z, pb->is[i], &x));
+      PetscCall(PetscFree(c));
+    }
+  }
+  PetscCall(PetscFree(h));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode PCReset_Bordered(PC pc)
+{
+  PC_Bordered *pb = (PC_Bordered *)pc->data;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < pb->nb; i++) {
+    PetscCall(KSPDestroy(&pb->ksp[i]));
+    PetscCall(MatDestroy(&pb->Y[i]));
+    PetscCall(PetscFree(pb->beta[i]));
+    PetscCall(ISDestroy(&pb->is[i]));
+  }
+  PetscCall(PetscFree5(pb->ksp, pb->Y, pb->Astate, pb->Wstate, pb->beta));
+  PetscCall(PetscFree(pb->is));
+  PetscCall(PetscFree2(pb->S, pb->S_piv));
+  pb->bd = NULL;
+  pb->nb = pb->m = 0;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode PCDestroy_Bordered(PC pc)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PCReset_Bordered(pc));
+  PetscCall(PetscFree(pc->data));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode PCView_Bordered(PC pc, PetscViewer viewer)
+{
+  PC_Bordered *pb = (PC_Bordered *)pc->data;
+  PetscBool    ascii;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
+  if (!ascii) PetscFunctionReturn(0);
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  %" PetscInt_FMT " sparse block(s), %" PetscInt_FMT " discrete unknowns, A^{-1} W computed %" PetscInt_FMT " time(s)\n", pb->nb, pb->m, pb->nfactor));
+  for (PetscInt i = 0; i < pb->nb; i++) {
+    const char *name;
+    PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "  solver for the sparse block of %s:\n", name));
+    PetscCall(PetscViewerASCIIPushTab(viewer));
+    PetscCall(KSPView(pb->ksp[i], viewer));
+    PetscCall(PetscViewerASCIIPopTab(viewer));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode PCCreate_Bordered(PC pc)
+{
+  PC_Bordered *pb;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&pb));
+  pc->data         = pb;
+  pc->ops->setup   = PCSetUp_Bordered;
+  pc->ops->apply   = PCApply_Bordered;
+  pc->ops->reset   = PCReset_Bordered;
+  pc->ops->destroy = PCDestroy_Bordered;
+  pc->ops->view    = PCView_Bordered;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPCRegister - registers the PC type "phlexbordered" (selectable by -pc_type in the {velocity, discrete} split)
+@*/
+PetscErrorCode PhlexPCRegister(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PCRegister("phlexbordered", PCCreate_Bordered));
+  PetscFunctionReturn(0);
+}

@@ -1,0 +1,646 @@
+/* The assembled system of a scene: the index-2 pHDAE of all parts interconnected by the joints (paper Section 5,
+   eq. int_beams for N parts), in implicit form F(t, X, X') = 0 for PETSc TS, non-dimensional.
+
+   Unknowns X = [U | Sigma | V | Q], field-major, each field contiguous on every rank:
+     U, Sigma, V   the displacement, stress and velocity fields of the flexible bodies, body after body;
+     Q             the discrete unknowns on rank 0: each part's (frame states, lumped states, internal impulses)
+                   then each joint's impulses Lambda (Lambda' = lambda, the multipliers).
+   The multipliers enter as rates of impulses: with the implicit midpoint rule the scheme uses one multiplier per
+   step, (Lambda_{n+1} - Lambda_n)/dt, the midpoint value, and the written joint wrenches are these step averages
+   (they do not oscillate as end-of-step algebraic values would).
+
+   Residual: every part writes the rows of its unknowns given the wrenches on its ports; every joint sets those
+   wrenches from its multipliers and writes its constraint rows. The system never asks what kind a part is.
+
+   Jacobian: a MATNEST. Field blocks are the parts' own matrices (a MATNEST over the bodies when several); the
+   borders between fields and Q are shells (border.c) that apply each part's own border and the joints' port maps;
+   the Q x Q block is dense (replicated array D, copied to rank 0's rows). */
+#include <phlex_impl.h>
+#include <petsc/private/petscimpl.h> /* PetscObjectStateIncrease: blocks changed in place */
+
+const char *const PhlexFieldNames[] = {"displacement", "stress", "velocity", "discrete"};
+
+PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);
+
+static PetscErrorCode IdentityMatrix(MPI_Comm comm, PetscInt n, PetscReal value, Mat *A)
+{
+  Vec d;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateAIJ(comm, n, n, PETSC_DETERMINE, PETSC_DETERMINE, 1, NULL, 0, NULL, A));
+  PetscCall(MatCreateVecs(*A, &d, NULL));
+  PetscCall(VecSet(d, value));
+  PetscCall(MatDiagonalSet(*A, d, INSERT_VALUES));
+  PetscCall(VecDestroy(&d));
+  PetscFunctionReturn(0);
+}
+
+/* the block-diagonal matrix of one matrix per field part (rows in field fr, columns in field fc): the part's own
+   matrix when it is alone, else a MATNEST (NULL blocks allowed: the index sets give the sizes) */
+PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem sys, Mat *mats, PhlexField fr, PhlexField fc, Mat *A)
+{
+  const PetscInt n = sys->nfparts;
+  Mat           *blocks;
+  IS            *isr, *isc;
+  PetscBool      any = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < n; i++)
+    if (mats[i]) any = PETSC_TRUE;
+  *A = NULL;
+  if (!any) PetscFunctionReturn(0);
+  if (n == 1) {
+    *A = mats[0];
+    PetscCall(PetscObjectReference((PetscObject)mats[0]));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscCalloc3(n * n, &blocks, n, &isr, n, &isc));
+  for (PetscInt i = 0; i < n; i++) {
+    blocks[i * n + i] = mats[i];
+    isr[i]            = sys->fis[fr][i];
+    isc[i]            = sys->fis[fc][i];
+  }
+  PetscCall(MatCreateNest(sys->comm, n, isr, n, isc, blocks, A));
+  PetscCall(PetscFree3(blocks, isr, isc));
+  PetscFunctionReturn(0);
+}
+
+/* the compliance masses of all bodies in one AIJ matrix, with the per-cell blocks as variable block sizes (so that
+   point-block Jacobi inverts them exactly for any mix of element degrees) */
+static PetscErrorCode AssembleStressBlock(PhlexSystem sys, PhlexFieldOperators *ops, Mat *Ms)
+{
+  PetscInt  ns = 0, bs = -1, rstart, nblocks = 0, *bsizes, *nnz;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    ns += sys->fparts[i]->ns;
+    nblocks += sys->fparts[i]->ns / ops[i].stress_bs;
+    bs = (bs < 0 || bs == ops[i].stress_bs) ? ops[i].stress_bs : 1;
+  }
+  PetscCall(PetscMalloc2(PetscMax(nblocks, 1), &bsizes, PetscMax(ns, 1), &nnz));
+  nblocks = 0;
+  for (PetscInt i = 0; i < sys->nfparts; i++)
+    for (PetscInt b = 0; b < sys->fparts[i]->ns / ops[i].stress_bs; b++) bsizes[nblocks++] = ops[i].stress_bs;
+  {
+    PetscInt r = 0;
+    for (PetscInt b = 0; b < nblocks; b++)
+      for (PetscInt k = 0; k < bsizes[b]; k++) nnz[r++] = bsizes[b];
+  }
+  PetscCall(MatCreate(sys->comm, Ms));
+  PetscCall(MatSetSizes(*Ms, ns, ns, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetType(*Ms, MATAIJ));
+  if (bs > 1) PetscCall(MatSetBlockSize(*Ms, bs));
+  PetscCall(MatSeqAIJSetPreallocation(*Ms, 0, nnz));
+  PetscCall(MatMPIAIJSetPreallocation(*Ms, 0, nnz, 0, NULL));
+  PetscCall(MatGetOwnershipRange(*Ms, &rstart, NULL));
+  {
+    PetscInt off = rstart;
+    for (PetscInt i = 0; i < sys->nfparts; i++) {
+      Mat      M = ops[i].Ms;
+      PetscInt mstart, mend;
+      PetscCall(MatGetOwnershipRange(M, &mstart, &mend));
+      for (PetscInt row = mstart; row < mend; row++) {
+        const PetscInt    *cols;
+        const PetscScalar *vals;
+        PetscInt           nc, grow = off + row - mstart, gcols[64];
+        PetscCall(MatGetRow(M, row, &nc, &cols, &vals));
+        PetscCheck(nc <= 64, sys->comm, PETSC_ERR_PLIB, "stress block row with %" PetscInt_FMT " entries", nc);
+        for (PetscInt k = 0; k < nc; k++) gcols[k] = off + cols[k] - mstart;
+        PetscCall(MatSetValues(*Ms, 1, &grow, nc, gcols, vals, INSERT_VALUES));
+        PetscCall(MatRestoreRow(M, row, &nc, &cols, &vals));
+      }
+      off += mend - mstart;
+    }
+  }
+  PetscCall(MatAssemblyBegin(*Ms, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*Ms, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatSetVariableBlockSizes(*Ms, nblocks, bsizes));
+  PetscCall(PetscFree2(bsizes, nnz));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemCreate - the global unknowns, the Jacobian structure and the border data of a scene
+
+  Collective
+
+  Options Database Key:
+. -phlex_jacobian_aij - also assemble the Jacobian as one AIJ matrix (monolithic factorisations, -snes_test_jacobian)
+@*/
+PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
+{
+  PhlexSystem          sys;
+  PetscMPIInt          rank;
+  PhlexFieldOperators *ops;
+  PetscInt             nlocal[PHLEX_NUM_FIELDS] = {0, 0, 0, 0}, bs[PHLEX_NUM_FIELDS] = {3, 1, 3, 1};
+  const char          *names[PHLEX_NUM_FIELDS];
+  PetscInt             lsize[PHLEX_NUM_FIELDS], lbs[PHLEX_NUM_FIELDS], sbs = -1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&sys));
+  PetscCallMPI(MPI_Comm_rank(scene->comm, &rank));
+  sys->scene   = scene;
+  sys->comm    = scene->comm;
+  sys->units   = &scene->units;
+  sys->nparts  = scene->nparts;
+  sys->parts   = scene->parts;
+  sys->njoints = scene->njoints;
+  sys->joints  = scene->joints;
+
+  /* the parts with fields, their operators and places */
+  PetscCall(PetscMalloc1(PetscMax(sys->nparts, 1), &sys->fparts));
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
+    if (p->nv) sys->fparts[sys->nfparts++] = p;
+    if (p->nonlinear) sys->nonlinear = PETSC_TRUE;
+  }
+  if (sys->njoints) sys->nonlinear = PETSC_TRUE; /* joint directions turn with the bodies */
+  PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &ops));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops[i]));
+    nlocal[PHLEX_FIELD_DISPLACEMENT] += sys->fparts[i]->nu;
+    nlocal[PHLEX_FIELD_STRESS] += sys->fparts[i]->ns;
+    nlocal[PHLEX_FIELD_VELOCITY] += sys->fparts[i]->nv;
+    sbs = (sbs < 0 || sbs == ops[i].stress_bs) ? ops[i].stress_bs : 1;
+  }
+  bs[PHLEX_FIELD_STRESS] = sbs > 0 ? sbs : 1;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    sys->parts[i]->qoff = sys->nq;
+    sys->nq += sys->parts[i]->nq;
+  }
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    sys->joints[k]->qoff = sys->nq;
+    sys->nq += sys->joints[k]->nc;
+  }
+  sys->qlocal                     = rank == 0 ? sys->nq : 0;
+  nlocal[PHLEX_FIELD_DISCRETE]    = sys->qlocal;
+  PetscCall(PetscCalloc5(PetscMax(sys->nq, 1), &sys->q, PetscMax(sys->nq, 1), &sys->qd, PetscMax(sys->nq, 1), &sys->fq, PetscMax(sys->nq * sys->nq, 1), &sys->D, PetscMax(sys->nq, 1), &sys->qkind));
+  for (PetscInt i = 0; i < sys->nparts; i++)
+    for (PetscInt k = 0; k < sys->parts[i]->nq; k++) sys->qkind[sys->parts[i]->qoff + k] = sys->parts[i]->qkind[k];
+  for (PetscInt k = 0; k < sys->njoints; k++)
+    for (PetscInt r = 0; r < sys->joints[k]->nc; r++) sys->qkind[sys->joints[k]->qoff + r] = PHLEX_DOF_IMPULSE;
+
+  /* the layout: the fields present */
+  for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++) sys->field[f] = -1;
+  for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++) {
+    const PetscBool present = f == PHLEX_FIELD_DISCRETE ? (sys->nq > 0) : (sys->nfparts > 0);
+    if (!present) continue;
+    sys->field[f]          = sys->nfields;
+    names[sys->nfields]    = PhlexFieldNames[f];
+    lsize[sys->nfields]    = nlocal[f];
+    lbs[sys->nfields]      = bs[f];
+    sys->nfields++;
+  }
+  PetscCheck(sys->nfields, sys->comm, PETSC_ERR_USER_INPUT, "the scene has nothing that moves: no flexible body and no discrete unknowns");
+  PetscCall(PhlexLayoutCreateDM(sys->comm, sys->nfields, names, lsize, lbs, PhlexSystemPmat, sys, &sys->dm));
+  /* the same layout for auxiliary solvers (the consistent start): a solver's callbacks live on its DM */
+  PetscCall(PhlexLayoutCreateDM(sys->comm, sys->nfields, names, lsize, lbs, PhlexSystemPmat, sys, &sys->dm_aux));
+  for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++)
+    if (sys->field[f] >= 0) PetscCall(PhlexLayoutGetFieldIS(sys->dm, sys->field[f], &sys->is[f]));
+
+  /* each part's blocks in the global vector */
+  {
+    PetscInt fstart[PHLEX_NUM_FIELDS];
+    for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++)
+      if (sys->is[f]) PetscCall(ISGetMinMax(sys->is[f], &fstart[f], NULL));
+    for (PetscInt i = 0; i < sys->nfparts; i++) {
+      PhlexPart p = sys->fparts[i];
+      PetscCall(ISCreateStride(sys->comm, p->nu, fstart[PHLEX_FIELD_DISPLACEMENT], 1, &p->isu));
+      PetscCall(ISCreateStride(sys->comm, p->ns, fstart[PHLEX_FIELD_STRESS], 1, &p->iss));
+      PetscCall(ISCreateStride(sys->comm, p->nv, fstart[PHLEX_FIELD_VELOCITY], 1, &p->isv));
+      fstart[PHLEX_FIELD_DISPLACEMENT] += p->nu;
+      fstart[PHLEX_FIELD_STRESS] += p->ns;
+      fstart[PHLEX_FIELD_VELOCITY] += p->nv;
+    }
+  }
+  /* and in the numbering of each field (the sub-blocks of the field blocks of the Jacobian) */
+  for (PetscInt f = 0; f < 3; f++) {
+    PetscInt start = 0, off;
+    PetscCall(PetscMalloc1(PetscMax(sys->nfparts, 1), &sys->fis[f]));
+    PetscCallMPI(MPI_Exscan(&nlocal[f], &start, 1, MPIU_INT, MPI_SUM, sys->comm));
+    if (rank == 0) start = 0;
+    off = start;
+    for (PetscInt i = 0; i < sys->nfparts; i++) {
+      const PetscInt n = f == PHLEX_FIELD_STRESS ? sys->fparts[i]->ns : sys->fparts[i]->nv;
+      PetscCall(ISCreateStride(sys->comm, n, off, 1, &sys->fis[f][i]));
+      off += n;
+    }
+  }
+
+  /* the Jacobian */
+  if (sys->nfparts) {
+    Mat *m;
+    PetscCall(PetscMalloc1(sys->nfparts, &m));
+    PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], 1.0, &sys->Juu));
+    PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], -1.0, &sys->Juv));
+    PetscCall(AssembleStressBlock(sys, ops, &sys->Ms));
+    PetscCall(MatDuplicate(sys->Ms, MAT_COPY_VALUES, &sys->Jss));
+    {
+      PetscInt        nb;
+      const PetscInt *bsz;
+      PetscCall(MatGetVariableBlockSizes(sys->Ms, &nb, &bsz));
+      PetscCall(MatSetVariableBlockSizes(sys->Jss, nb, (PetscInt *)bsz));
+    }
+    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
+    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Gt;
+    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, &sys->Jvs));
+    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvv;
+    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
+    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvu;
+    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_DISPLACEMENT, &sys->Jvu));
+    PetscCall(PetscFree(m));
+  }
+  PetscCall(MatCreateDense(sys->comm, sys->qlocal, sys->qlocal, sys->nq, sys->nq, NULL, &sys->Dq));
+  PetscCall(MatZeroEntries(sys->Dq));
+  PetscCall(MatAssemblyBegin(sys->Dq, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(sys->Dq, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscObjectSetName((PetscObject)sys->Dq, "discrete block"));
+  if (sys->nfparts && sys->nq) PetscCall(PhlexBorderCreateShells(sys));
+  {
+    const PetscInt nf = sys->nfields, U = sys->field[PHLEX_FIELD_DISPLACEMENT], S = sys->field[PHLEX_FIELD_STRESS], V = sys->field[PHLEX_FIELD_VELOCITY], Q = sys->field[PHLEX_FIELD_DISCRETE];
+    Mat           *blocks;
+    IS             isl[PHLEX_NUM_FIELDS];
+    PetscCall(PetscCalloc1(nf * nf, &blocks));
+    if (U >= 0) {
+      blocks[U * nf + U] = sys->Juu, blocks[U * nf + V] = sys->Juv;
+      blocks[S * nf + S] = sys->Jss, blocks[S * nf + V] = sys->Jsv;
+      blocks[V * nf + U] = sys->Jvu, blocks[V * nf + S] = sys->Jvs, blocks[V * nf + V] = sys->Jvv;
+    }
+    if (Q >= 0) {
+      blocks[Q * nf + Q] = sys->Dq;
+      if (U >= 0) blocks[V * nf + Q] = sys->Bvq, blocks[Q * nf + U] = sys->Cqu, blocks[Q * nf + V] = sys->Cqv;
+    }
+    for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++)
+      if (sys->field[f] >= 0) isl[sys->field[f]] = sys->is[f];
+    PetscCall(MatCreateNest(sys->comm, nf, isl, nf, isl, blocks, &sys->J));
+    PetscCall(PetscFree(blocks));
+  }
+  PetscCall(PetscObjectSetName((PetscObject)sys->J, "Jacobian"));
+  PetscCall(PetscOptionsGetBool(NULL, NULL, "-phlex_jacobian_aij", &sys->use_aij, NULL));
+  PetscCall(PetscMalloc2(PetscMax(sys->nfparts, 1), &sys->xu, PetscMax(sys->nfparts, 1), &sys->xv));
+  PetscCall(PetscFree(ops));
+  PetscCall(PhlexSystemSetUpBorder(sys));
+  if (!sys->nfparts) {
+    /* no flexible body: PC phlexbordered works on the whole (dense) system */
+    PetscContainer c;
+    PetscCall(PetscContainerCreate(sys->comm, &c));
+    PetscCall(PetscContainerSetPointer(c, &sys->border));
+    PetscCall(PetscObjectCompose((PetscObject)sys->J, "phlex_border", (PetscObject)c));
+    PetscCall(PetscContainerDestroy(&c));
+  }
+  *system = sys;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemGather - the discrete unknowns of a global vector on every rank (they live on rank 0)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemGather(PhlexSystem sys, Vec X, PetscReal *q)
+{
+  Vec                xq;
+  const PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  if (!sys->nq) PetscFunctionReturn(0);
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISCRETE], &xq));
+  PetscCall(VecGetArrayRead(xq, &a));
+  for (PetscInt k = 0; k < sys->qlocal; k++) q[k] = PetscRealPart(a[k]);
+  PetscCall(VecRestoreArrayRead(xq, &a));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_DISCRETE], &xq));
+  PetscCallMPI(MPI_Bcast(q, (PetscMPIInt)sys->nq, MPIU_REAL, 0, sys->comm));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemScatter - writes replicated discrete values into a global vector (rank 0's part)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemScatter(PhlexSystem sys, const PetscReal *q, Vec X)
+{
+  Vec          xq;
+  PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  if (!sys->nq) PetscFunctionReturn(0);
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISCRETE], &xq));
+  PetscCall(VecGetArray(xq, &a));
+  for (PetscInt k = 0; k < sys->qlocal; k++) a[k] = q[k];
+  PetscCall(VecRestoreArray(xq, &a));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_DISCRETE], &xq));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemPartVec - a part's view of a global vector whose discrete values (replicated) are q
+@*/
+PetscErrorCode PhlexSystemPartVec(PhlexSystem sys, PhlexPart p, Vec X, PetscReal *q, PhlexPartVec *pv)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexPartGetVec(p, X, q, pv));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode PhlexSystemPartVecRestore(PhlexSystem sys, PhlexPart p, Vec X, PhlexPartVec *pv)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexPartRestoreVec(p, X, pv));
+  PetscFunctionReturn(0);
+}
+
+/* evaluate every part at (t, X, X') (X' NULL: rest), then the joints, which set the port wrenches */
+static PetscErrorCode EvaluateAll(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot, PhlexPartVec *pX, PhlexPartVec *pXd)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemGather(sys, X, sys->q));
+  if (Xdot) PetscCall(PhlexSystemGather(sys, Xdot, sys->qd));
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
+    for (PetscInt k = 0; k < p->nports; k++)
+      for (PetscInt c = 0; c < 6; c++) p->wrench[k][c] = 0.0;
+    PetscCall(PhlexPartGetVec(p, X, sys->q, &pX[i]));
+    if (Xdot) PetscCall(PhlexPartGetVec(p, Xdot, sys->qd, &pXd[i]));
+    PetscCall((*p->ops.evaluate)(p, t, &pX[i], Xdot ? &pXd[i] : NULL));
+  }
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PetscCall(PhlexJointEvaluate(sys->joints[k], t, sys->q, Xdot ? sys->qd : NULL));
+    PetscCall(PhlexJointApplyWrenches(sys->joints[k]));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode RestoreAll(PhlexSystem sys, Vec X, Vec Xdot, PhlexPartVec *pX, PhlexPartVec *pXd)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PetscCall(PhlexPartRestoreVec(sys->parts[i], X, &pX[i]));
+    if (Xdot) PetscCall(PhlexPartRestoreVec(sys->parts[i], Xdot, &pXd[i]));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemEvaluate - evaluates every part and joint at (t, X, X') (X' NULL: rest); the parts' views of X are
+  released afterwards (outputs take them again)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemEvaluate(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot)
+{
+  PhlexPartVec *pX, *pXd;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc2(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd));
+  PetscCall(EvaluateAll(sys, t, X, Xdot, pX, pXd));
+  PetscCall(RestoreAll(sys, X, Xdot, pX, pXd));
+  PetscCall(PetscFree2(pX, pXd));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemIFunction - F(t, X, X') of the scene (TS IFunction; t and X' in SI time)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, void *ctx)
+{
+  PhlexSystem   sys = (PhlexSystem)ctx;
+  PhlexPartVec *pX, *pXd, *pF;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_SysIFunction, 0, 0, 0, 0));
+  PetscCall(PetscMalloc3(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd, PetscMax(sys->nparts, 1), &pF));
+  PetscCall(EvaluateAll(sys, t, X, Xdot, pX, pXd));
+  for (PetscInt k = 0; k < sys->nq; k++) sys->fq[k] = 0.0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
+    PetscCall(PhlexPartGetVec(p, F, sys->fq, &pF[i]));
+    PetscCall((*p->ops.residual)(p, t, &pX[i], &pXd[i], &pF[i]));
+    PetscCall(PhlexPartRestoreVec(p, F, &pF[i]));
+  }
+  PetscCall(PetscLogEventBegin(PHLEX_JointResidual, 0, 0, 0, 0));
+  for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointResidual(sys->joints[k], t, sys->fq));
+  PetscCall(PetscLogEventEnd(PHLEX_JointResidual, 0, 0, 0, 0));
+  PetscCall(PhlexSystemScatter(sys, sys->fq, F));
+  PetscCall(RestoreAll(sys, X, Xdot, pX, pXd));
+  PetscCall(PetscFree3(pX, pXd, pF));
+  PetscCall(PetscLogEventEnd(PHLEX_SysIFunction, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemIJacobian - dF/dX + shift dF/dX' (TS IJacobian). Constant field blocks are only rescaled when the shift
+  changes; the state-dependent pieces (frames, borders, joints, the dense discrete block) are recomputed at every
+  call of a nonlinear scene.
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscReal shift, Mat A, Mat P, void *ctx)
+{
+  PhlexSystem     sys = (PhlexSystem)ctx;
+  const PetscReal s   = shift * sys->units->time; /* non-dimensional shift */
+  const PetscBool new_shift = PetscAbsReal(s - sys->shift) > 1e-12 * s ? PETSC_TRUE : PETSC_FALSE;
+  PhlexPartVec   *pX, *pXd;
+
+  PetscFunctionBeginUser;
+  /* multistep methods recompute the shift from the step size: ignore round-off changes */
+  if (!sys->nonlinear && !new_shift) PetscFunctionReturn(0);
+  PetscCall(PetscLogEventBegin(PHLEX_SysIJacobian, 0, 0, 0, 0));
+  if (new_shift) {
+    sys->shift = s;
+    if (sys->nfparts) {
+      PetscCall(MatScale(sys->Juu, 0.0));
+      PetscCall(MatShift(sys->Juu, s));
+      PetscCall(MatCopy(sys->Ms, sys->Jss, SAME_NONZERO_PATTERN));
+      PetscCall(MatScale(sys->Jss, -s));
+      /* assembling resets the matrices' cached diagonal (block) inverses (point-block Jacobi on the stress block
+         would otherwise keep the inverse of the previous shift's block) */
+      PetscCall(MatAssemblyBegin(sys->Juu, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(sys->Juu, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyBegin(sys->Jss, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(sys->Jss, MAT_FINAL_ASSEMBLY));
+    }
+  }
+  PetscCall(PetscMalloc2(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd));
+  PetscCall(EvaluateAll(sys, t, X, Xdot, pX, pXd));
+  for (PetscInt k = 0; k < sys->nq * sys->nq; k++) sys->D[k] = 0.0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
+    PetscCall((*p->ops.jacobian)(p, s, &pX[i], sys->D + p->qoff * sys->nq + p->qoff, sys->nq));
+  }
+  for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointJacobian(sys->joints[k], s, sys->D, sys->nq));
+  PetscCall(RestoreAll(sys, X, Xdot, pX, pXd));
+  PetscCall(PetscFree2(pX, pXd));
+  if (sys->nq) {
+    PetscScalar *da;
+    PetscInt     lda;
+    PetscCall(MatDenseGetLDA(sys->Dq, &lda));
+    PetscCall(MatDenseGetArrayWrite(sys->Dq, &da));
+    for (PetscInt i = 0; i < sys->qlocal; i++)
+      for (PetscInt j = 0; j < sys->nq; j++) da[j * lda + i] = sys->D[sys->nq * i + j];
+    PetscCall(MatDenseRestoreArrayWrite(sys->Dq, &da));
+  }
+  /* the preconditioning matrices of the splits: the condensed velocity operators changed with the shift */
+  if (new_shift && sys->Sv && sys->nfparts > 1) {
+    Mat *m, N;
+    PetscCall(PetscMalloc1(sys->nfparts, &m));
+    for (PetscInt i = 0; i < sys->nfparts; i++) {
+      PhlexFieldOperators ops;
+      PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+      m[i] = ops.Sv;
+    }
+    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &N));
+    PetscCall(MatConvert(N, MATAIJ, MAT_REUSE_MATRIX, &sys->Sv));
+    PetscCall(MatDestroy(&N));
+    PetscCall(PetscFree(m));
+  }
+  if (sys->Ssv && new_shift) {
+    Mat blocks[4] = {sys->Jss, sys->Jsv, sys->Jvs, sys->Jvv}, N;
+    PetscCall(MatCreateNest(sys->comm, 2, NULL, 2, NULL, blocks, &N));
+    PetscCall(MatConvert(N, MATAIJ, MAT_REUSE_MATRIX, &sys->Ssv));
+    PetscCall(MatDestroy(&N));
+  }
+  /* the blocks changed in place: raise the nests' states (assembling a nest would also raise the state of every
+     block, and the factorisations of the unchanged ones would be redone) */
+  if (sys->Bvq) {
+    PetscCall(PetscObjectStateIncrease((PetscObject)sys->Bvq));
+    PetscCall(PetscObjectStateIncrease((PetscObject)sys->Cqu));
+    PetscCall(PetscObjectStateIncrease((PetscObject)sys->Cqv));
+  }
+  if (sys->Jvv && sys->nfparts > 1) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvv));
+  if (sys->Jvu && sys->nfparts > 1) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvu));
+  PetscCall(PetscObjectStateIncrease((PetscObject)sys->J));
+  if (sys->Pvq) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Pvq));
+  if (sys->use_aij) {
+    Mat Jaij;
+    /* shells and virtual blocks: build the operator column by column (small test meshes) */
+    PetscCall(MatComputeOperator(sys->J, MATAIJ, &Jaij));
+    if (!sys->Jaij) sys->Jaij = Jaij;
+    else {
+      PetscCall(MatCopy(Jaij, sys->Jaij, DIFFERENT_NONZERO_PATTERN));
+      PetscCall(MatDestroy(&Jaij));
+    }
+    if (A != sys->Jaij && A != sys->J) PetscCall(MatCopy(sys->Jaij, A, DIFFERENT_NONZERO_PATTERN));
+  }
+  PetscCall(PetscLogEventEnd(PHLEX_SysIJacobian, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemInitialState - every part's initial unknowns (impulses zero)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemInitialState(PhlexSystem sys, Vec X)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(X, 0.0));
+  for (PetscInt k = 0; k < sys->nq; k++) sys->q[k] = 0.0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart    p = sys->parts[i];
+    PhlexPartVec pv;
+    PetscCall(PhlexPartGetVec(p, X, sys->q, &pv));
+    PetscCall((*p->ops.initialstate)(p, &pv));
+    PetscCall(PhlexPartRestoreVec(p, X, &pv));
+  }
+  PetscCall(PhlexSystemScatter(sys, sys->q, X));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemPostStep - after a step: every part cleans its discrete unknowns (rotations back onto SO(3));
+  returns the largest correction
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemPostStep(PhlexSystem sys, Vec X, PetscReal *defect)
+{
+  PetscFunctionBeginUser;
+  *defect = 0.0;
+  PetscCall(PhlexSystemGather(sys, X, sys->q));
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
+    PetscReal d;
+    if (!p->ops.poststep || !p->nq) continue;
+    PetscCall((*p->ops.poststep)(p, sys->q + p->qoff, &d));
+    *defect = PetscMax(*defect, d);
+  }
+  PetscCall(PhlexSystemScatter(sys, sys->q, X));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemDestroy - frees the system
+@*/
+PetscErrorCode PhlexSystemDestroy(PhlexSystem *system)
+{
+  PhlexSystem sys = *system;
+
+  PetscFunctionBeginUser;
+  if (!sys) PetscFunctionReturn(0);
+  for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++) PetscCall(ISDestroy(&sys->is[f]));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PetscCall(ISDestroy(&sys->fparts[i]->isu));
+    PetscCall(ISDestroy(&sys->fparts[i]->iss));
+    PetscCall(ISDestroy(&sys->fparts[i]->isv));
+    for (PetscInt f = 0; f < 3; f++)
+      if (sys->fis[f]) PetscCall(ISDestroy(&sys->fis[f][i]));
+  }
+  for (PetscInt f = 0; f < 3; f++) PetscCall(PetscFree(sys->fis[f]));
+  PetscCall(MatDestroy(&sys->J));
+  PetscCall(MatDestroy(&sys->Jaij));
+  PetscCall(MatDestroy(&sys->Juu));
+  PetscCall(MatDestroy(&sys->Juv));
+  PetscCall(MatDestroy(&sys->Ms));
+  PetscCall(MatDestroy(&sys->Jss));
+  PetscCall(MatDestroy(&sys->Jsv));
+  PetscCall(MatDestroy(&sys->Jvs));
+  PetscCall(MatDestroy(&sys->Jvv));
+  PetscCall(MatDestroy(&sys->Jvu));
+  PetscCall(MatDestroy(&sys->Bvq));
+  PetscCall(MatDestroy(&sys->Cqu));
+  PetscCall(MatDestroy(&sys->Cqv));
+  PetscCall(MatDestroy(&sys->Cpre));
+  PetscCall(MatDestroy(&sys->Dq));
+  PetscCall(MatDestroy(&sys->Sv));
+  PetscCall(MatDestroy(&sys->Pvq));
+  PetscCall(MatDestroy(&sys->Ssv));
+  PetscCall(MatDestroy(&sys->Abd));
+  PetscCall(PetscFree(sys->border.A));
+  PetscCall(PetscFree(sys->border.W));
+  PetscCall(PetscFree2(sys->border.off, sys->border.n));
+  PetscCall(PetscFree5(sys->q, sys->qd, sys->fq, sys->D, sys->qkind));
+  PetscCall(PetscFree2(sys->xu, sys->xv));
+  PetscCall(PetscFree(sys->fparts));
+  PetscCall(DMDestroy(&sys->dm));
+  PetscCall(DMDestroy(&sys->dm_aux));
+  PetscCall(PetscFree(*system));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemSNESConverged - Newton convergence of a nonlinear scene: PETSc's tests (-snes_rtol, -snes_atol, ...),
+  plus stagnation at the round-off floor of the residual. The residual carries shift (X - X_n) terms, so its floor
+  grows with the state and the shift (a body far from the origin, a very short step): a fixed -snes_atol may be out
+  of reach. Newton is accepted as converged once the residual no longer decreases (by half) and is below
+  100 eps shift ||X||.
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemSNESConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason, void *ctx)
+{
+  PhlexSystem sys = (PhlexSystem)ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
+  if (it == 0) sys->fprev = PETSC_MAX_REAL;
+  if (it > 0 && (*reason == SNES_CONVERGED_ITERATING || *reason == SNES_DIVERGED_MAX_IT)) {
+    const PetscReal floor = 100.0 * PETSC_MACHINE_EPSILON * PetscMax(1.0, sys->shift) * xnorm;
+    if (fnorm <= floor && fnorm >= 0.5 * sys->fprev) *reason = SNES_CONVERGED_FNORM_ABS;
+  }
+  sys->fprev = fnorm;
+  PetscFunctionReturn(0);
+}
