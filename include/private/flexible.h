@@ -56,7 +56,9 @@ typedef struct {
   PetscReal m, s[3], sd[3], sgrav[3], Vf[3], Vfd[3], E[9], Ed[9], J[9], Jd[9], L[3], Ld[3];
   PetscReal pt[3], pr[3], ptd[3], prd[3], gbody[3], Fext[3], Mext[3];
   PetscReal Lx[3]; /* int rho (x - P) x v (the mean-axes rotation constraint) */
-  Vec       Mu, Mvv, Mud, Mvd, bext; /* Mv u, Mv v, Mv u', Mv v', elastic load (field only) */
+  Vec       Mu, Mvv, Mud, Mvd;      /* Mv u, Mv v, Mv u', Mv v' (field only) */
+  Vec       bext, barm;             /* elastic load; its part whose moment arm about P moves with u (forces, not the
+                                       moment distributions of ports: a port turns by its mean rotation) */
 } PhlexFrameState;
 
 PETSC_INTERN PetscErrorCode PhlexFrameEvaluate(PhlexFrame *, Vec, Vec, Vec, Vec, const PetscReal[18], const PetscReal[18], PhlexFrameState *);
@@ -190,7 +192,7 @@ struct _p_PhlexFlexible {
   Vec       ud, vd;           /* non-dimensional rates (floating) */
   PetscReal (*port_ext)[6];   /* external port wrenches at the evaluated time (body frame) */
   PetscReal (*port_y)[6];     /* port outputs at the evaluated state */
-  PetscReal (*port_arm)[18];  /* full model: sum_l u(l) x dist_k(l), 3 x 6 per port (moment arms of the port forces) */
+  PetscReal (*port_ubar)[3];  /* full model: mean displacement of each port (the arm of its force beyond the drawn point) */
   PetscReal  t_eval, power_ext;
   PetscBool  joints_added;    /* the joint wrenches are in the loads of the evaluated state */
   Vec        bgrav;           /* fixed body: nodal gravity load */

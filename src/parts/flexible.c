@@ -214,7 +214,7 @@ static PetscErrorCode SetUpPorts(PhlexPart part)
     PetscCall(PetscStrcpy(part->ports[n - 1].name, b->frame_patch));
     part->ports[n - 1].dim = 6;
   }
-  PetscCall(PetscCalloc3(PetscMax(n, 1), &b->port_ext, PetscMax(n, 1), &b->port_y, PetscMax(n, 1), &b->port_arm));
+  PetscCall(PetscCalloc3(PetscMax(n, 1), &b->port_ext, PetscMax(n, 1), &b->port_y, PetscMax(n, 1), &b->port_ubar));
   PetscCall(PetscCalloc1(PetscMax(n, 1), &b->port_basis_col));
   for (PetscInt p = 0; p < n; p++) b->port_basis_col[p] = -1;
   PetscFunctionReturn(0);
@@ -323,7 +323,7 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(VecDestroy(&b->ud));
   PetscCall(VecDestroy(&b->vd));
   PetscCall(VecDestroy(&b->bgrav));
-  PetscCall(PetscFree3(b->port_ext, b->port_y, b->port_arm));
+  PetscCall(PetscFree3(b->port_ext, b->port_y, b->port_ubar));
   PetscCall(PetscFree(b->port_basis_col));
   PetscCall(PhlexFlexibleDestroyFE(b));
   PetscCall(PetscFree(part->data));

@@ -10,9 +10,9 @@
    The operators Mv, Ms, G are constant in the body frame and assembled once (flexible_fe.c); the residual is a few
    sparse mat-vecs. Time derivatives arrive in SI time (X'_nondim = T X'_SI).
 
-   Port p: output y = B_p^T (v [+ w x u]) (+ (v_P + w x (c - P), w) floating), wrench distribution B_p w on the
-   elastic rows and (F, (c - P) x F + T [+ sum_l u(l) x (B_p w)(l)]) on the frame rows: the transposes of each other,
-   so that the port power is w . y. The u terms appear in the full-inertia model only (as the inertia terms). */
+   Port p: output y = B_p^T v (+ (v_P + w x (c - P + ubar_p), w) floating), wrench distribution B_p w on the elastic
+   rows and (F, (c - P + ubar_p) x F + T) on the frame rows: the transposes of each other, so that the port power is
+   w . y (ubar_p = B_t^T u, the port's mean displacement: full-inertia model only, as the inertia terms). */
 #include <phlex_impl.h>
 #include <petsc/private/petscimpl.h> /* PetscObjectStateIncrease: blocks changed in place */
 
@@ -20,24 +20,26 @@
 /* Loads                                                                                                          */
 
 /* the port wrenches of the scene's inputs at t and the external loads on the body: the elastic load vector, and for
-   a floating body the resultant force and moment about P (frame.c adds the u arms), and their power */
+   a floating body the resultant force and moment about P (frame.c adds the u arms of the forces), and their power */
 static PetscErrorCode ExternalLoads(PhlexPart part, PetscReal t, const PhlexPartVec *X)
 {
   PhlexFlexible     b = (PhlexFlexible)part->data;
   const PhlexUnits *u = part->units;
   PhlexFrameState  *f = &b->fs;
-  Vec               bext = b->floating ? f->bext : b->load;
+  Vec               bext = b->floating ? f->bext : b->load, barm = b->floating ? f->barm : b->load;
   PetscScalar       p;
 
   PetscFunctionBeginUser;
   PetscCall(VecSet(bext, 0.0));
+  if (barm != bext) PetscCall(VecSet(barm, 0.0));
   for (PetscInt k = 0; k < 3; k++) f->Fext[k] = f->Mext[k] = 0.0;
   for (PetscInt q = 0; q < b->nports; q++) {
     PetscReal *w = b->port_ext[q];
     PetscCall(PhlexPortLoadEvaluate(&b->ports[q].load, t, u, b->floating ? f->R : NULL, w));
     if (!b->ports[q].load.loaded) continue;
+    /* forces into barm (their arms move with u); the moment distributions (self-equilibrated) into bext */
     for (PetscInt k = 0; k < 6; k++)
-      if (w[k] != 0.0) PetscCall(VecAXPY(bext, w[k], b->ports[q].dist[k]));
+      if (w[k] != 0.0) PetscCall(VecAXPY(k < 3 ? barm : bext, w[k], b->ports[q].dist[k]));
     if (b->floating) {
       PetscReal a[3];
       PhlexCross(part->ports[q].point, w, a);
@@ -61,7 +63,7 @@ static PetscErrorCode ExternalLoads(PhlexPart part, PetscReal t, const PhlexPart
     /* force density scale: force / length^3 = E_ref / L */
     for (PetscInt c = 0; c < 3; c++) beta[c] = fr * b->body_force[c] * u->length / u->modulus;
     for (PetscInt c = 0; c < 3; c++)
-      if (beta[c] != 0.0) PetscCall(VecAXPY(bext, beta[c], b->fvol[c]));
+      if (beta[c] != 0.0) PetscCall(VecAXPY(barm, beta[c], b->fvol[c]));
     if (b->floating) {
       PetscReal a[3];
       PhlexCross(b->inertia.svol, beta, a);
@@ -73,7 +75,8 @@ static PetscErrorCode ExternalLoads(PhlexPart part, PetscReal t, const PhlexPart
   }
   if (b->floating) {
     PetscCall(PhlexFrameAddLoadArms(&b->frame, X->u, f));
-    /* power of the inputs: b . v + F . v_P + M . w (M with the u arms: b . (w x u) in the full model) */
+    PetscCall(VecAXPY(bext, 1.0, barm));
+    /* power of the inputs: b . v + F . v_P + M . w (M with the u arms of the forces, full model) */
     PetscCall(VecDot(X->v, bext, &p));
     b->power_ext = PetscRealPart(p) + PhlexDot3(f->Fext, f->vP) + PhlexDot3(f->Mext, f->w);
   } else {
@@ -102,18 +105,20 @@ static PetscErrorCode AddJointLoads(PhlexPart part)
       if (w[k] != 0.0) zero = PETSC_FALSE;
     if (zero) continue;
     if (q < b->nports)
-      for (PetscInt k = 0; k < 6; k++)
-        if (w[k] != 0.0) PetscCall(VecAXPY(bext, w[k], b->ports[q].dist[k]));
+      for (PetscInt k = 0; k < 6; k++) {
+        if (w[k] == 0.0) continue;
+        PetscCall(VecAXPY(bext, w[k], b->ports[q].dist[k]));
+        if (b->floating && k < 3) PetscCall(VecAXPY(f->barm, w[k], b->ports[q].dist[k])); /* the Jacobian's arms */
+      }
     if (b->floating) {
-      PetscReal a[3];
+      PetscReal a[3], c[3];
       PhlexCross(part->ports[q].point, w, a);
+      if (!b->frozen_inertia && q < b->nports) PhlexCross(b->port_ubar[q], w, c);
+      else c[0] = c[1] = c[2] = 0.0;
       for (PetscInt k = 0; k < 3; k++) {
         f->Fext[k] += w[k];
-        f->Mext[k] += a[k] + w[3 + k];
+        f->Mext[k] += a[k] + c[k] + w[3 + k];
       }
-      if (!b->frozen_inertia && q < b->nports)
-        for (PetscInt a3 = 0; a3 < 3; a3++)
-          for (PetscInt k = 0; k < 6; k++) f->Mext[a3] += b->port_arm[q][6 * a3 + k] * w[k];
     }
   }
   PetscFunctionReturn(0);
@@ -122,86 +127,40 @@ static PetscErrorCode AddJointLoads(PhlexPart part)
 /* ------------------------------------------------------------------------------------------------------------ */
 /* Ports                                                                                                          */
 
-/* the velocity field whose port averages are the elastic part of the outputs: v (+ w x u, full model) */
-static PetscErrorCode OutputField(PhlexFlexible b, Vec u, PetscReal au, Vec v, const PetscReal w[3], Vec out)
-{
-  PetscFunctionBeginUser;
-  if (v) PetscCall(VecCopy(v, out));
-  else PetscCall(VecSet(out, 0.0));
-  if (u && b->floating && !b->frozen_inertia && au != 0.0) {
-    const PetscScalar *ua;
-    PetscScalar       *oa;
-    PetscInt           n;
-    PetscCall(VecGetLocalSize(u, &n));
-    PetscCall(VecGetArrayRead(u, &ua));
-    PetscCall(VecGetArray(out, &oa));
-    for (PetscInt l = 0; l < n / 3; l++) {
-      PetscReal x[3], a[3];
-      for (PetscInt k = 0; k < 3; k++) x[k] = au * PetscRealPart(ua[3 * l + k]);
-      PhlexCross(w, x, a);
-      for (PetscInt k = 0; k < 3; k++) oa[3 * l + k] += a[k];
-    }
-    PetscCall(VecRestoreArrayRead(u, &ua));
-    PetscCall(VecRestoreArray(out, &oa));
-  }
-  PetscFunctionReturn(0);
-}
+/* Port q's output, the velocity of its mean motion (body frame): translation B_t^T V of the material velocity
+   V = v [+ v_P + w x (x - P + u)], rotation w + B_r^T v. A port turns with its mean rotation theta = B_r^T u, so its
+   angular velocity has no w x u term (to first order in theta); its position r + R (c - P + ubar) has exactly the
+   rate of the translation, so a joint's position-level gap follows its velocity constraint (midpoint rule: exactly
+   for translations). The wrench distribution is the transpose: B w on the elastic rows; F and
+   (c - P + ubar) x F + T on the frame. The ubar terms appear in the full-inertia model only (as the inertia terms). */
 
-/* outputs of the ports (all, or those a joint uses) at the evaluated state; the moment-arm matrices of the full
-   model, A_p[a][k] = sum_l (u(l) x dist_k(l))_a, with one reduction */
+/* the mean displacements of the ports (full model; every port: loads in the inertial frame need them too) and the
+   outputs of the ports (all, or those a joint uses) at the evaluated state */
 static PetscErrorCode PortOutputs(PhlexPart part, const PhlexPartVec *X, PetscBool all)
 {
   PhlexFlexible b    = (PhlexFlexible)part->data;
-  PetscBool     full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE, any = PETSC_FALSE;
+  PetscBool     full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  for (PetscInt q = 0; q < part->nports; q++)
-    if (all || part->port_used[q]) any = PETSC_TRUE;
-  if (!any) PetscFunctionReturn(0);
-  PetscCall(OutputField(b, X->u, 1.0, X->v, b->fs.w, b->work));
   for (PetscInt q = 0; q < part->nports; q++) {
-    PetscScalar d[6] = {0, 0, 0, 0, 0, 0};
+    PetscScalar d[6] = {0, 0, 0, 0, 0, 0}, du[3] = {0, 0, 0};
+    PetscReal   ub[3] = {0, 0, 0};
+    if (full && q < b->nports) {
+      PetscCall(VecMDot(X->u, 3, b->ports[q].dist, du));
+      for (PetscInt k = 0; k < 3; k++) ub[k] = b->port_ubar[q][k] = PetscRealPart(du[k]);
+    }
     if (!(all || part->port_used[q])) continue;
-    if (q < b->nports) PetscCall(VecMDot(b->work, 6, b->ports[q].dist, d));
+    if (q < b->nports) PetscCall(VecMDot(X->v, 6, b->ports[q].dist, d));
     for (PetscInt k = 0; k < 6; k++) b->port_y[q][k] = PetscRealPart(d[k]);
     if (b->floating) {
-      PetscReal a[3];
-      PhlexCross(b->fs.w, part->ports[q].point, a);
+      PetscReal arm[3], a[3];
+      for (PetscInt k = 0; k < 3; k++) arm[k] = part->ports[q].point[k] + ub[k];
+      PhlexCross(b->fs.w, arm, a);
       for (PetscInt k = 0; k < 3; k++) {
         b->port_y[q][k] += b->fs.vP[k] + a[k];
         b->port_y[q][3 + k] += b->fs.w[k];
       }
     }
-  }
-  if (full && !all) {
-    PetscReal         *loc, *glob;
-    const PetscScalar *ua;
-    PetscInt           n, np = b->nports;
-    PetscCall(PetscCalloc2(18 * PetscMax(np, 1), &loc, 18 * PetscMax(np, 1), &glob));
-    PetscCall(VecGetLocalSize(X->u, &n));
-    PetscCall(VecGetArrayRead(X->u, &ua));
-    for (PetscInt q = 0; q < np; q++) {
-      if (!part->port_used[q]) continue;
-      for (PetscInt k = 0; k < 6; k++) {
-        const PetscScalar *da;
-        PetscCall(VecGetArrayRead(b->ports[q].dist[k], &da));
-        for (PetscInt l = 0; l < n / 3; l++) {
-          PetscReal x[3], y[3], a[3];
-          for (PetscInt c = 0; c < 3; c++) {
-            x[c] = PetscRealPart(ua[3 * l + c]);
-            y[c] = PetscRealPart(da[3 * l + c]);
-          }
-          PhlexCross(x, y, a);
-          for (PetscInt c = 0; c < 3; c++) loc[18 * q + 6 * c + k] += a[c];
-        }
-        PetscCall(VecRestoreArrayRead(b->ports[q].dist[k], &da));
-      }
-    }
-    PetscCall(VecRestoreArrayRead(X->u, &ua));
-    PetscCall(MPIU_Allreduce(loc, glob, 18 * np, MPIU_REAL, MPI_SUM, b->comm));
-    for (PetscInt q = 0; q < np; q++)
-      for (PetscInt k = 0; k < 18; k++) b->port_arm[q][k] = glob[18 * q + k];
-    PetscCall(PetscFree2(loc, glob));
   }
   PetscFunctionReturn(0);
 }
@@ -235,25 +194,29 @@ static PetscErrorCode FlexPortLinear(PhlexPart part, PetscInt q, Vec du, PetscRe
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < 6; k++) dy[k] = 0.0;
-  if (q < b->nports && (dv || (du && full))) {
+  if (q < b->nports && dv) {
     PetscScalar d[6];
-    if (du && full) {
-      PetscCall(OutputField(b, du, au, dv, b->fs.w, b->work));
-      PetscCall(VecMDot(b->work, 6, b->ports[q].dist, d));
-    } else PetscCall(VecMDot(dv, 6, b->ports[q].dist, d));
+    PetscCall(VecMDot(dv, 6, b->ports[q].dist, d));
     for (PetscInt k = 0; k < 6; k++) dy[k] = PetscRealPart(d[k]);
+  }
+  if (q < b->nports && du && full && au != 0.0) {
+    /* w x d ubar */
+    PetscScalar d[3];
+    PetscReal   dub[3], a[3];
+    PetscCall(VecMDot(du, 3, b->ports[q].dist, d));
+    for (PetscInt k = 0; k < 3; k++) dub[k] = au * PetscRealPart(d[k]);
+    PhlexCross(b->fs.w, dub, a);
+    for (PetscInt k = 0; k < 3; k++) dy[k] += a[k];
   }
   if (b->floating && dq) {
     const PetscReal *dvP = dq + 12, *dw = dq + 15;
-    PetscReal        a[3];
-    PhlexCross(dw, part->ports[q].point, a);
+    PetscReal        arm[3], a[3];
+    for (PetscInt k = 0; k < 3; k++) arm[k] = part->ports[q].point[k] + (full && q < b->nports ? b->port_ubar[q][k] : 0.0);
+    PhlexCross(dw, arm, a);
     for (PetscInt k = 0; k < 3; k++) {
       dy[k] += dvP[k] + a[k];
       dy[3 + k] += dw[k];
     }
-    /* d/dw of B^T (w x u) = w . sum_l u(l) x dist_k(l) */
-    if (full && q < b->nports)
-      for (PetscInt k = 0; k < 6; k++) dy[k] += dw[0] * b->port_arm[q][k] + dw[1] * b->port_arm[q][6 + k] + dw[2] * b->port_arm[q][12 + k];
   }
   PetscFunctionReturn(0);
 }
@@ -266,7 +229,6 @@ static PetscErrorCode FlexPortLinearBlock(PhlexPart part, PetscInt q, Mat Y, Pet
   const PetscScalar *Ya, *da[6];
   PetscReal         *loc;
   PetscInt           n, k, ld;
-  const PetscReal   *w = b->fs.w;
 
   PetscFunctionBeginUser;
   PetscCall(MatGetSize(Y, NULL, &k));
@@ -278,26 +240,25 @@ static PetscErrorCode FlexPortLinearBlock(PhlexPart part, PetscInt q, Mat Y, Pet
     for (PetscInt c = 0; c < 6; c++) PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da[c]));
     for (PetscInt j = 0; j < k; j++) {
       const PetscScalar *y = Ya + j * ld;
-      for (PetscInt l = 0; l < n / 3; l++) {
-        PetscReal z[3];
-        for (PetscInt c = 0; c < 3; c++) z[c] = PetscRealPart(y[3 * l + c]);
-        if (full) {
-          PetscReal a[3];
-          PhlexCross(w, z, a);
-          for (PetscInt c = 0; c < 3; c++) z[c] += ainv * a[c];
-        }
-        for (PetscInt c = 0; c < 6; c++) loc[6 * j + c] += PetscRealPart(da[c][3 * l]) * z[0] + PetscRealPart(da[c][3 * l + 1]) * z[1] + PetscRealPart(da[c][3 * l + 2]) * z[2];
-      }
+      for (PetscInt i = 0; i < n; i++)
+        for (PetscInt c = 0; c < 6; c++) loc[6 * j + c] += PetscRealPart(da[c][i] * y[i]);
     }
     for (PetscInt c = 0; c < 6; c++) PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da[c]));
     PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
   }
   PetscCall(MPIU_Allreduce(loc, out, 6 * k, MPIU_REAL, MPI_SUM, b->comm));
+  if (full)
+    for (PetscInt j = 0; j < k; j++) {
+      /* translation: + w x (mean of Y/shift) */
+      PetscReal a[3];
+      PhlexCross(b->fs.w, out + 6 * j, a);
+      for (PetscInt c = 0; c < 3; c++) out[6 * j + c] += ainv * a[c];
+    }
   PetscCall(PetscFree(loc));
   PetscFunctionReturn(0);
 }
 
-/* += generalized force of a wrench w on port q: B_q w on the elastic rows, (F, (c - P) x F + T [+ arms]) on the frame */
+/* += generalized force of a wrench w on port q: B_q w on the elastic rows, (F, (c - P [+ ubar]) x F + T) on the frame */
 static PetscErrorCode FlexPortForce(PhlexPart part, PetscInt q, const PetscReal w[6], Vec fv, PetscReal *fq)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
@@ -307,15 +268,13 @@ static PetscErrorCode FlexPortForce(PhlexPart part, PetscInt q, const PetscReal 
     for (PetscInt k = 0; k < 6; k++)
       if (w[k] != 0.0) PetscCall(VecAXPY(fv, w[k], b->ports[q].dist[k]));
   if (b->floating && fq) {
-    PetscReal a[3];
-    PhlexCross(part->ports[q].point, w, a);
+    PetscReal arm[3], a[3];
+    for (PetscInt k = 0; k < 3; k++) arm[k] = part->ports[q].point[k] + (!b->frozen_inertia && q < b->nports ? b->port_ubar[q][k] : 0.0);
+    PhlexCross(arm, w, a);
     for (PetscInt k = 0; k < 3; k++) {
       fq[12 + k] += w[k];
       fq[15 + k] += a[k] + w[3 + k];
     }
-    if (!b->frozen_inertia && q < b->nports)
-      for (PetscInt c = 0; c < 3; c++)
-        for (PetscInt k = 0; k < 6; k++) fq[15 + c] += b->port_arm[q][6 * c + k] * w[k];
   }
   PetscFunctionReturn(0);
 }

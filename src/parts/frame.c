@@ -70,7 +70,7 @@ static inline void InertiaFromE(const PetscReal E[9], PetscReal J[9])
 . q, qd  - rigid state [r | R | v_P | w] and its rate (qd may be NULL)
 
   Notes:
-  The external loads (f->Fext, f->Mext about P, f->bext) are set by the caller afterwards, then
+  The external loads (f->Fext, f->Mext about P, f->bext, f->barm) are set by the caller afterwards, then
   PhlexFrameAddLoadArms adds the u-dependent moment arms of the full model.
 
   Output Parameter:
@@ -91,6 +91,7 @@ PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, 
     PetscCall(VecDuplicate(u, &f->Mud));
     PetscCall(VecDuplicate(u, &f->Mvd));
     PetscCall(VecDuplicate(u, &f->bext));
+    PetscCall(VecDuplicate(u, &f->barm));
   }
   for (PetscInt k = 0; k < 3; k++) {
     f->r[k]  = q[k];
@@ -209,8 +210,8 @@ PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, 
 }
 
 /*@C
-  PhlexFrameAddLoadArms - adds to the moment about P the u-dependent arms of the elastic load in the full model,
-  sum_l u(l) x b_ext(l) (the caller has set f->bext, f->Fext and f->Mext)
+  PhlexFrameAddLoadArms - adds to the moment about P the u-dependent arms of the elastic forces in the full model,
+  sum_l u(l) x b_arm(l) (the caller has set f->barm, f->Fext and f->Mext)
 
   Collective
 @*/
@@ -225,7 +226,7 @@ PetscErrorCode PhlexFrameAddLoadArms(PhlexFrame *fr, Vec u, PhlexFrameState *f)
   if (!fr->frozen) {
     PetscCall(VecGetLocalSize(u, &n));
     PetscCall(VecGetArrayRead(u, &ua));
-    PetscCall(VecGetArrayRead(f->bext, &ba));
+    PetscCall(VecGetArrayRead(f->barm, &ba));
     for (PetscInt l = 0; l < n / 3; l++) {
       PetscReal x[3], y[3], a[3];
       for (PetscInt k = 0; k < 3; k++) {
@@ -236,7 +237,7 @@ PetscErrorCode PhlexFrameAddLoadArms(PhlexFrame *fr, Vec u, PhlexFrameState *f)
       for (PetscInt k = 0; k < 3; k++) Mloc[k] += a[k];
     }
     PetscCall(VecRestoreArrayRead(u, &ua));
-    PetscCall(VecRestoreArrayRead(f->bext, &ba));
+    PetscCall(VecRestoreArrayRead(f->barm, &ba));
     PetscCall(MPIU_Allreduce(Mloc, Mu, 3, MPIU_REAL, MPI_SUM, fr->comm));
     for (PetscInt k = 0; k < 3; k++) f->Mext[k] += Mu[k];
   }
@@ -460,7 +461,7 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
   PetscCall(VecGetArrayRead(f->Mvv, &Mvva));
   PetscCall(VecGetArrayRead(f->Mud, &Muda));
   PetscCall(VecGetArrayRead(f->Mvd, &Mvda));
-  PetscCall(VecGetArrayRead(f->bext, &ba));
+  PetscCall(VecGetArrayRead(f->barm, &ba));
   for (PetscInt col = 0; col < 18; col++)
     for (PetscInt i = 0; i < n; i++) Bc[col * ld + i] = Cu[col * ld + i] = Cv[col * ld + i] = 0.0;
   for (PetscInt l = 0; l < n / 3; l++) {
@@ -550,7 +551,7 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
           PhlexCross(ee, Mvdl, t6);   /* e_e x Mv v' from L' */
           PhlexCross(w, ee, t1);
           PhlexCross(vP, t1, t2);     /* vP x (w x e_e) t from vP x p_t */
-          PhlexCross(ee, bl, b3);     /* - e_e x b_ext from -M */
+          PhlexCross(ee, bl, b3);     /* - e_e x b_arm from -M */
           for (PetscInt k = 0; k < 3; k++) Cu[(15 + k) * ld + colidx] += shift * tl * t3[k] + tl * t4[k] + shift * D[3 * k + e] + Dd[3 * k + e] + Dwd[3 * k + e] + shift * t5[k] + t6[k] + c3[k] + tl * t2[k] - b3[k];
         }
       }
@@ -562,7 +563,7 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
   PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
   PetscCall(VecRestoreArrayRead(f->Mud, &Muda));
   PetscCall(VecRestoreArrayRead(f->Mvd, &Mvda));
-  PetscCall(VecRestoreArrayRead(f->bext, &ba));
+  PetscCall(VecRestoreArrayRead(f->barm, &ba));
   PetscFunctionReturn(0);
 }
 
@@ -613,6 +614,7 @@ PetscErrorCode PhlexFrameStateDestroy(PhlexFrameState *f)
   PetscCall(VecDestroy(&f->Mud));
   PetscCall(VecDestroy(&f->Mvd));
   PetscCall(VecDestroy(&f->bext));
+  PetscCall(VecDestroy(&f->barm));
   PetscFunctionReturn(0);
 }
 
