@@ -1,11 +1,12 @@
 /* Joints: transformer interconnections of two ports at velocity level (paper Section 5, DESIGN section 3).
 
    A joint between port a (of part A) and port b (of part B, or the ground) constrains the velocity of b relative
-   to a, Delta = R_ab y~_b - y~_a (a's body frame; R_ab = R_a^T R_b, y~ = the port output moved to the joint point),
+   to a, Delta = R_ab y~_b - G y~_a (a's body frame; R_ab = R_a^T R_b, G = R_a^T R_a, y~ = the port output moved to the
+   joint point),
    along directions s_k fixed in a's joint frame:
        c_k = s_k . Delta - g_k(t) = 0          (g = 0 for a workless joint; a prescribed motion otherwise)
    Its impulses Lambda_k are unknowns; their rates lambda_k are the multipliers. They enter the two parts through the
-   same port distributions as wrenches, w_a = -T_a^T S lambda on port a and w_b = T_b^T R_ab^T S lambda on port b, so
+   same port distributions as wrenches, w_a = -T_a^T G S lambda on port a and w_b = T_b^T R_ab^T S lambda on port b, so
    that w_a . y_a + w_b . y_b = lambda . (c + g): the interconnection is power preserving (lossless for g = 0). */
 #ifndef PHLEX_PRIVATE_JOINT_H
 #define PHLEX_PRIVATE_JOINT_H
@@ -33,7 +34,9 @@ typedef struct {
   char      spec[2 * PHLEX_NAME_LEN + 2]; /* "body:port" or "ground" as given */
   PhlexPart part;                         /* the ground part for the ground */
   PetscInt  port;                         /* port index, -1 for the ground */
-  PetscReal offset[3];                    /* joint point relative to the port point, body frame (ground: the inertial point) */
+  PetscReal offset[3];                    /* joint point relative to the port point, port frame (ground: the inertial point) */
+  PetscReal arm[3];                       /* the offset in the body frame: turned by the port's own rotation relative to
+                                             the body frame (a flexible port's mean rotation) at the last accepted state */
   PetscBool rotation;                     /* the side has an orientation (not a point mass, not the ground... ground: yes) */
 } PhlexJointSide;
 
@@ -54,8 +57,10 @@ struct _p_PhlexJoint {
   PetscInt      nc;        /* rows kept */
   PhlexJointRow row[7];
   char          rowname[7][8];
-  PetscReal     frame[9];  /* rows e1, e2, e3 of a's joint frame, in a's body frame */
-  PetscReal     axis_b[3]; /* universal: second axis in b's body frame */
+  PetscReal     frame[9];  /* rows e1, e2, e3 of a's joint frame, in a's port frame */
+  PetscReal     axis_b[3]; /* universal: second axis in b's port frame */
+  PetscReal     dir[9];    /* e1, e2, e3 in a's body frame and */
+  PetscReal     eb[3];     /* the second axis in b's body frame, at the last accepted state (PhlexJointUpdateGeometry) */
   PetscReal     Rrel0[9];  /* R~_a^T R~_b at the drawn configuration (port orientations) */
   PetscInt      ndropped;  /* rows removed as redundant */
   char          dropped[7][8];
@@ -73,7 +78,7 @@ struct _p_PhlexJoint {
 
   /* evaluated */
   PetscReal ya[6], yb[6]; /* port outputs moved to the joint point (body frames) */
-  PetscReal Ra[9], Rb[9], Rab[9];
+  PetscReal Ra[9], Rb[9], Rab[9], G[9]; /* G = R_a^T R_a (the identity but at a step's midpoint) */
   PetscReal lambda[7];
   PetscReal c[7];
 
@@ -87,6 +92,7 @@ struct _p_PhlexJoint {
 
 PETSC_INTERN PetscErrorCode PhlexJointResolve(PhlexJoint);
 PETSC_INTERN PetscErrorCode PhlexJointSetUp(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *);
+PETSC_INTERN PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexJointEvaluate(PhlexJoint, PetscReal, const PetscReal *, const PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointApplyWrenches(PhlexJoint);
 PETSC_INTERN PetscErrorCode PhlexJointResidual(PhlexJoint, PetscReal, PetscReal *);
@@ -101,7 +107,7 @@ PETSC_INTERN PetscErrorCode PhlexJointRelativeMotion(PhlexJoint, const PhlexPart
 PETSC_INTERN PetscErrorCode PhlexJointRigidGradient(PhlexJoint, PetscReal *, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointDropRow(PhlexJoint, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointOutputOpen(PhlexJoint, PhlexOutput);
-PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointPower(PhlexJoint, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointOutputClose(PhlexJoint);
 PETSC_INTERN PetscBool      PhlexJointTouches(PhlexJoint, PhlexPart);

@@ -77,6 +77,9 @@ PETSC_INTERN PetscErrorCode PhlexSystemPartVec(PhlexSystem, PhlexPart, Vec, Pets
 PETSC_INTERN PetscErrorCode PhlexSystemPartVecRestore(PhlexSystem, PhlexPart, Vec, PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexSystemInitialState(PhlexSystem, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemPostStep(PhlexSystem, Vec, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexSystemJointSides(PhlexSystem, PhlexJoint, Vec, PetscReal *, PhlexPartVec[2]);
+PETSC_INTERN PetscErrorCode PhlexSystemJointSidesRestore(PhlexSystem, PhlexJoint, Vec, PhlexPartVec[2]);
+PETSC_INTERN PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem, Vec, PetscReal);
 PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);

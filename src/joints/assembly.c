@@ -9,35 +9,6 @@
      projection: M (z - z0) = G^T Lambda, G z = g). */
 #include <phlex_impl.h>
 
-/* the part vectors of both sides of joint j at X */
-static PetscErrorCode Sides(PhlexSystem sys, PhlexJoint j, Vec X, PhlexPartVec pv[2])
-{
-  PetscFunctionBeginUser;
-  for (PetscInt s = 0; s < 2; s++) {
-    PhlexPart p = j->side[s].part;
-    pv[s].u = pv[s].s = pv[s].v = NULL;
-    pv[s].q                     = NULL;
-    if (PhlexPartIsGround(p)) continue;
-    if (s == 1 && p == j->side[0].part) {
-      pv[1] = pv[0];
-      continue;
-    }
-    PetscCall(PhlexPartGetVec(p, X, sys->q, &pv[s]));
-  }
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode SidesRestore(PhlexSystem sys, PhlexJoint j, Vec X, PhlexPartVec pv[2])
-{
-  PetscFunctionBeginUser;
-  for (PetscInt s = 0; s < 2; s++) {
-    PhlexPart p = j->side[s].part;
-    if (PhlexPartIsGround(p) || (s == 1 && p == j->side[0].part)) continue;
-    PetscCall(PhlexPartRestoreVec(p, X, &pv[s]));
-  }
-  PetscFunctionReturn(0);
-}
-
 /*@C
   PhlexAssemblyPlaceAttached - a part attached to a port (a lumped mass) given no position of its own is put on the
   port at the drawn configuration
@@ -188,9 +159,9 @@ static PetscErrorCode Gaps(PhlexSystem sys, PetscReal t, Vec X, PetscReal *gap, 
   for (PetscInt k = 0; k < sys->njoints; k++) {
     PhlexJoint   j = sys->joints[k];
     PhlexPartVec pv[2];
-    PetscCall(Sides(sys, j, X, pv));
+    PetscCall(PhlexSystemJointSides(sys, j, X, sys->q, pv));
     PetscCall(PhlexJointGap(j, t, &pv[0], &pv[1], gap + n));
-    PetscCall(SidesRestore(sys, j, X, pv));
+    PetscCall(PhlexSystemJointSidesRestore(sys, j, X, pv));
     for (PetscInt c = 0; c < j->nc; c++) {
       const PetscReal g = PetscAbsReal(gap[n + c]) * (j->row[c] <= PHLEX_ROW_T3 ? sys->units->length : 1.0);
       if (g > *gmax) {
@@ -442,8 +413,14 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
   PetscCall(SNESCreate(sys->comm, &snes));
   PetscCall(SNESSetDM(snes, sys->dm_aux));
   PetscCall(SNESSetFunction(snes, F, ShortStepFunction, &c));
-  PetscCall(SNESSetJacobian(snes, sys->J, sys->J, ShortStepJacobian, &c));
+  PetscCall(SNESSetJacobian(snes, sys->use_aij ? sys->Jaij : sys->J, sys->use_aij ? sys->Jaij : sys->J, ShortStepJacobian, &c));
   PetscCall(SNESSetTolerances(snes, 1e-50, 1e-12, 0.0, 20, PETSC_DEFAULT));
+  {
+    SNESLineSearch ls;
+    /* full Newton steps: a line search cannot improve on the residual's round-off floor */
+    PetscCall(SNESGetLineSearch(snes, &ls));
+    PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
+  }
   PetscCall(SNESSetFromOptions(snes));
   PetscCall(SNESSetConvergenceTest(snes, PhlexSystemSNESConverged, sys, NULL));
 

@@ -71,33 +71,34 @@ static void RowDirection(PhlexJoint j, PetscInt k, const PetscReal Rab[9], const
   case PHLEX_ROW_T2:
   case PHLEX_ROW_T3:
     if (!dRab)
-      for (PetscInt c = 0; c < 3; c++) s[c] = j->frame[3 * (j->row[k] - PHLEX_ROW_T1) + c];
+      for (PetscInt c = 0; c < 3; c++) s[c] = j->dir[3 * (j->row[k] - PHLEX_ROW_T1) + c];
     break;
   case PHLEX_ROW_R1:
   case PHLEX_ROW_R2:
   case PHLEX_ROW_R3:
     if (!dRab)
-      for (PetscInt c = 0; c < 3; c++) s[3 + c] = j->frame[3 * (j->row[k] - PHLEX_ROW_R1) + c];
+      for (PetscInt c = 0; c < 3; c++) s[3 + c] = j->dir[3 * (j->row[k] - PHLEX_ROW_R1) + c];
     break;
   case PHLEX_ROW_CROSS: {
     /* n = e_a x (R_ab e_b): both axes turn with their bodies */
     PetscReal eb[3];
-    PhlexMatVec3(dRab ? dRab : Rab, j->axis_b, eb);
-    PhlexCross(j->frame + 6, eb, s + 3);
+    PhlexMatVec3(dRab ? dRab : Rab, j->eb, eb);
+    PhlexCross(j->dir + 6, eb, s + 3);
   } break;
   }
 }
 
-/* dR_ab for the entry m of R of side s (R_ab = R_a^T R_b) */
-static void RabDerivative(PetscInt s, PetscInt m, const PetscReal Ra[9], const PetscReal Rb[9], PetscReal dRab[9])
+/* dR_ab and dG for the entry m of R of side s (R_ab = R_a^T R_b, G = R_a^T R_a) */
+static void RabDerivative(PetscInt s, PetscInt m, const PetscReal Ra[9], const PetscReal Rb[9], PetscReal dRab[9], PetscReal dG[9])
 {
   const PetscInt i = m / 3, jj = m % 3;
 
-  for (PetscInt k = 0; k < 9; k++) dRab[k] = 0.0;
+  for (PetscInt k = 0; k < 9; k++) dRab[k] = dG[k] = 0.0;
   for (PetscInt k = 0; k < 3; k++)
     for (PetscInt l = 0; l < 3; l++) {
       if (s == 0 && k == jj) dRab[3 * k + l] = Rb[3 * i + l]; /* d(R_a)_ij: delta_kj (R_b)_il */
       if (s == 1 && l == jj) dRab[3 * k + l] = Ra[3 * i + k]; /* d(R_b)_ij: (R_a)_ik delta_lj */
+      if (s == 0) dG[3 * k + l] = (k == jj ? Ra[3 * i + l] : 0.0) + (l == jj ? Ra[3 * i + k] : 0.0);
     }
 }
 
@@ -286,28 +287,40 @@ PetscErrorCode PhlexJointResolve(PhlexJoint j)
   PetscFunctionReturn(0);
 }
 
+/* a side's port orientation Rp (inertial) and its body frame R_f at X (the ground: identity) */
+static PetscErrorCode SidePlacement(PhlexJoint j, PetscInt s, const PhlexPartVec *X, PetscReal xp[3], PetscReal Rp[9], PetscReal Rf[9])
+{
+  PhlexJointSide *side = &j->side[s];
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 9; k++) Rf[k] = Rp[k] = (k % 4 == 0) ? 1.0 : 0.0;
+  for (PetscInt k = 0; k < 3; k++) xp[k] = 0.0;
+  if (PhlexPartIsGround(side->part)) PetscFunctionReturn(0);
+  PetscCall((*side->part->ops.portplacement)(side->part, side->port, X, xp, Rp));
+  if (side->part->frame.R >= 0)
+    for (PetscInt k = 0; k < 9; k++) Rf[k] = X->q[side->part->frame.R + k];
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexJointSetUp - the joint's geometry from the drawn configuration (the initial state): joint point offsets
-  on both ports, the joint frame in a's body frame, the reference relative orientation
+  on both ports, the joint frame and the universal's second axis in the port frames, the reference relative
+  orientation
 
   Collective
+
+  Notes:
+  The joint frame is attached to port a (offsets and the second axis to their ports): it turns with the body and,
+  on a flexible body, with the port's mean rotation relative to the body frame.
 @*/
 PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb)
 {
-  const PhlexUnits *u = &j->scene->units;
+  const PhlexUnits   *u = &j->scene->units;
   const PhlexPartVec *X[2] = {Xa, Xb};
-  PetscReal         xp[2][3], Rp[2][9], Rf[2][9], xJ[3];
+  PetscReal           xp[2][3], Rp[2][9], Rf[2][9], xJ[3];
 
   PetscFunctionBeginUser;
-  for (PetscInt s = 0; s < 2; s++) {
-    PhlexJointSide *side = &j->side[s];
-    for (PetscInt k = 0; k < 9; k++) Rf[s][k] = Rp[s][k] = (k % 4 == 0) ? 1.0 : 0.0;
-    for (PetscInt k = 0; k < 3; k++) xp[s][k] = 0.0;
-    if (PhlexPartIsGround(side->part)) continue;
-    PetscCall((*side->part->ops.portplacement)(side->part, side->port, X[s], xp[s], Rp[s]));
-    if (side->part->frame.R >= 0)
-      for (PetscInt k = 0; k < 9; k++) Rf[s][k] = X[s]->q[side->part->frame.R + k];
-  }
+  for (PetscInt s = 0; s < 2; s++) PetscCall(SidePlacement(j, s, X[s], xp[s], Rp[s], Rf[s]));
   /* the joint point: as given, else the first port's point (the other one if that is the ground) */
   if (j->position_given)
     for (PetscInt k = 0; k < 3; k++) xJ[k] = j->position[k] / u->length;
@@ -320,28 +333,58 @@ PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const Phlex
     } else if (j->position_given) {
       PetscReal d[3];
       for (PetscInt k = 0; k < 3; k++) d[k] = xJ[k] - xp[s][k];
-      PhlexMatTVec3(Rf[s], d, side->offset);
+      PhlexMatTVec3(Rp[s], d, side->offset);
     } else
       for (PetscInt k = 0; k < 3; k++) side->offset[k] = 0.0; /* the port points must meet: the assembly closes a gap */
   }
-  /* the joint frame (rows e1, e2, e3) in a's body frame */
+  /* the joint frame (rows e1, e2, e3) in a's port frame */
   {
-    PetscReal F[9], e[3];
+    PetscReal F[9];
     if (j->axis_given) PhlexCompleteFrame(j->axis, j->reference_given ? j->reference : NULL, F);
     else if (j->reference_given) PhlexCompleteFrame((PetscReal[3]){0, 0, 1}, j->reference, F);
     else
       for (PetscInt k = 0; k < 9; k++) F[k] = (k % 4 == 0) ? 1.0 : 0.0;
-    for (PetscInt r = 0; r < 3; r++) {
-      PhlexMatTVec3(Rf[0], F + 3 * r, e);
-      for (PetscInt k = 0; k < 3; k++) j->frame[3 * r + k] = e[k];
-    }
+    for (PetscInt r = 0; r < 3; r++) PhlexMatTVec3(Rp[0], F + 3 * r, j->frame + 3 * r);
     if (j->type == PHLEX_JOINT_UNIVERSAL) {
       PetscReal n = PhlexNorm3(j->axis2), a2[3];
       for (PetscInt k = 0; k < 3; k++) a2[k] = j->axis2[k] / n;
-      PhlexMatTVec3(Rf[1], a2, j->axis_b);
+      PhlexMatTVec3(Rp[1], a2, j->axis_b);
     }
   }
   PhlexMatTMat3(Rp[0], Rp[1], j->Rrel0);
+  PetscCall(PhlexJointUpdateGeometry(j, Xa, Xb));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointUpdateGeometry - the joint's directions and arms in the body frames at an accepted state X: the port
+  frame relative to the body frame, P = R_f^T Rp (identity but on a flexible port: its mean rotation), turns the
+  joint frame, the universal's second axis and the offsets
+
+  Collective
+
+  Notes:
+  Called at set-up and after every step. Within a step P is held (lagged by one step): the rows and the wrenches
+  use the same directions, so the joint stays exactly workless, and the Jacobian has no term from P; the joint
+  frame follows the port's elastic rotation up to its change over one step.
+@*/
+PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb)
+{
+  const PhlexPartVec *X[2] = {Xa, Xb};
+  PetscReal           P[2][9];
+
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < 2; s++) {
+    PhlexJointSide *side = &j->side[s];
+    PetscReal       xp[3], Rp[9], Rf[9];
+    PetscCall(SidePlacement(j, s, X[s], xp, Rp, Rf));
+    PhlexMatTMat3(Rf, Rp, P[s]);
+    if (PhlexPartIsGround(side->part))
+      for (PetscInt k = 0; k < 3; k++) side->arm[k] = side->offset[k];
+    else PhlexMatVec3(P[s], side->offset, side->arm);
+  }
+  for (PetscInt r = 0; r < 3; r++) PhlexMatVec3(P[0], j->frame + 3 * r, j->dir + 3 * r);
+  PhlexMatVec3(P[1], j->axis_b, j->eb);
   PetscFunctionReturn(0);
 }
 
@@ -364,11 +407,12 @@ PetscErrorCode PhlexJointEvaluate(PhlexJoint j, PetscReal t, const PetscReal *q,
     for (PetscInt k = 0; k < 6; k++) yt[k] = 0.0;
     if (PhlexPartIsGround(side->part)) continue;
     PetscCall((*side->part->ops.portoutput)(side->part, side->port, y));
-    MoveToJoint(side->offset, y, yt);
+    MoveToJoint(side->arm, y, yt);
   }
   SideRotation(j, 0, q, j->Ra);
   SideRotation(j, 1, q, j->Rb);
   PhlexMatTMat3(j->Ra, j->Rb, j->Rab);
+  PhlexMatTMat3(j->Ra, j->Ra, j->G);
   for (PetscInt k = 0; k < j->nc; k++) j->lambda[k] = qd ? T * qd[j->qoff + k] : 0.0;
   PetscFunctionReturn(0);
 }
@@ -384,20 +428,26 @@ static void JointWrench(PhlexJoint j, const PetscReal *lambda, const PetscReal *
   }
 }
 
-/* the port wrenches of a joint wrench w_J (and of its change dw_J with dRab): a gets -w_J, b gets R_ab^T w_J */
-static void PortWrenches(PhlexJoint j, const PetscReal wJ[6], const PetscReal *dwJ, const PetscReal *dRab, PetscReal wa[6], PetscReal wb[6])
+/* the port wrenches of a joint wrench w_J (and of its change dw_J with dRab, dG): a gets -G w_J, b gets R_ab^T w_J */
+static void PortWrenches(PhlexJoint j, const PetscReal wJ[6], const PetscReal *dwJ, const PetscReal *dRab, const PetscReal *dG, PetscReal wa[6], PetscReal wb[6])
 {
   PetscReal na[6], wbJ[6], t[6];
 
-  for (PetscInt c = 0; c < 6; c++) na[c] = -(dwJ ? dwJ[c] : wJ[c]);
-  MoveToPort(j->side[0].offset, na, wa);
   if (dRab) {
-    /* d(R_ab^T w_J) = dR_ab^T w_J + R_ab^T dw_J */
+    /* d(G w_J) = dG w_J + G dw_J, d(R_ab^T w_J) = dR_ab^T w_J + R_ab^T dw_J */
+    Rotate6(dG, PETSC_FALSE, wJ, na);
+    Rotate6(j->G, PETSC_FALSE, dwJ, t);
+    for (PetscInt c = 0; c < 6; c++) na[c] = -(na[c] + t[c]);
     Rotate6(dRab, PETSC_TRUE, wJ, wbJ);
     Rotate6(j->Rab, PETSC_TRUE, dwJ, t);
     for (PetscInt c = 0; c < 6; c++) wbJ[c] += t[c];
-  } else Rotate6(j->Rab, PETSC_TRUE, wJ, wbJ);
-  MoveToPort(j->side[1].offset, wbJ, wb);
+  } else {
+    Rotate6(j->G, PETSC_FALSE, wJ, na);
+    for (PetscInt c = 0; c < 6; c++) na[c] = -na[c];
+    Rotate6(j->Rab, PETSC_TRUE, wJ, wbJ);
+  }
+  MoveToPort(j->side[0].arm, na, wa);
+  MoveToPort(j->side[1].arm, wbJ, wb);
 }
 
 /*@C
@@ -409,7 +459,7 @@ PetscErrorCode PhlexJointApplyWrenches(PhlexJoint j)
 
   PetscFunctionBeginUser;
   JointWrench(j, j->lambda, NULL, wJ);
-  PortWrenches(j, wJ, NULL, NULL, w[0], w[1]);
+  PortWrenches(j, wJ, NULL, NULL, NULL, w[0], w[1]);
   for (PetscInt s = 0; s < 2; s++) {
     PhlexPart p = j->side[s].part;
     if (PhlexPartIsGround(p)) continue;
@@ -418,13 +468,17 @@ PetscErrorCode PhlexJointApplyWrenches(PhlexJoint j)
   PetscFunctionReturn(0);
 }
 
-/* Delta = R_ab y~_b - y~_a, the relative velocity (a's body frame) */
+/* Delta = R_a^T (R_b y~_b - R_a y~_a) = R_ab y~_b - G y~_a, the relative velocity (a's body frame). The metric
+   G = R_a^T R_a is the identity for an orthogonal R_a, but not at the midpoint of a step (the mean of two
+   rotations): written this way, a joint that holds the whole translation keeps the inertial velocities of its
+   points equal, so the midpoint rule moves them alike and the joint does not drift. */
 static void Relative(PhlexJoint j, PetscReal D[6])
 {
-  PetscReal r[6];
+  PetscReal r[6], a[6];
 
   Rotate6(j->Rab, PETSC_FALSE, j->yb, r);
-  for (PetscInt c = 0; c < 6; c++) D[c] = r[c] - j->ya[c];
+  Rotate6(j->G, PETSC_FALSE, j->ya, a);
+  for (PetscInt c = 0; c < 6; c++) D[c] = r[c] - a[c];
 }
 
 /* g_k(t): the prescribed relative velocity of row k (non-dimensional) */
@@ -493,10 +547,12 @@ static PetscErrorCode RowsFromPortChange(PhlexJoint j, PetscInt s, const PetscRe
   PetscReal dyt[6], r[6];
 
   PetscFunctionBeginUser;
-  MoveToJoint(j->side[s].offset, dy, dyt);
+  MoveToJoint(j->side[s].arm, dy, dyt);
   if (s == 1) Rotate6(j->Rab, PETSC_FALSE, dyt, r);
-  else
-    for (PetscInt c = 0; c < 6; c++) r[c] = -dyt[c];
+  else {
+    Rotate6(j->G, PETSC_FALSE, dyt, r);
+    for (PetscInt c = 0; c < 6; c++) r[c] = -r[c];
+  }
   for (PetscInt k = 0; k < j->nc; k++) {
     PetscReal sk[6];
     RowDirection(j, k, j->Rab, NULL, sk);
@@ -538,7 +594,7 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
       PetscReal e[7] = {0, 0, 0, 0, 0, 0, 0}, wk[6], w[2][6], *fq;
       e[k] = 1.0;
       JointWrench(j, e, NULL, wk);
-      PortWrenches(j, wk, NULL, NULL, w[0], w[1]);
+      PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
       PetscCall(PetscCalloc1(p->nq, &fq));
       PetscCall((*p->ops.portforce)(p, j->side[s].port, w[s], NULL, fq));
       for (PetscInt m = 0; m < p->nq; m++) D[ld * (p->qoff + m) + j->qoff + k] -= shift * fq[m];
@@ -551,9 +607,11 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
     if (PhlexPartIsGround(p) || p->frame.R < 0) continue;
     for (PetscInt m = 0; m < 9; m++) {
       const PetscInt col = QIndex(p, p->frame.R + m);
-      PetscReal      dRab[9], r[6], dwJ[6], w[2][6];
-      RabDerivative(s, m, j->Ra, j->Rb, dRab);
+      PetscReal      dRab[9], dG[9], r[6], ra[6], dwJ[6], w[2][6];
+      RabDerivative(s, m, j->Ra, j->Rb, dRab, dG);
       Rotate6(dRab, PETSC_FALSE, j->yb, r);
+      Rotate6(dG, PETSC_FALSE, j->ya, ra);
+      for (PetscInt c = 0; c < 6; c++) r[c] -= ra[c];
       for (PetscInt k = 0; k < j->nc; k++) {
         PetscReal sk[6], dsk[6];
         RowDirection(j, k, j->Rab, NULL, sk);
@@ -567,7 +625,7 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
           RowDirection(j, k, j->Rab, dRab, dsk);
           for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
         }
-      PortWrenches(j, wJ, dwJ, dRab, w[0], w[1]);
+      PortWrenches(j, wJ, dwJ, dRab, dG, w[0], w[1]);
       for (PetscInt t = 0; t < 2; t++) {
         PhlexPart  pt = j->side[t].part;
         PetscReal *fq;
@@ -592,7 +650,7 @@ static PetscErrorCode WrenchChange(PhlexJoint j, PetscInt s, PetscReal shift, co
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < j->nc; k++) dl[k] = shift * x[j->qoff + k];
   JointWrench(j, dl, NULL, wk);
-  PortWrenches(j, wk, NULL, NULL, w[0], w[1]);
+  PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
   for (PetscInt c = 0; c < 6; c++) dw[c] = w[s][c];
   JointWrench(j, j->lambda, NULL, wJ);
   for (PetscInt t = 0; t < 2; t++) {
@@ -600,16 +658,16 @@ static PetscErrorCode WrenchChange(PhlexJoint j, PetscInt s, PetscReal shift, co
     if (PhlexPartIsGround(p) || p->frame.R < 0) continue;
     for (PetscInt m = 0; m < 9; m++) {
       const PetscReal xm = x[QIndex(p, p->frame.R + m)];
-      PetscReal       dRab[9], dwJ[6] = {0, 0, 0, 0, 0, 0};
+      PetscReal       dRab[9], dG[9], dwJ[6] = {0, 0, 0, 0, 0, 0};
       if (xm == 0.0) continue;
-      RabDerivative(t, m, j->Ra, j->Rb, dRab);
+      RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
       for (PetscInt k = 0; k < j->nc; k++)
         if (j->row[k] == PHLEX_ROW_CROSS) {
           PetscReal dsk[6];
           RowDirection(j, k, j->Rab, dRab, dsk);
           for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
         }
-      PortWrenches(j, wJ, dwJ, dRab, w[0], w[1]);
+      PortWrenches(j, wJ, dwJ, dRab, dG, w[0], w[1]);
       for (PetscInt c = 0; c < 6; c++) dw[c] += xm * w[s][c];
     }
   }
@@ -698,22 +756,22 @@ PetscErrorCode PhlexJointBorderCoefficients(PhlexJoint j, PhlexPart part, PetscR
       PetscReal e[7] = {0, 0, 0, 0, 0, 0, 0}, wk[6], w[2][6];
       e[k] = 1.0;
       JointWrench(j, e, NULL, wk);
-      PortWrenches(j, wk, NULL, NULL, w[0], w[1]);
+      PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
       for (PetscInt c = 0; c < 6; c++) beta[c0 + c + ld * (j->qoff + k)] -= shift * w[s][c];
     }
     for (PetscInt t = 0; t < 2; t++) {
       PhlexPart p = j->side[t].part;
       if (PhlexPartIsGround(p) || p->frame.R < 0) continue;
       for (PetscInt m = 0; m < 9; m++) {
-        PetscReal dRab[9], dwJ[6] = {0, 0, 0, 0, 0, 0}, w[2][6];
-        RabDerivative(t, m, j->Ra, j->Rb, dRab);
+        PetscReal dRab[9], dG[9], dwJ[6] = {0, 0, 0, 0, 0, 0}, w[2][6];
+        RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
         for (PetscInt k = 0; k < j->nc; k++)
           if (j->row[k] == PHLEX_ROW_CROSS) {
             PetscReal dsk[6];
             RowDirection(j, k, j->Rab, dRab, dsk);
             for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
           }
-        PortWrenches(j, wJ, dwJ, dRab, w[0], w[1]);
+        PortWrenches(j, wJ, dwJ, dRab, dG, w[0], w[1]);
         for (PetscInt c = 0; c < 6; c++) beta[c0 + c + ld * QIndex(p, p->frame.R + m)] -= w[s][c];
       }
     }
@@ -766,9 +824,9 @@ PetscErrorCode PhlexJointDrivePosition(PhlexJoint j, PetscReal t, PetscReal *x)
   PetscFunctionReturn(0);
 }
 
-/* placements of both joint points (inertial), the rotation of b relative to a since the drawn configuration E
-   (a's frame), and Delta x = R_a^T (x_b - x_a) */
-static PetscErrorCode Placements(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal dx[3], PetscReal E[9], PetscReal Ra[9])
+/* the joint points from the placements of both ports (inertial): Delta x = Rp_a^T (x_b - x_a) and the rotation E of
+   b's port relative to a's since the drawn configuration, both in a's port frame (where the joint frame lives) */
+static PetscErrorCode Placements(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal dx[3], PetscReal E[9])
 {
   const PhlexPartVec *X[2] = {Xa, Xb};
   PetscReal           x[2][3], Rp[2][9], Rrel[9];
@@ -776,25 +834,20 @@ static PetscErrorCode Placements(PhlexJoint j, const PhlexPartVec *Xa, const Phl
   PetscFunctionBeginUser;
   for (PetscInt s = 0; s < 2; s++) {
     PhlexJointSide *side = &j->side[s];
-    PetscReal       Rf[9], d[3];
+    PetscReal       d[3];
     if (PhlexPartIsGround(side->part)) {
       for (PetscInt k = 0; k < 3; k++) x[s][k] = side->offset[k];
-      for (PetscInt k = 0; k < 9; k++) Rp[s][k] = Rf[k] = (k % 4 == 0) ? 1.0 : 0.0;
+      for (PetscInt k = 0; k < 9; k++) Rp[s][k] = (k % 4 == 0) ? 1.0 : 0.0;
     } else {
       PetscCall((*side->part->ops.portplacement)(side->part, side->port, X[s], x[s], Rp[s]));
-      for (PetscInt k = 0; k < 9; k++) Rf[k] = (k % 4 == 0) ? 1.0 : 0.0;
-      if (side->part->frame.R >= 0)
-        for (PetscInt k = 0; k < 9; k++) Rf[k] = X[s]->q[side->part->frame.R + k];
-      PhlexMatVec3(Rf, side->offset, d);
+      PhlexMatVec3(Rp[s], side->offset, d);
       for (PetscInt k = 0; k < 3; k++) x[s][k] += d[k];
     }
-    if (s == 0)
-      for (PetscInt k = 0; k < 9; k++) Ra[k] = Rf[k];
   }
   {
     PetscReal d[3];
     for (PetscInt k = 0; k < 3; k++) d[k] = x[1][k] - x[0][k];
-    PhlexMatTVec3(Ra, d, dx);
+    PhlexMatTVec3(Rp[0], d, dx);
   }
   PhlexMatTMat3(Rp[0], Rp[1], Rrel);
   PhlexMatMatT3(Rrel, j->Rrel0, E);
@@ -818,10 +871,10 @@ static PetscReal AngleAboutAxis(PhlexJoint j, const PetscReal E[9])
 @*/
 PetscErrorCode PhlexJointGap(PhlexJoint j, PetscReal t, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal gap[7])
 {
-  PetscReal dx[3], E[9], Ra[9], phi[3], Ee3[3], perp[3];
+  PetscReal dx[3], E[9], phi[3], Ee3[3], perp[3];
 
   PetscFunctionBeginUser;
-  PetscCall(Placements(j, Xa, Xb, dx, E, Ra));
+  PetscCall(Placements(j, Xa, Xb, dx, E));
   PhlexRotationVector(E, phi);
   PhlexMatVec3(E, j->frame + 6, Ee3);
   PhlexCross(j->frame + 6, Ee3, perp); /* the misalignment of the axis: e3 x (E e3) */
@@ -864,10 +917,10 @@ PetscErrorCode PhlexJointGap(PhlexJoint j, PetscReal t, const PhlexPartVec *Xa, 
 @*/
 PetscErrorCode PhlexJointRelativeMotion(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal m[6], PetscInt *n)
 {
-  PetscReal dx[3], E[9], Ra[9];
+  PetscReal dx[3], E[9];
 
   PetscFunctionBeginUser;
-  PetscCall(Placements(j, Xa, Xb, dx, E, Ra));
+  PetscCall(Placements(j, Xa, Xb, dx, E));
   *n = 0;
   switch (j->type) {
   case PHLEX_JOINT_REVOLUTE:
@@ -981,28 +1034,28 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
 }
 
 /*@C
-  PhlexJointOutputStep - one row of the joint's series (SI) with the multipliers lambda (non-dimensional) at the
-  evaluated state; returns the largest violation of its rows (SI: m or rad)
+  PhlexJointOutputStep - one row of the joint's series (SI): the multipliers lambda of the step and the power P
+  through the joint over the step (non-dimensional, from the monitor: at the state where the scheme enforces the
+  constraints), the relative motion and the violations at the state X; returns the largest violation (SI: m or rad)
 
   Collective
 @*/
-PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
+PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
 {
   const PhlexUnits *u = &j->scene->units;
-  PetscReal         wJ[6], mo[6], gap[7], P;
+  PetscReal         wJ[6], mo[6], gap[7];
   PetscInt          nm;
 
   PetscFunctionBeginUser;
   JointWrench(j, lambda, NULL, wJ);
   PetscCall(PhlexJointRelativeMotion(j, Xa, Xb, mo, &nm));
   PetscCall(PhlexJointGap(j, t, Xa, Xb, gap));
-  PetscCall(PhlexJointPower(j, lambda, &P));
   *gapmax = 0.0;
   for (PetscInt k = 0; k < j->nc; k++) *gapmax = PetscMax(*gapmax, PetscAbsReal(gap[k]) * (j->row[k] <= PHLEX_ROW_T3 ? u->length : 1.0));
   if (!j->csv) PetscFunctionReturn(0);
   PetscCall(PetscViewerASCIIPrintf(j->csv, "%.12e", (double)t));
-  for (PetscInt r = 0; r < 3; r++) PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->frame + 3 * r, wJ) * u->force)));
-  for (PetscInt r = 0; r < 3; r++) PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->frame + 3 * r, wJ + 3) * u->force * u->length)));
+  for (PetscInt r = 0; r < 3; r++) PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->dir + 3 * r, wJ) * u->force)));
+  for (PetscInt r = 0; r < 3; r++) PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->dir + 3 * r, wJ + 3) * u->force * u->length)));
   for (PetscInt k = 0; k < nm; k++) {
     const PetscBool length = (j->type == PHLEX_JOINT_PRISMATIC || (j->type == PHLEX_JOINT_CYLINDRICAL && k == 1) || (j->type == PHLEX_JOINT_PLANAR && k < 2)) ? PETSC_TRUE : PETSC_FALSE;
     PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(length ? mo[k] * u->length : mo[k])));

@@ -1,11 +1,8 @@
 /* Modal analysis of one flexible body with SLEPc: the symmetric-definite pencil (K, Mv) of the velocity after exact
    stress elimination (K = G^T Ms^{-1} G element by element), shift-and-invert, EPS options under the prefix modes_.
    A floating body is solved on the pencil of its linearisation at rest (the kinetic energy of v_P + w x x + v):
-   with a frame patch directly; with mean axes as a constrained pencil (a saddle point shift-and-invert). */
-#include <phlex_impl.h>
-
-/* Modal analysis with SLEPc: the symmetric-definite pencil (K, Mv) of the velocity after exact stress elimination
-   (K = G^T Ms^{-1} G element by element), shift-and-invert, EPS options under the prefix modes_. */
+   with a frame patch directly (FloatingPencil); with mean axes on (K, Mv) restricted to the constraint space
+   T^T v = 0 (below). */
 #include <phlex_impl.h>
 
 /* Lowest free-free bending frequency of a beam with the body's bounding box (non-dimensional, rad per unit time):
@@ -108,169 +105,6 @@ static PetscErrorCode FloatingPencil(PhlexFlexible b, Mat *A, Mat *B, IS is[2])
   PetscFunctionReturn(0);
 }
 
-/* Mean axes: the constraint T^T v = 0 (T = Bm: int rho v = 0, int rho (x - P) x v = 0) removes the rigid motion of
-   the elastic field, which the frame carries (without it B is singular: the field's rigid modes and the frame's
-   motion are the same velocities). The eigenproblem A x = lambda B x on {C^T x = 0}, C = [T; 0], is solved by
-   shift-and-invert on the saddle point: OP x = y with [[A - sigma B, C], [C^T, 0]] [y; mu] = [B x; 0], whose
-   range is the constraint space (STSHELL; the saddle matrix is factored once, LU). */
-typedef struct {
-  KSP       ksp;            /* the saddle matrix */
-  Mat       B;              /* [v | q] kinetic matrix */
-  IS        isx[2], isk[3]; /* blocks of the [v | q] and [v | q | mu] layouts */
-  Vec       Bx, rhs, sol;
-  PetscReal sigma;
-} MeanAxesST;
-
-static PetscErrorCode MeanAxesApply(ST st, Vec x, Vec y)
-{
-  MeanAxesST *c;
-  Vec         a, b;
-
-  PetscFunctionBeginUser;
-  PetscCall(STShellGetContext(st, &c));
-  PetscCall(MatMult(c->B, x, c->Bx));
-  PetscCall(VecSet(c->rhs, 0.0));
-  for (PetscInt k = 0; k < 2; k++) {
-    PetscCall(VecGetSubVector(c->Bx, c->isx[k], &a));
-    PetscCall(VecGetSubVector(c->rhs, c->isk[k], &b));
-    PetscCall(VecCopy(a, b));
-    PetscCall(VecRestoreSubVector(c->Bx, c->isx[k], &a));
-    PetscCall(VecRestoreSubVector(c->rhs, c->isk[k], &b));
-  }
-  PetscCall(KSPSolve(c->ksp, c->rhs, c->sol));
-  for (PetscInt k = 0; k < 2; k++) {
-    PetscCall(VecGetSubVector(y, c->isx[k], &a));
-    PetscCall(VecGetSubVector(c->sol, c->isk[k], &b));
-    PetscCall(VecCopy(b, a));
-    PetscCall(VecRestoreSubVector(y, c->isx[k], &a));
-    PetscCall(VecRestoreSubVector(c->sol, c->isk[k], &b));
-  }
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MeanAxesBackTransform(ST st, PetscInt n, PetscScalar *eigr, PetscScalar *eigi)
-{
-  MeanAxesST *c;
-
-  PetscFunctionBeginUser;
-  PetscCall(STShellGetContext(st, &c));
-  for (PetscInt i = 0; i < n; i++) eigr[i] = c->sigma + 1.0 / eigr[i];
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MeanAxesSetUp(PhlexFlexible b, Mat A, Mat B, IS is[2], PetscReal sigma, MeanAxesST *c)
-{
-  MPI_Comm    comm = b->comm;
-  PetscMPIInt rank;
-  Mat         S, C, Z6, N, blocks[4];
-  PetscInt    m, q, ld;
-  PetscScalar *ca;
-  const PetscScalar *ta, *wa;
-  PC          pc;
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  q = rank == 0 ? 6 : 0;
-  c->sigma = sigma;
-  c->B     = B;
-  c->isx[0] = is[0];
-  c->isx[1] = is[1];
-  /* A - sigma B */
-  PetscCall(MatDuplicate(A, MAT_COPY_VALUES, &S));
-  PetscCall(MatAXPY(S, -sigma, B, DIFFERENT_NONZERO_PATTERN));
-  /* C = [T; 0]: the columns t e_c and e_a x w on the velocity rows */
-  PetscCall(MatGetLocalSize(A, &m, NULL));
-  PetscCall(MatCreateDense(comm, m, q, PETSC_DETERMINE, 6, NULL, &C));
-  PetscCall(MatDenseGetLDA(C, &ld));
-  PetscCall(MatDenseGetArrayWrite(C, &ca));
-  for (PetscInt j = 0; j < 6; j++)
-    for (PetscInt i = 0; i < m; i++) ca[j * ld + i] = 0.0;
-  PetscCall(VecGetArrayRead(b->tnode, &ta));
-  PetscCall(VecGetArrayRead(b->wnode, &wa));
-  {
-    PetscInt rstart, vstart;
-    PetscCall(MatGetOwnershipRange(A, &rstart, NULL));
-    PetscCall(ISGetMinMax(is[0], &vstart, NULL));
-    (void)vstart;
-    /* the velocity rows come first on every rank in the [v | q] layout of FloatingPencil */
-    for (PetscInt l = 0; l < b->nv_local / 3; l++) {
-      const PetscReal w[3] = {PetscRealPart(wa[3 * l]), PetscRealPart(wa[3 * l + 1]), PetscRealPart(wa[3 * l + 2])};
-      for (PetscInt cc = 0; cc < 3; cc++) {
-        PetscReal e[3] = {0, 0, 0}, a[3];
-        e[cc]                       = 1.0;
-        ca[cc * ld + 3 * l + cc]     = ta[3 * l];
-        PhlexCross(e, w, a);
-        for (PetscInt k = 0; k < 3; k++) ca[(3 + cc) * ld + 3 * l + k] = a[k];
-      }
-    }
-  }
-  PetscCall(VecRestoreArrayRead(b->tnode, &ta));
-  PetscCall(VecRestoreArrayRead(b->wnode, &wa));
-  PetscCall(MatDenseRestoreArrayWrite(C, &ca));
-  PetscCall(MatAssemblyBegin(C, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(C, MAT_FINAL_ASSEMBLY));
-  {
-    Mat Ct;
-    PetscCall(MatTranspose(C, MAT_INITIAL_MATRIX, &Ct));
-    PetscCall(MatCreateAIJ(comm, q, q, 6, 6, 0, NULL, 0, NULL, &Z6));
-    PetscCall(MatAssemblyBegin(Z6, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(Z6, MAT_FINAL_ASSEMBLY));
-    blocks[0] = S, blocks[1] = C, blocks[2] = Ct, blocks[3] = Z6;
-    PetscCall(MatCreateNest(comm, 2, NULL, 2, NULL, blocks, &N));
-    PetscCall(MatDestroy(&Ct));
-  }
-  {
-    Mat K;
-    IS  isn[2];
-    PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &K));
-    PetscCall(MatNestGetISs(N, isn, NULL));
-    /* the saddle layout [v | q | mu]: [v | q] is the nest's first block */
-    {
-      const PetscInt *idx;
-      PetscInt        n0, n1, off0 = 0, off1 = 0, kstart;
-      PetscCall(MatGetOwnershipRange(K, &kstart, NULL));
-      PetscCall(ISGetLocalSize(is[0], &n0));
-      PetscCall(ISGetLocalSize(is[1], &n1));
-      PetscCall(ISGetIndices(isn[0], &idx));
-      (void)idx;
-      PetscCall(ISRestoreIndices(isn[0], &idx));
-      off0 = kstart;
-      off1 = kstart + n0;
-      PetscCall(ISCreateStride(comm, n0, off0, 1, &c->isk[0]));
-      PetscCall(ISCreateStride(comm, n1, off1, 1, &c->isk[1]));
-      PetscCall(ISCreateStride(comm, q, off1 + n1, 1, &c->isk[2]));
-    }
-    PetscCall(KSPCreate(comm, &c->ksp));
-    PetscCall(KSPSetOptionsPrefix(c->ksp, "modes_saddle_"));
-    PetscCall(KSPSetOperators(c->ksp, K, K));
-    PetscCall(KSPSetType(c->ksp, KSPPREONLY));
-    PetscCall(KSPGetPC(c->ksp, &pc));
-    PetscCall(PCSetType(pc, PCLU));
-    if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-    PetscCall(KSPSetFromOptions(c->ksp));
-    PetscCall(KSPSetUp(c->ksp));
-    PetscCall(MatCreateVecs(K, &c->rhs, &c->sol));
-    PetscCall(MatCreateVecs(B, &c->Bx, NULL));
-    PetscCall(MatDestroy(&K));
-  }
-  PetscCall(MatDestroy(&N));
-  PetscCall(MatDestroy(&S));
-  PetscCall(MatDestroy(&C));
-  PetscCall(MatDestroy(&Z6));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode MeanAxesDestroy(MeanAxesST *c)
-{
-  PetscFunctionBeginUser;
-  PetscCall(KSPDestroy(&c->ksp));
-  PetscCall(VecDestroy(&c->Bx));
-  PetscCall(VecDestroy(&c->rhs));
-  PetscCall(VecDestroy(&c->sol));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(ISDestroy(&c->isk[k]));
-  PetscFunctionReturn(0);
-}
-
 /*@C
   PhlexFlexibleComputeModes - lowest eigenpairs of K x = lambda Mv x of a flexible body (non-dimensional lambda = omega^2)
 
@@ -291,8 +125,10 @@ static PetscErrorCode MeanAxesDestroy(MeanAxesST *c)
 
   Notes:
   A floating body is solved on the pencil of its linearisation at rest (FloatingPencil): six rigid modes, then the
-  free-free modes; with mean axes on the constrained pencil (MeanAxesSetUp), whose elastic modes are those of the
-  unconstrained free body.
+  free-free modes. With mean axes the field's rigid content is constrained away, T^T v = 0 with T = Mv Phi (Phi: the
+  six rigid fields; int rho v = 0, int rho (x - P) x v = 0), so the kinetic energy splits into the frame's and the
+  field's: the six rigid modes are the frame's own (v = 0), and the elastic ones solve K v = lambda Mv v on the
+  Mv-orthogonal complement of Phi (SLEPc's deflation space), i.e. they are the unconstrained free body's.
 
   Options Database Keys:
 + -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)
@@ -303,7 +139,6 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
 {
   PhlexFlexible     b     = (PhlexFlexible)part->data;
   const PhlexUnits *units = part->units;
-  MeanAxesST        ma;
   PetscBool         mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
   EPS       eps;
   ST        st;
@@ -317,7 +152,6 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   Vec       x = NULL;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMemzero(&ma, sizeof(ma)));
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
   want  = nev + (free_body ? 6 : 0);
   sigma = free_body ? -PetscSqr(1e-2 * omega) : 0.0;
@@ -329,7 +163,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   }
   PetscCall(EPSCreate(b->comm, &eps));
   PetscCall(EPSSetOptionsPrefix(eps, "modes_"));
-  if (b->floating) PetscCall(FloatingPencil(b, &A, &B, is));
+  if (b->floating && !mean_axes) PetscCall(FloatingPencil(b, &A, &B, is));
   PetscCall(EPSSetOperators(eps, A, B));
   PetscCall(EPSSetProblemType(eps, EPS_GHEP));
   PetscCall(EPSSetType(eps, EPSKRYLOVSCHUR));
@@ -343,16 +177,19 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(EPSSetPurify(eps, PETSC_FALSE));
   PetscCall(EPSGetST(eps, &st));
   if (mean_axes) {
-    /* the saddle-point shift-and-invert of the constrained pencil; B is singular off the constraint space, and
-       purification keeps the eigenvectors in it */
-    PetscCall(MeanAxesSetUp(b, A, B, is, sigma, &ma));
-    PetscCall(STSetType(st, STSHELL));
-    PetscCall(STShellSetContext(st, &ma));
-    PetscCall(STShellSetApply(st, MeanAxesApply));
-    PetscCall(STShellSetBackTransform(st, MeanAxesBackTransform));
-    PetscCall(EPSSetWhichEigenpairs(eps, EPS_LARGEST_MAGNITUDE));
-    PetscCall(EPSSetPurify(eps, PETSC_TRUE));
-  } else {
+    /* the constraint space: Mv-orthogonal to the rigid fields */
+    MatNullSpace       nsp;
+    const Vec         *rig;
+    PetscInt           nrig;
+    PetscBool          has_const;
+    PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
+    PetscCall(MatNullSpaceGetVecs(nsp, &has_const, &nrig, &rig));
+    PetscCall(EPSSetDeflationSpace(eps, nrig, (Vec *)rig));
+    PetscCall(MatNullSpaceDestroy(&nsp));
+    want -= 6; /* the frame's rigid modes are added below */
+    PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
+  }
+  {
     PetscCall(STSetType(st, STSINVERT));
     PetscCall(STGetKSP(st, &ksp));
     PetscCall(KSPSetType(ksp, KSPPREONLY));
@@ -365,52 +202,65 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(EPSGetDimensions(eps, &want, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &n));
   n = PetscMin(n, want);
-  PetscCall(PetscMalloc1(n, lambda));
-  if (resid) PetscCall(PetscMalloc1(n, resid));
-  if (vecs) PetscCall(PetscMalloc1(n, vecs));
-  if (rigid) PetscCall(PetscCalloc1(6 * n, rigid));
-  PetscCall(MatCreateVecs(A, &x, NULL));
-  *nrigid = 0;
-  for (PetscInt i = 0; i < n; i++) {
-    PetscScalar kr, ki;
-    PetscCall(EPSGetEigenpair(eps, i, &kr, &ki, x, NULL));
-    (*lambda)[i] = PetscRealPart(kr);
-    if (PetscAbsReal((*lambda)[i]) < 1e-6 * omega * omega) {
-      (*nrigid)++;
-      /* lambda ~ 0: the relative residual divides by |lambda|; report the backward error instead */
-      if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_BACKWARD, &(*resid)[i]));
-    } else if (resid) PetscCall(EPSComputeError(eps, i, EPS_ERROR_RELATIVE, &(*resid)[i]));
-    if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
-    if (!b->floating) {
-      if (vecs) PetscCall(VecCopy(x, (*vecs)[i]));
-    } else {
-      Vec                xv, xq;
-      const PetscScalar *qa;
-      PetscReal          q6[6] = {0, 0, 0, 0, 0, 0};
-      PetscInt           nq;
-      PetscCall(VecGetSubVector(x, is[0], &xv));
-      if (vecs) PetscCall(VecCopy(xv, (*vecs)[i]));
-      PetscCall(VecRestoreSubVector(x, is[0], &xv));
-      PetscCall(VecGetSubVector(x, is[1], &xq));
-      PetscCall(VecGetLocalSize(xq, &nq));
-      PetscCall(VecGetArrayRead(xq, &qa));
-      for (PetscInt k = 0; k < nq; k++) q6[k] = PetscRealPart(qa[k]);
-      PetscCall(VecRestoreArrayRead(xq, &qa));
-      PetscCall(VecRestoreSubVector(x, is[1], &xq));
-      PetscCallMPI(MPI_Bcast(q6, 6, MPIU_REAL, 0, b->comm));
-      if (rigid) PetscCall(PetscArraycpy(&(*rigid)[6 * i], q6, 6));
+  {
+    /* mean axes: the frame's six rigid modes (v = 0) come first */
+    const PetscInt r0 = mean_axes ? 6 : 0, ntot = n + r0;
+    PetscCall(PetscMalloc1(ntot, lambda));
+    if (resid) PetscCall(PetscMalloc1(ntot, resid));
+    if (vecs) PetscCall(PetscMalloc1(ntot, vecs));
+    if (rigid) PetscCall(PetscCalloc1(6 * ntot, rigid));
+    for (PetscInt i = 0; i < r0; i++) {
+      (*lambda)[i] = 0.0;
+      if (resid) (*resid)[i] = 0.0;
+      if (vecs) {
+        PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
+        PetscCall(VecSet((*vecs)[i], 0.0));
+      }
+      if (rigid) (*rigid)[6 * i + i] = 1.0;
     }
+    *nrigid = r0;
+    PetscCall(MatCreateVecs(A, &x, NULL));
+    for (PetscInt e = 0; e < n; e++) {
+      const PetscInt i = r0 + e;
+      PetscScalar    kr, ki;
+      PetscCall(EPSGetEigenpair(eps, e, &kr, &ki, x, NULL));
+      (*lambda)[i] = PetscRealPart(kr);
+      if (PetscAbsReal((*lambda)[i]) < 1e-6 * omega * omega) {
+        (*nrigid)++;
+        /* lambda ~ 0: the relative residual divides by |lambda|; report the backward error instead */
+        if (resid) PetscCall(EPSComputeError(eps, e, EPS_ERROR_BACKWARD, &(*resid)[i]));
+      } else if (resid) PetscCall(EPSComputeError(eps, e, EPS_ERROR_RELATIVE, &(*resid)[i]));
+      if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
+      if (!b->floating || mean_axes) {
+        if (vecs) PetscCall(VecCopy(x, (*vecs)[i]));
+      } else {
+        Vec                xv, xq;
+        const PetscScalar *qa;
+        PetscReal          q6[6] = {0, 0, 0, 0, 0, 0};
+        PetscInt           nq;
+        PetscCall(VecGetSubVector(x, is[0], &xv));
+        if (vecs) PetscCall(VecCopy(xv, (*vecs)[i]));
+        PetscCall(VecRestoreSubVector(x, is[0], &xv));
+        PetscCall(VecGetSubVector(x, is[1], &xq));
+        PetscCall(VecGetLocalSize(xq, &nq));
+        PetscCall(VecGetArrayRead(xq, &qa));
+        for (PetscInt k = 0; k < nq; k++) q6[k] = PetscRealPart(qa[k]);
+        PetscCall(VecRestoreArrayRead(xq, &qa));
+        PetscCall(VecRestoreSubVector(x, is[1], &xq));
+        PetscCallMPI(MPI_Bcast(q6, 6, MPIU_REAL, 0, b->comm));
+        if (rigid) PetscCall(PetscArraycpy(&(*rigid)[6 * i], q6, 6));
+      }
+    }
+    *nconv = ntot;
   }
   PetscCall(VecDestroy(&x));
-  if (b->floating) {
+  if (b->floating && !mean_axes) {
     PetscCall(MatDestroy(&A));
     PetscCall(MatDestroy(&B));
     PetscCall(ISDestroy(&is[0]));
     PetscCall(ISDestroy(&is[1]));
   }
-  *nconv = n;
   PetscCall(EPSDestroy(&eps));
-  if (mean_axes) PetscCall(MeanAxesDestroy(&ma));
   PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }

@@ -551,6 +551,77 @@ PetscErrorCode PhlexSystemInitialState(PhlexSystem sys, Vec X)
 }
 
 /*@C
+  PhlexSystemJointSides - the part vectors of both sides of joint j at X (q: the replicated discrete unknowns of X);
+  the ground's are empty, a joint between two ports of one part shares one view
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemJointSides(PhlexSystem sys, PhlexJoint j, Vec X, PetscReal *q, PhlexPartVec pv[2])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < 2; s++) {
+    PhlexPart p = j->side[s].part;
+    pv[s].u = pv[s].s = pv[s].v = NULL;
+    pv[s].q                     = NULL;
+    if (PhlexPartIsGround(p)) continue;
+    if (s == 1 && p == j->side[0].part) {
+      pv[1] = pv[0];
+      continue;
+    }
+    PetscCall(PhlexPartGetVec(p, X, q, &pv[s]));
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode PhlexSystemJointSidesRestore(PhlexSystem sys, PhlexJoint j, Vec X, PhlexPartVec pv[2])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < 2; s++) {
+    PhlexPart p = j->side[s].part;
+    if (PhlexPartIsGround(p) || (s == 1 && p == j->side[0].part)) continue;
+    PetscCall(PhlexPartRestoreVec(p, X, &pv[s]));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemUpdateJoints - the joints' directions and arms for a step of length dt from the accepted state X
+  (PhlexJointUpdateGeometry), at the displacements extrapolated to the middle of the step, u + dt/2 u' (u' = v)
+
+  Collective
+
+  Notes:
+  The directions are held over the step (no Jacobian term); taking them at the step's middle instead of its start
+  makes their lag behind the ports' elastic rotation second order in dt.
+@*/
+PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem sys, Vec X, PetscReal dt)
+{
+  Vec Xm;
+
+  PetscFunctionBeginUser;
+  if (!sys->njoints) PetscFunctionReturn(0);
+  PetscCall(VecDuplicate(X, &Xm));
+  PetscCall(VecCopy(X, Xm));
+  if (sys->nfparts) {
+    Vec um, v;
+    PetscCall(VecGetSubVector(Xm, sys->is[PHLEX_FIELD_DISPLACEMENT], &um));
+    PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &v));
+    PetscCall(VecAXPY(um, 0.5 * dt / sys->scene->units.time, v));
+    PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &v));
+    PetscCall(VecRestoreSubVector(Xm, sys->is[PHLEX_FIELD_DISPLACEMENT], &um));
+  }
+  PetscCall(PhlexSystemGather(sys, Xm, sys->q));
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PhlexPartVec pv[2];
+    PetscCall(PhlexSystemJointSides(sys, sys->joints[k], Xm, sys->q, pv));
+    PetscCall(PhlexJointUpdateGeometry(sys->joints[k], &pv[0], &pv[1]));
+    PetscCall(PhlexSystemJointSidesRestore(sys, sys->joints[k], Xm, pv));
+  }
+  PetscCall(VecDestroy(&Xm));
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexSystemPostStep - after a step: every part cleans its discrete unknowns (rotations back onto SO(3));
   returns the largest correction
 

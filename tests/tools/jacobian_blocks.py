@@ -12,6 +12,10 @@ PETSc's own summary (||J - Jfd||_F / ||J||_F) is dominated by the largest blocks
 orders of magnitude smaller, so an error there would hide in it. Standard library only.
 
     bin/phlex ... | python3 tests/tools/jacobian_blocks.py --nv 120 --ns 360 [--rtol 1e-6]
+    bin/phlex ... | python3 tests/tools/jacobian_blocks.py --blocks u:120,s:360,v:120,bob:18,hinge:5
+
+--nv/--ns: one flexible body (and its floating frame); --blocks: any layout, the unknowns in order as name:count
+(the fields of all flexible bodies first, then the discrete unknowns of the parts and the joints' impulses).
 """
 
 import argparse
@@ -19,9 +23,14 @@ import re
 import sys
 
 
-def parse(lines):
-    """The three matrices (hand-coded, finite difference, difference) of the first test, as {row: {col: value}}."""
+def parse(lines, last=False):
+    """The three matrices (hand-coded, finite difference, difference) of the first test (or of the last one), as
+    {row: {col: value}}."""
     names = {"Hand-coded Jacobian": "J", "Finite difference Jacobian": "F", "Hand-coded minus finite-difference": "D"}
+    if last:
+        starts = [i for i, line in enumerate(lines) if "Hand-coded Jacobian" in line and "----" in line]
+        if starts:
+            lines = lines[starts[-1]:]
     mats, current = {}, None
     entry = re.compile(r"\((\d+), ([-+0-9.eEinfa]+)\)")
     for line in lines:
@@ -47,27 +56,39 @@ def parse(lines):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--nv", type=int, required=True, help="velocity (and displacement) unknowns")
-    ap.add_argument("--ns", type=int, required=True, help="stress unknowns")
+    ap.add_argument("--nv", type=int, help="velocity (and displacement) unknowns")
+    ap.add_argument("--ns", type=int, help="stress unknowns")
+    ap.add_argument("--blocks", help="the layout as name:count,name:count,... (instead of --nv/--ns)")
     ap.add_argument("--rtol", type=float, default=1e-6, help="bound on max|J - Jfd| / max|J| per block")
+    ap.add_argument("--last", action="store_true", help="check the last test printed (the last Newton iteration) instead of the first")
     args = ap.parse_args()
-    mats = parse(sys.stdin.read().splitlines())
+    mats = parse(sys.stdin.read().splitlines(), args.last)
     for key in "JFD":
         if key not in mats:
             print(f"FAIL: no {'hand-coded finite-difference difference'.split()[('JFD').index(key)]} matrix in the input")
             return 1
-    nv, ns = args.nv, args.ns
-    q0 = 2 * nv + ns
-    fields = [("u", 0, nv), ("s", nv, nv + ns), ("v", nv + ns, q0),
-              ("r", q0, q0 + 3), ("R", q0 + 3, q0 + 12), ("vP", q0 + 12, q0 + 15), ("w", q0 + 15, q0 + 18)]
     n = max(max(mats["J"]), max(mats["F"])) + 1
-    if n not in (q0, q0 + 18):
-        print(f"FAIL: the matrix has {n} rows, expected {q0} or {q0 + 18} for --nv {nv} --ns {ns}")
-        return 1
-    if n == q0:
-        fields = fields[:3]
+    if args.blocks:
+        fields, start = [], 0
+        for item in args.blocks.split(","):
+            name, count = item.rsplit(":", 1)
+            fields.append((name, start, start + int(count)))
+            start += int(count)
+        if n > start:
+            print(f"FAIL: the matrix has {n} rows, the blocks {start}")
+            return 1
+    else:
+        nv, ns = args.nv, args.ns
+        q0 = 2 * nv + ns
+        fields = [("u", 0, nv), ("s", nv, nv + ns), ("v", nv + ns, q0),
+                  ("r", q0, q0 + 3), ("R", q0 + 3, q0 + 12), ("vP", q0 + 12, q0 + 15), ("w", q0 + 15, q0 + 18)]
+        if n not in (q0, q0 + 18):
+            print(f"FAIL: the matrix has {n} rows, expected {q0} or {q0 + 18} for --nv {nv} --ns {ns}")
+            return 1
+        if n == q0:
+            fields = fields[:3]
     failed = 0
-    print(f"{'block':>8} {'max|J|':>10} {'max|Jfd|':>10} {'rel diff':>10}")
+    print(f"{'block':>16} {'max|J|':>10} {'max|Jfd|':>10} {'rel diff':>10}")
     for rname, r0, r1 in fields:
         for cname, c0, c1 in fields:
             def bmax(mat):
@@ -78,7 +99,7 @@ def main():
             rel = dm / max(jm, fm)
             ok = rel <= args.rtol
             failed += not ok
-            print(f"{rname + ' x ' + cname:>8} {jm:10.3e} {fm:10.3e} {rel:10.1e} {'PASS' if ok else 'FAIL'}")
+            print(f"{rname + ' x ' + cname:>16} {jm:10.3e} {fm:10.3e} {rel:10.1e} {'PASS' if ok else 'FAIL'}")
     print(f"Jacobian blocks: {'PASS' if not failed else 'FAIL'} ({failed} blocks above rtol {args.rtol:g})")
     return 0
 
