@@ -2,12 +2,14 @@
 // for convergence studies.
 //   x in [0, 1], y, z in [-0.05, 0.05]   (units: metres)
 //
-// Parameter: n. The bar is cut into nx x ny x nz = 10n x n x n cubes of edge 0.1/n
+// Parameters: n, and the length L (default 1; 10 n L must be a whole number). The bar is cut into
+// nx x ny x nz = 10nL x n x n cubes of edge 0.1/n
 // (Transfinite Curve/Surface/Volume, no Recombine). gmsh 4.8 splits every cube into
 // 6 tetrahedra (consistent with the diagonals of the transfinite face triangulations),
 // so the mesh has 60 n^3 tetrahedra and (10n+1)(n+1)^2 vertices.
 // Regenerate (see Makefile):
 //   gmsh bar_struct.geo -3 -setnumber n 2 -format msh41 -o bar_struct_n2.msh
+//   gmsh bar_struct.geo -3 -setnumber n 2 -setnumber L 0.5 -format msh41 -o bar_half_struct_n2.msh
 //
 // Physical groups (same as bar.geo, disjoint):
 //   volume  "bar"     tag 1
@@ -17,14 +19,13 @@
 SetFactory("OpenCASCADE");
 
 DefineConstant[ n = {2, Name "Parameters/n"} ];
-
-L = 1.0;     // length (x)
+DefineConstant[ L = {1.0, Name "Parameters/L"} ];   // length (x)
 W = 0.1;     // width = height (y, z)
 eps = 1e-6;  // bounding-box tolerance
 
 Box(1) = {0, -W/2, -W/2, L, W, W};
 
-// Long edges (along x) get 10n intervals, short edges n: decide by bounding box.
+// Long edges (along x) get 10nL intervals, short edges n: decide by bounding box.
 edges() = Curve In BoundingBox{-eps, -W/2-eps, -W/2-eps, L+eps, W/2+eps, W/2+eps};
 If (#edges() != 12)
   Error("bar_struct.geo: expected 12 edges, got %g", #edges());
@@ -33,7 +34,7 @@ EndIf
 For i In {0:#edges()-1}
   bb() = BoundingBox Curve{ edges(i) };
   If (bb(3) - bb(0) > L/2)
-    Transfinite Curve{ edges(i) } = 10*n + 1;
+    Transfinite Curve{ edges(i) } = Round(10*n*L) + 1;
   Else
     Transfinite Curve{ edges(i) } = n + 1;
   EndIf

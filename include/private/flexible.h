@@ -234,6 +234,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexPortDestroy(PhlexFlexPort *);
 
 /* flexible_ic.c */
 PETSC_INTERN PetscErrorCode PhlexFlexibleICSetFromOptions(PhlexFlexible, PhlexIC *, const char[], PetscInt);
+PETSC_INTERN PetscBool      PhlexFlexibleFrameVelocity(PhlexFlexible, PetscReal[3], PetscReal[3]);
 PETSC_INTERN PetscErrorCode PhlexFlexibleInitialState(PhlexPart, PhlexPartVec *);
 
 /* flexible_modes.c */

@@ -46,6 +46,7 @@ struct _p_PhlexJoint {
   PetscInt       index;
   char           prefix[32];
   char           name[PHLEX_NAME_LEN];
+  char           ports_option[48]; /* the option that named its ports (-joint<k>_ports, or -body<k>_attach) */
   PhlexJointType type;
   PhlexJointSide side[2];
 

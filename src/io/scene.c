@@ -111,6 +111,7 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
       if (!s->parts[k]->attach[0]) continue;
       PetscCall(PhlexJointCreate(s, s->njoints, &j));
       PetscCall(PetscSNPrintf(j->name, sizeof(j->name), "%s_attach", s->parts[k]->name));
+      PetscCall(PetscSNPrintf(j->ports_option, sizeof(j->ports_option), "-%sattach", s->parts[k]->prefix));
       j->type = PHLEX_JOINT_SPHERICAL;
       PetscCall(PetscStrncpy(j->side[0].spec, s->parts[k]->attach, sizeof(j->side[0].spec)));
       PetscCall(PetscSNPrintf(j->side[1].spec, sizeof(j->side[1].spec), "%s:point", s->parts[k]->name));

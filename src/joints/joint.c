@@ -132,6 +132,7 @@ PetscErrorCode PhlexJointCreate(PhlexScene scene, PetscInt index, PhlexJoint *jo
   j->index     = index;
   j->drive_row = -1;
   PetscCall(PetscSNPrintf(j->prefix, sizeof(j->prefix), "joint%" PetscInt_FMT "_", index));
+  PetscCall(PetscSNPrintf(j->ports_option, sizeof(j->ports_option), "-%sports", j->prefix));
   PetscCall(PetscSNPrintf(j->name, sizeof(j->name), "joint%" PetscInt_FMT, index));
   *joint = j;
   PetscFunctionReturn(0);
@@ -253,10 +254,10 @@ static PetscErrorCode ResolveSide(PhlexJoint j, PetscInt s)
   }
   PetscCall(PetscStrncpy(body, side->spec, sizeof(body)));
   colon = strchr(body, ':');
-  PetscCheck(colon, j->comm, PETSC_ERR_USER_INPUT, "joint %s: option -%sports: '%s' is not body:port or ground", j->name, j->prefix, side->spec);
+  PetscCheck(colon, j->comm, PETSC_ERR_USER_INPUT, "joint %s: option %s: '%s' is not body:port or ground", j->name, j->ports_option, side->spec);
   *colon = 0;
   PetscCall(PhlexSceneFindPart(j->scene, body, &side->part));
-  PetscCheck(side->part, j->comm, PETSC_ERR_USER_INPUT, "joint %s: option -%sports: no body named '%s'", j->name, j->prefix, body);
+  PetscCheck(side->part, j->comm, PETSC_ERR_USER_INPUT, "joint %s: option %s: no body named '%s'", j->name, j->ports_option, body);
   PetscCall(PhlexPartFindPort(side->part, colon + 1, &side->port));
   if (side->port < 0) {
     char avail[1024] = "";
@@ -264,7 +265,7 @@ static PetscErrorCode ResolveSide(PhlexJoint j, PetscInt s)
       PetscCall(PetscStrlcat(avail, k ? ", " : "", sizeof(avail)));
       PetscCall(PetscStrlcat(avail, side->part->ports[k].name, sizeof(avail)));
     }
-    SETERRQ(j->comm, PETSC_ERR_USER_INPUT, "joint %s: option -%sports: body %s has no port '%s' (its ports: %s)", j->name, j->prefix, body, colon + 1, side->part->nports ? avail : "none");
+    SETERRQ(j->comm, PETSC_ERR_USER_INPUT, "joint %s: option %s: body %s has no port '%s' (its ports: %s)", j->name, j->ports_option, body, colon + 1, side->part->nports ? avail : "none");
   }
   side->rotation = side->part->ports[side->port].dim == 6 ? PETSC_TRUE : PETSC_FALSE;
   PetscFunctionReturn(0);

@@ -129,7 +129,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
       PetscCheck(!flg, b->comm, PETSC_ERR_USER_INPUT, "body %s: port '%s' is listed twice in -%sports", b->name, pptr[p], b->prefix);
     }
     PetscCall(PetscStrcmp(b->frame_patch, pptr[p], &flg));
-    PetscCheck(!flg || !b->floating, b->comm, PETSC_ERR_USER_INPUT, "body %s: the frame patch %s is already a port of the floating body (its wrench acts on the frame: -%sframe_force); remove it from -%sports", b->name, pptr[p], b->prefix, b->prefix);
+    PetscCheck(!flg || !b->floating, b->comm, PETSC_ERR_USER_INPUT, "body %s: the frame patch %s is a port of the floating body already (joints name it %s:%s; its input is -%sframe_force/-%sframe_moment); remove it from -%sports", b->name, pptr[p], b->name, pptr[p], b->prefix, b->prefix, b->prefix);
     PetscCall(PetscFree(pptr[p]));
     PetscCall(PhlexPortLoadSetFromOptions(part, b->ports[p].name, PETSC_TRUE, &b->ports[p].load));
   }
@@ -277,7 +277,11 @@ static PetscErrorCode FlexView(PhlexPart part, PetscViewer viewer)
     if (b->frame_condition == PHLEX_FRAME_PATCH) PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on patch %s (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", b->frame_patch, (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
     else PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on mean axes (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
     PhlexRotationToQuaternion(b->pose.rotation, q);
-    PetscCall(PetscViewerASCIIPrintf(viewer, "initial r_P (%.6g, %.6g, %.6g) m, orientation quaternion (%.6g, %.6g, %.6g, %.6g), v_P (%.6g, %.6g, %.6g) m/s, w_P (%.6g, %.6g, %.6g) rad/s (body frame)\n", (double)b->pose.position[0], (double)b->pose.position[1], (double)b->pose.position[2], (double)q[0], (double)q[1], (double)q[2], (double)q[3], (double)b->pose.velocity[0], (double)b->pose.velocity[1], (double)b->pose.velocity[2], (double)b->pose.omega[0], (double)b->pose.omega[1], (double)b->pose.omega[2]));
+    {
+      PetscReal       v0[3], w0[3];
+      const PetscBool mapped = PhlexFlexibleFrameVelocity(b, v0, w0);
+      PetscCall(PetscViewerASCIIPrintf(viewer, "initial r_P (%.6g, %.6g, %.6g) m, orientation quaternion (%.6g, %.6g, %.6g, %.6g), v_P (%.6g, %.6g, %.6g) m/s, w_P (%.6g, %.6g, %.6g) rad/s (body frame%s)\n", (double)b->pose.position[0], (double)b->pose.position[1], (double)b->pose.position[2], (double)q[0], (double)q[1], (double)q[2], (double)q[3], (double)v0[0], (double)v0[1], (double)v0[2], (double)w0[0], (double)w0[1], (double)w0[2], mapped ? "; from the rigid initial velocity field" : ""));
+    }
     if (b->frame_loaded) {
       char prof[256];
       PetscCall(PhlexProfileDescribe(b->frame_profile, prof, sizeof(prof)));
@@ -392,6 +396,13 @@ static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool 
       PetscCall(PetscSNPrintf(cols, sizeof(cols), ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
       PetscCall(PetscStrlcat(header, cols, sizeof(header)));
     }
+    /* then the inertial positions of the port points (the mean of the patch's displaced points) */
+    for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
+      const char *n = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
+      char        cols[256];
+      PetscCall(PetscSNPrintf(cols, sizeof(cols), ",%s_x,%s_y,%s_z", n, n, n));
+      PetscCall(PetscStrlcat(header, cols, sizeof(header)));
+    }
     PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", b->name));
     PetscCall(PhlexOutputCSVOpen(out, name, header, (PetscViewer *)&b->ports_csv));
   }
@@ -431,6 +442,11 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
       for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force * u->length)));
       for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->port_y[p][c] * u->velocity)));
       for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->port_y[p][c] / u->time)));
+    }
+    for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
+      PetscReal x[3], R[9];
+      PetscCall((*part->ops.portplacement)(part, p >= 0 ? p : part->nports - 1, X, x, R));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
     }
     PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
   }

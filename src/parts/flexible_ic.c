@@ -241,6 +241,32 @@ static PetscErrorCode RemoveRigidContent(PhlexPart part, Vec x, PetscReal a[6])
 }
 
 /*@C
+  PhlexFlexibleFrameVelocity - the initial velocity of a floating body's frame (SI, body frame): -velocity and
+  -angular_velocity, or the rigid ("rigid", "uniform") initial velocity field mapped to the frame, v_P = value +
+  angular x (P - origin), w = angular; returns whether the field was mapped
+@*/
+PetscBool PhlexFlexibleFrameVelocity(PhlexFlexible b, PetscReal v0[3], PetscReal w0[3])
+{
+  const PhlexIC *ic = &b->ic_velocity;
+
+  for (PetscInt k = 0; k < 3; k++) {
+    v0[k] = b->pose.velocity[k];
+    w0[k] = b->pose.omega[k];
+  }
+  if (!b->floating || !(ic->type == PHLEX_IC_UNIFORM || ic->type == PHLEX_IC_RIGID)) return PETSC_FALSE;
+  {
+    PetscReal d[3], a[3] = {0, 0, 0};
+    for (PetscInt k = 0; k < 3; k++) d[k] = b->origin[k] - ic->origin[k];
+    if (ic->type == PHLEX_IC_RIGID) PhlexCross(ic->angular, d, a);
+    for (PetscInt k = 0; k < 3; k++) {
+      v0[k] = ic->value[k] + a[k];
+      w0[k] = ic->type == PHLEX_IC_RIGID ? ic->angular[k] : 0.0;
+    }
+  }
+  return PETSC_TRUE;
+}
+
+/*@C
   PhlexFlexibleInitialState - the initial fields of a flexible body and, floating, its frame's state
 
   Collective
@@ -259,23 +285,10 @@ PetscErrorCode PhlexFlexibleInitialState(PhlexPart part, PhlexPartVec *X)
   PetscReal         v0[3], w0[3], r0[3], R0[9];
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < 3; k++) {
-    v0[k] = b->pose.velocity[k];
-    w0[k] = b->pose.omega[k];
-    r0[k] = b->pose.position[k];
-  }
+  for (PetscInt k = 0; k < 3; k++) r0[k] = b->pose.position[k];
   for (PetscInt k = 0; k < 9; k++) R0[k] = b->pose.rotation[k];
-  if (b->floating && (b->ic_velocity.type == PHLEX_IC_UNIFORM || b->ic_velocity.type == PHLEX_IC_RIGID)) {
-    const PhlexIC *ic = &b->ic_velocity;
-    PetscReal      d[3], a[3];
-    for (PetscInt k = 0; k < 3; k++) d[k] = b->origin[k] - ic->origin[k];
-    if (ic->type == PHLEX_IC_RIGID) PhlexCross(ic->angular, d, a);
-    for (PetscInt k = 0; k < 3; k++) {
-      v0[k] = ic->value[k] + (ic->type == PHLEX_IC_RIGID ? a[k] : 0.0);
-      w0[k] = ic->type == PHLEX_IC_RIGID ? ic->angular[k] : 0.0;
-    }
-    PetscCall(VecSet(X->v, 0.0));
-  } else PetscCall(SetKinematicIC(part, &b->ic_velocity, "velocity", 1.0 / un->velocity, X->v, mode_rigid));
+  if (PhlexFlexibleFrameVelocity(b, v0, w0)) PetscCall(VecSet(X->v, 0.0));
+  else PetscCall(SetKinematicIC(part, &b->ic_velocity, "velocity", 1.0 / un->velocity, X->v, mode_rigid));
   PetscCall(SetKinematicIC(part, &b->ic_displacement, "displacement", 1.0 / un->length, X->u, NULL));
   if (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
     PetscCall(RemoveRigidContent(part, X->v, av));
