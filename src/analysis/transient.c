@@ -34,8 +34,10 @@ typedef struct {
 /* Energy and power-balance monitor                                                                            */
 
 /* the power of the inputs at (t, X): external inputs of every part and the drives of the joints (multipliers
-   m->lambda); the joints' share, times weight, is added to m->jpower */
-static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscReal weight, PetscReal *P)
+   m->lambda); the joints' share, times weight, is added to m->jpower. At the stage of a theta method (X: the state
+   where the constraints hold) a joint's power is measured from its ports, lambda . (c + g), zero to solver
+   tolerance for a workless joint; for the other schemes it is lambda . g(t), the scheme holding c = g. */
+static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscReal weight, PetscBool stage, PetscReal *P)
 {
   PhlexSystem sys = m->sys;
 
@@ -49,7 +51,8 @@ static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscRea
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
     PetscReal p;
-    PetscCall(PhlexJointPower(sys->joints[k], m->lambda + sys->joints[k]->qoff, &p));
+    if (stage) PetscCall(PhlexJointPower(sys->joints[k], m->lambda + sys->joints[k]->qoff, &p));
+    else PetscCall(PhlexJointSourcePower(sys->joints[k], t, m->lambda + sys->joints[k]->qoff, &p));
     *P += p;
     m->jpower[k] += weight * p;
   }
@@ -189,7 +192,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   if (step == 0 && sys->njoints) {
     /* the joints' power at the consistent start */
     PetscReal P0;
-    PetscCall(InputPower(m, t, X, 1.0, &P0));
+    PetscCall(InputPower(m, t, X, 1.0, PETSC_TRUE, &P0));
   }
   if (step > 0) {
     dt = (t - m->tprev) / u->time;
@@ -197,17 +200,17 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     PetscCall(PhlexSystemGather(sys, X, sys->q));
     for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dt : 0.0;
     if (m->theta && !m->endpoint && m->have_stage) {
-      PetscCall(InputPower(m, m->tstage, m->Xstage, 1.0, &power));
+      PetscCall(InputPower(m, m->tstage, m->Xstage, 1.0, PETSC_TRUE, &power));
     } else if (m->theta && m->endpoint) {
       PetscReal P1, P0;
       PetscCall(VecAXPBYPCZ(m->Xmid, 0.5, 0.5, 0.0, X, m->Xprev));
-      PetscCall(InputPower(m, t, m->Xmid, m->theta_value, &P1));
-      PetscCall(InputPower(m, m->tprev, m->Xmid, 1.0 - m->theta_value, &P0));
+      PetscCall(InputPower(m, t, m->Xmid, m->theta_value, PETSC_FALSE, &P1));
+      PetscCall(InputPower(m, m->tprev, m->Xmid, 1.0 - m->theta_value, PETSC_FALSE, &P0));
       power = m->theta_value * P1 + (1.0 - m->theta_value) * P0;
     } else {
       PetscReal P1, P0;
-      PetscCall(InputPower(m, t, X, 0.5, &P1));
-      PetscCall(InputPower(m, m->tprev, m->Xprev, 0.5, &P0));
+      PetscCall(InputPower(m, t, X, 0.5, PETSC_FALSE, &P1));
+      PetscCall(InputPower(m, m->tprev, m->Xprev, 0.5, PETSC_FALSE, &P0));
       power = 0.5 * (P0 + P1);
     }
   }
@@ -392,19 +395,26 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(TSSetMaxTime(ts, PETSC_MAX_REAL));
   PetscCall(TSSetMaxSteps(ts, PETSC_MAX_INT));
   PetscCall(TSSetExactFinalTime(ts, TS_EXACTFINALTIME_MATCHSTEP));
-  /* adaptive steppers: the unknowns are non-dimensional (velocities ~ 1e-4 of the wave speed), so PETSc's default
-     absolute tolerance 1e-4 would accept anything: a relative criterion; the impulses (whose rates are the
-     multipliers of an index-2 system) are left out of the error norm */
+  /* Adaptive steppers (-ts_adapt_type basic, the default of BDF): weights atol + rtol |x| per unknown, rtol 1e-6.
+     The fields are non-dimensional (velocities ~ 1e-4 of the wave speed), so PETSc's default absolute tolerance 1e-4
+     would accept anything: atol 1e-12. The frames' positions and rotations are O(1) (lengths in L, rotation entries,
+     some of which start at 0): atol 1e-6. Their velocities: 1e-6 of the larger of the initial speeds and sqrt(|g| L).
+     The impulses (whose rates are the multipliers of an index-2 system) are left out of the error norm. */
   {
-    Vec vatol, vrtol;
+    Vec        vatol, vrtol;
+    PetscReal  vchar = PetscSqrtReal(PhlexNorm3(sys->scene->gravity) * sys->scene->units.length) / sys->scene->units.velocity;
     PetscCall(VecDuplicate(X, &vatol));
     PetscCall(VecDuplicate(X, &vrtol));
     PetscCall(VecSet(vatol, 1e-12));
     PetscCall(VecSet(vrtol, 1e-6));
     if (sys->nq) {
       PetscReal *a;
+      PetscCall(PhlexSystemGather(sys, X, sys->q));
+      for (PetscInt k = 0; k < sys->nq; k++)
+        if (sys->qkind[k] == PHLEX_DOF_VELOCITY) vchar = PetscMax(vchar, PetscAbsReal(sys->q[k]));
+      if (vchar == 0) vchar = 1.0;
       PetscCall(PetscMalloc1(sys->nq, &a));
-      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 1e300 : 1e-12;
+      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 1e300 : (sys->qkind[k] == PHLEX_DOF_VELOCITY ? 1e-6 * vchar : 1e-6);
       PetscCall(PhlexSystemScatter(sys, a, vatol));
       for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 0.0 : 1e-6;
       PetscCall(PhlexSystemScatter(sys, a, vrtol));

@@ -539,6 +539,23 @@ PetscErrorCode PhlexJointPower(PhlexJoint j, const PetscReal *lambda, PetscReal 
   PetscFunctionReturn(0);
 }
 
+/*@C
+  PhlexJointSourcePower - the power the joint supplies, lambda . g(t): its drive's or prescribed motion's (zero for a
+  workless joint), given that the scheme holds c = g at its stage (for the schemes whose stage state the monitor does
+  not see)
+@*/
+PetscErrorCode PhlexJointSourcePower(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal *P)
+{
+  PetscFunctionBeginUser;
+  *P = 0.0;
+  for (PetscInt k = 0; k < j->nc; k++) {
+    PetscReal g;
+    PetscCall(Source(j, k, t, &g));
+    *P += lambda[k] * g;
+  }
+  PetscFunctionReturn(0);
+}
+
 /* ------------------------------------------------------------------------------------------------------------ */
 /* Jacobian                                                                                                      */
 
