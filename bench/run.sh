@@ -80,8 +80,8 @@ case_args() {
     ARGS="-options_file options/cantilever.yaml -solver_options_file options/solver/$preset.opts -body0_dm_plex_filename $MESHDIR/bar_h$h.msh -body0_ic_velocity_type beam -body0_ic_velocity_direction 0,0,1 -ts_max_steps $steps -output_fields 0 -output_dir ${OUTROOT}_tr/$1$TAG -log_view"
     ;;
   # --- floating body against the same body clamped: fl_<variant>_h<h>_s<steps>
-  #     full, frozen: options/floating_tumbling.yaml (full or frozen inertia), preset floating.opts
-  #     full_iterative, frozen_iterative: the same with options/solver/floating_iterative.opts
+  #     full, frozen: options/floating_tumbling.yaml (full or frozen inertia), preset bordered.opts
+  #     full_iterative, frozen_iterative: the same with options/solver/bordered_iterative.opts
   #     clamped_<preset>: options/cantilever.yaml (beam-shaped initial velocity), preset <preset>.opts
   #     all with P2 velocity and dt = 2e-4 s
   fl_*)
@@ -97,11 +97,30 @@ case_args() {
     frozen) ARGS="-options_file options/floating_tumbling.yaml -body0_inertia frozen $mesh $common" ;;
     full_iterative|frozen_iterative)
       inertia=${variant%_iterative}
-      ARGS="-options_file options/floating_tumbling.yaml -body0_inertia $inertia -solver_options_file options/solver/floating_iterative.opts $mesh $common" ;;
+      ARGS="-options_file options/floating_tumbling.yaml -body0_inertia $inertia -solver_options_file options/solver/bordered_iterative.opts $mesh $common" ;;
     clamped_*)
       preset=${variant#clamped_}
       [ -f "options/solver/$preset.opts" ] || return 1
       ARGS="-options_file options/cantilever.yaml -solver_options_file options/solver/$preset.opts $mesh -body0_ic_velocity_type beam -body0_ic_velocity_direction 0,0,1 -ts_dt 2e-4 $common" ;;
+    *) return 1 ;;
+    esac
+    ;;
+  # --- mechanism: two floating flexible bars, the flexible double pendulum (options/flexible_double_pendulum.yaml),
+  #     against each bar alone: mb_<variant>_h<h>_s<steps>
+  #     pair: both bars, shoulder and elbow revolutes; pinned: the upper bar alone on its shoulder revolute (a
+  #     flexible pendulum); free: the upper bar alone, falling freely (no joint). P2, dt = 2e-4 s, preset bordered.opts
+  mb_*)
+    rest=${1#mb_}
+    variant=${rest%%_h*}
+    rest=${rest#*_h}
+    h=${rest%%_*}
+    steps=${rest#*_s}
+    mesh="-body0_dm_plex_filename $MESHDIR/bar_h$h.msh -body1_dm_plex_filename $MESHDIR/bar_h$h.msh"
+    common="-options_file options/flexible_double_pendulum.yaml $mesh -ts_max_steps $steps -output_fields 0 -output_dir ${OUTROOT}_mb/$1$TAG -log_view"
+    case $variant in
+    pair) ARGS="$common" ;;
+    pinned) ARGS="$common -num_bodies 1 -num_joints 1" ;;
+    free) ARGS="$common -num_bodies 1 -num_joints 0" ;;
     *) return 1 ;;
     esac
     ;;
@@ -122,7 +141,8 @@ for p in exact ldlt iterative; do
 done
 ALL_CASES="$ALL_CASES tr_exact_h0.01_s20_np2 tr_exact_h0.01_s40_np2"
 FLOAT_CASES="fl_clamped_exact_h0.013_s10 fl_clamped_exact_h0.013_s20 fl_frozen_h0.013_s10 fl_frozen_h0.013_s20 fl_full_h0.013_s10 fl_full_h0.013_s20 fl_clamped_iterative_h0.006_s2 fl_full_iterative_h0.006_s2"
-EXTRA_CASES="$FLOAT_CASES modes_h0.007 modes_h0.01_view modes_h0.01_pord modes_h0.01_nopurify modes_h0.01_ncv80"
+MB_CASES="mb_pair_h0.02_s5 mb_pinned_h0.02_s5 mb_free_h0.02_s5 mb_pair_h0.02_s15 mb_pinned_h0.02_s15 mb_free_h0.02_s15 mb_pair_h0.013_s3 mb_pinned_h0.013_s3 mb_free_h0.013_s3 mb_pair_h0.013_s8 mb_pinned_h0.013_s8 mb_free_h0.013_s8"
+EXTRA_CASES="$FLOAT_CASES $MB_CASES modes_h0.007 modes_h0.01_view modes_h0.01_pord modes_h0.01_nopurify modes_h0.01_ncv80"
 
 # busy CPU time of the whole machine so far, in clock ticks (user + nice + system + irq + softirq + steal)
 cpu_busy() { awk '/^cpu /{print $2 + $3 + $4 + $7 + $8 + $9; exit}' /proc/stat; }

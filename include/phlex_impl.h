@@ -105,6 +105,7 @@ PETSC_INTERN PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *);
 
 /* error.c: option input with checked length */
 PETSC_INTERN PetscErrorCode PhlexOptionsRealN(PetscOptionItems *, MPI_Comm, const char[], const char[], const char[], const char[], const char[], PetscInt, PetscReal[], PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexOptionsListLength(const char[], const char[], PetscInt *);
 
 /* expect.c: self-verification */
 PETSC_INTERN PetscErrorCode PhlexExpectMax(MPI_Comm, const char[], const char[], PetscReal, PetscReal, PetscBool);

@@ -3,7 +3,7 @@
 #include <phlex_impl.h>
 
 static const char help[] = "phlex: flexible multibody dynamics of 3D elastic bodies in port-Hamiltonian form (PETSc/SLEPc).\n"
-                           "  bin/phlex -options_file options/<scene>.yaml [-options_file options/solver/<preset>.yaml] [options]\n"
+                           "  bin/phlex -options_file options/<scene>.yaml [-solver_options_file options/solver/<preset>.opts] [options]\n"
                            "  -help lists every option with its unit; README.md has the option tables.\n";
 
 static PetscErrorCode Run(PhlexScene *scene)

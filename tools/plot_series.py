@@ -5,11 +5,15 @@ Usage:
     python3 tools/plot_series.py <output_dir> [--dpi N]
 
 Reads whichever of these files exist in <output_dir> and writes:
-    energy.csv -> energy.png         kinetic, strain and total energy vs time
-               -> power_balance.png  |balance_residual| = |H(n+1) - H(n) - dt P| (log scale),
-                                     supplied work W and H - H0 vs time
-    modes.csv  -> modes.png          natural frequency vs mode number
-    ports.csv  -> ports.png          force, moment, velocity and angular velocity of every port vs time
+    energy.csv          -> energy.png         kinetic, strain and total energy vs time
+                        -> power_balance.png  |balance_residual| = |H(n+1) - H(n) - dt P| (log scale),
+                                              supplied work W and H - H0 vs time
+    modes.csv           -> modes.png          natural frequency vs mode number
+    <body>_ports.csv    -> <body>_ports.png   force, moment, velocity and angular velocity of every port vs time
+    <body>_rigid.csv    -> <body>_rigid.png   centre of mass, angular velocity, orthogonality of R vs time (a point
+                                              mass: position, velocity, the force on it)
+    <joint>_joint.csv   -> <joint>_joint.png  joint force and moment, relative motion, violations (log scale),
+                                              power through the joint vs time
 
 Needs only numpy and matplotlib (Debian: python3-numpy python3-matplotlib, which 'make deps' installs).
 Renders with the Agg backend, so no display is needed. Exit status: 0 when every plot was written,
@@ -180,8 +184,7 @@ def port_names(header):
     return names
 
 
-def plot_ports(dirpath, np, plt, dpi):
-    path = os.path.join(dirpath, "ports.csv")
+def plot_ports(dirpath, np, plt, dpi, path):
     header, s = read_csv(path, np, ("time",))
     names = port_names(header)
     if not names:
@@ -206,16 +209,104 @@ def plot_ports(dirpath, np, plt, dpi):
             ax.grid(True, alpha=0.3)
     for ax in axes[-1]:
         ax.set_xlabel("time t [s]")
-    fig.suptitle(f"Port inputs (force, moment) and collocated outputs (velocity) ({_label(dirpath)})")
-    _finish(fig, plt, os.path.join(dirpath, "ports.png"), dpi)
+    fig.suptitle(f"Port inputs (force, moment) and collocated outputs (velocity) ({os.path.basename(path)})")
+    _finish(fig, plt, path[:-4] + ".png", dpi)
 
 
-PLOTTERS = (("energy.csv", plot_energy), ("modes.csv", plot_modes), ("ports.csv", plot_ports))
+def plot_rigid(dirpath, np, plt, dpi, path):
+    """A moving frame (cx.., wx.., orthogonality) or a point mass (rx.., vx.., Fx..: the force on it)."""
+    header, s = read_csv(path, np, ("time",))
+    t = s["time"]
+    point = "cx" not in header
+    panels = (
+        (("rx", "ry", "rz") if point else ("cx", "cy", "cz"), "position [m]" if point else "centre of mass [m]"),
+        (("vx", "vy", "vz") if point else ("wx", "wy", "wz"), "velocity [m/s]" if point else "angular velocity ω [rad/s] (body)"),
+    )
+    missing = [c for cols, _ in panels for c in cols if c not in header]
+    if missing:
+        raise SeriesError(f"{path}: missing column(s) {', '.join(missing)}; header is: {','.join(header)}")
+    fig, axes = plt.subplots(3, 1, figsize=(9, 9), sharex=True)
+    for ax, (cols, ylabel) in zip(axes, panels):
+        for c in cols:
+            ax.plot(t, s[c], label=c)
+        ax.set_ylabel(ylabel)
+    if point and all(c in header for c in ("Fx", "Fy", "Fz")):
+        for c in ("Fx", "Fy", "Fz"):
+            axes[2].plot(t, s[c], label=c)
+        axes[2].set_ylabel("force on the point [N]")
+    elif "orthogonality" in header:
+        o = np.abs(s["orthogonality"])
+        shown = o > 0
+        if shown.any():
+            axes[2].semilogy(t[shown], o[shown], ".", ms=3, label="‖RᵀR − I‖")
+        axes[2].set_ylabel("orthogonality of R")
+    for ax in axes:
+        ax.grid(True, alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best", fontsize=8)
+    axes[-1].set_xlabel("time t [s]")
+    fig.suptitle(f"{'Point mass' if point else 'Rigid motion'} ({os.path.basename(path)})")
+    _finish(fig, plt, path[:-4] + ".png", dpi)
+
+
+def plot_joint(dirpath, np, plt, dpi, path):
+    header, s = read_csv(path, np, ("time", "Fx", "Fy", "Fz", "Mx", "My", "Mz", "power"))
+    t = s["time"]
+    motion = [c for c in ("angle", "slide", "slide1", "slide2", "rot1", "rot2", "rot3") if c in header]
+    gaps = [c for c in header if c.startswith("gap_")]
+    fig, axes = plt.subplots(5, 1, figsize=(9, 14), sharex=True)
+    for c in ("Fx", "Fy", "Fz"):
+        axes[0].plot(t, s[c], label=c)
+    axes[0].set_ylabel("force [N] (joint frame)")
+    for c in ("Mx", "My", "Mz"):
+        axes[1].plot(t, s[c], label=c)
+    axes[1].set_ylabel("moment [N m] (joint frame)")
+    for c in motion:
+        axes[2].plot(t, s[c], label=c)
+    axes[2].set_ylabel("relative motion [rad, m]")
+    if not motion:
+        axes[2].text(0.5, 0.5, "no free motion", transform=axes[2].transAxes, ha="center", va="center")
+    for c in gaps:
+        g = np.abs(s[c])
+        shown = g > 0
+        if shown.any():
+            axes[3].semilogy(t[shown], g[shown], ".", ms=3, label=c[4:])
+    axes[3].set_ylabel("|violation| [m, rad]")
+    axes[4].plot(t, s["power"], label="power through the joint")
+    axes[4].set_ylabel("power [W]")
+    for ax in axes:
+        ax.grid(True, which="both", alpha=0.3)
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(loc="best", fontsize=8)
+    axes[-1].set_xlabel("time t [s]")
+    fig.suptitle(f"Joint ({os.path.basename(path)}): wrench on the second port by the first")
+    _finish(fig, plt, path[:-4] + ".png", dpi)
+
+
+def _one(fn):
+    """A plotter of one fixed file name, called as the per-file ones."""
+    return lambda dirpath, np, plt, dpi, path: fn(dirpath, np, plt, dpi)
+
+
+# (file name or suffix, plotter): fixed names, then every file ending with the suffix
+PLOTTERS = (("energy.csv", _one(plot_energy)), ("modes.csv", _one(plot_modes)), ("_ports.csv", plot_ports),
+            ("_rigid.csv", plot_rigid), ("_joint.csv", plot_joint))
+
+
+def files_to_plot(dirpath):
+    """(path, plotter) for every known CSV in dirpath."""
+    names = sorted(os.listdir(dirpath))
+    found = []
+    for key, fn in PLOTTERS:
+        for name in names:
+            if (name == key) if not key.startswith("_") else (name.endswith(key) and len(name) > len(key)):
+                found.append((os.path.join(dirpath, name), fn))
+    return found
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(
-        description="Plot phlex's energy.csv, modes.csv and ports.csv as PNG files in the same directory."
+        description="Plot phlex's energy.csv, modes.csv, <body>_ports.csv, <body>_rigid.csv and <joint>_joint.csv as PNG files in the same directory."
     )
     parser.add_argument("output_dir", help="a phlex output directory (-output_dir)")
     parser.add_argument("--dpi", type=int, default=120, help="resolution of the PNG files (default 120)")
@@ -224,17 +315,17 @@ def main(argv=None):
     if not os.path.isdir(args.output_dir):
         print(f"plot_series: error: '{args.output_dir}' is not a directory", file=sys.stderr)
         return 2
-    found = [(name, fn) for name, fn in PLOTTERS if os.path.isfile(os.path.join(args.output_dir, name))]
+    found = files_to_plot(args.output_dir)
     if not found:
-        known = ", ".join(name for name, _ in PLOTTERS)
+        known = "energy.csv, modes.csv, <body>_ports.csv, <body>_rigid.csv, <joint>_joint.csv"
         print(f"plot_series: error: no known CSV ({known}) in '{args.output_dir}'", file=sys.stderr)
         return 2
 
     np, plt = _import_numpy_matplotlib()
     failed = 0
-    for name, plotter in found:
+    for path, plotter in found:
         try:
-            plotter(args.output_dir, np, plt, args.dpi)
+            plotter(args.output_dir, np, plt, args.dpi, path)
         except (SeriesError, OSError) as err:
             print(f"plot_series: error: {err}", file=sys.stderr)
             failed += 1

@@ -395,18 +395,23 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(TSSetMaxTime(ts, PETSC_MAX_REAL));
   PetscCall(TSSetMaxSteps(ts, PETSC_MAX_INT));
   PetscCall(TSSetExactFinalTime(ts, TS_EXACTFINALTIME_MATCHSTEP));
-  /* Adaptive steppers (-ts_adapt_type basic, the default of BDF): weights atol + rtol |x| per unknown, rtol 1e-6.
-     The fields are non-dimensional (velocities ~ 1e-4 of the wave speed), so PETSc's default absolute tolerance 1e-4
-     would accept anything: atol 1e-12. The frames' positions and rotations are O(1) (lengths in L, rotation entries,
-     some of which start at 0): atol 1e-6. Their velocities: 1e-6 of the larger of the initial speeds and sqrt(|g| L).
-     The impulses (whose rates are the multipliers of an index-2 system) are left out of the error norm. */
+  /* Adaptive steppers (-ts_adapt_type basic, the default of BDF): weights atol + rtol |x| per unknown, rtol from
+     -ts_rtol (1e-6). The fields are non-dimensional (velocities ~ 1e-4 of the wave speed), so PETSc's default absolute
+     tolerance 1e-4 would accept anything: atol from -ts_atol (1e-12). The frames' positions and rotations are O(1)
+     (lengths in L, rotation entries, some of which start at 0): atol = rtol. Their velocities: rtol times the larger
+     of the initial speeds and sqrt(|g| L). The impulses (whose rates are the multipliers of an index-2 system) are
+     left out of the error norm. PETSc takes vector tolerances over -ts_rtol/-ts_atol, hence they are read here. */
   {
     Vec        vatol, vrtol;
     PetscReal  vchar = PetscSqrtReal(PhlexNorm3(sys->scene->gravity) * sys->scene->units.length) / sys->scene->units.velocity;
+    PetscReal  rtol = 1e-6, atol = 1e-12;
+    PetscCall(PetscOptionsGetReal(NULL, NULL, "-ts_rtol", &rtol, NULL));
+    PetscCall(PetscOptionsGetReal(NULL, NULL, "-ts_atol", &atol, NULL));
+    PetscCheck(rtol > 0 && atol >= 0, scene->comm, PETSC_ERR_USER_INPUT, "-ts_rtol must be positive and -ts_atol non-negative, got %g and %g", (double)rtol, (double)atol);
     PetscCall(VecDuplicate(X, &vatol));
     PetscCall(VecDuplicate(X, &vrtol));
-    PetscCall(VecSet(vatol, 1e-12));
-    PetscCall(VecSet(vrtol, 1e-6));
+    PetscCall(VecSet(vatol, atol));
+    PetscCall(VecSet(vrtol, rtol));
     if (sys->nq) {
       PetscReal *a;
       PetscCall(PhlexSystemGather(sys, X, sys->q));
@@ -414,13 +419,13 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
         if (sys->qkind[k] == PHLEX_DOF_VELOCITY) vchar = PetscMax(vchar, PetscAbsReal(sys->q[k]));
       if (vchar == 0) vchar = 1.0;
       PetscCall(PetscMalloc1(sys->nq, &a));
-      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 1e300 : (sys->qkind[k] == PHLEX_DOF_VELOCITY ? 1e-6 * vchar : 1e-6);
+      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 1e300 : (sys->qkind[k] == PHLEX_DOF_VELOCITY ? rtol * vchar : rtol);
       PetscCall(PhlexSystemScatter(sys, a, vatol));
-      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 0.0 : 1e-6;
+      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 0.0 : rtol;
       PetscCall(PhlexSystemScatter(sys, a, vrtol));
       PetscCall(PetscFree(a));
     }
-    PetscCall(TSSetTolerances(ts, 1e-12, vatol, 1e-6, vrtol));
+    PetscCall(TSSetTolerances(ts, atol, vatol, rtol, vrtol));
     PetscCall(VecDestroy(&vatol));
     PetscCall(VecDestroy(&vrtol));
   }

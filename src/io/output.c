@@ -140,7 +140,8 @@ PetscErrorCode PhlexOutputAbort(PhlexOutput out)
 }
 
 /*@C
-  PhlexOutputCSVOpen - opens a CSV series in the output directory and writes its header line
+  PhlexOutputCSVOpen - opens a CSV series in the output directory and writes its header line; with header NULL the
+  caller writes the header itself (PetscViewerASCIIPrintf, in pieces: any number of columns), ending it with a newline
 
   Collective
 @*/
@@ -152,7 +153,7 @@ PetscErrorCode PhlexOutputCSVOpen(PhlexOutput out, const char name[], const char
   PetscCall(PhlexOutputFile(out, name, tmp));
   PetscCall(PetscViewerASCIIOpen(out->comm, tmp, viewer));
   PetscCall(PetscViewerPushFormat(*viewer, PETSC_VIEWER_ASCII_CSV));
-  PetscCall(PetscViewerASCIIPrintf(*viewer, "%s\n", header));
+  if (header) PetscCall(PetscViewerASCIIPrintf(*viewer, "%s\n", header));
   PetscFunctionReturn(0);
 }
 

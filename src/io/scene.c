@@ -85,7 +85,8 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
   PetscCheck(s->njoints >= 0, s->comm, PETSC_ERR_USER_INPUT, "-num_joints must be >= 0, got %" PetscInt_FMT, s->njoints);
   PetscCheck(s->scale_length >= 0 && s->scale_density >= 0 && s->scale_modulus >= 0, s->comm, PETSC_ERR_USER_INPUT, "-scale_length, -scale_density and -scale_modulus must be positive (or 0 for automatic)");
   PetscCheck(s->assembly_tol > 0, s->comm, PETSC_ERR_USER_INPUT, "-assembly_tol must be positive, got %g", (double)s->assembly_tol);
-  PetscCheck(s->project_interval >= 0, s->comm, PETSC_ERR_USER_INPUT, "-joints_project_interval must be >= 0, got %" PetscInt_FMT, s->project_interval);
+  PetscCheck(s->assembly_max_it > 0, s->comm, PETSC_ERR_USER_INPUT, "-assembly_max_it must be positive, got %" PetscInt_FMT, s->assembly_max_it);
+  PetscCheck(s->project_interval >= 0, s->comm, PETSC_ERR_USER_INPUT, "-joints_project_interval must be 0 (never) or positive, got %" PetscInt_FMT, s->project_interval);
   PetscCall(PetscCalloc1(s->nparts, &s->parts));
   for (PetscInt k = 0; k < s->nparts; k++) {
     PetscCall(PhlexPartCreate(s->comm, k, &s->parts[k]));

@@ -262,6 +262,13 @@ static PetscErrorCode ResolveSide(PhlexJoint j, PetscInt s)
   if (side->port < 0) {
     char avail[1024] = "";
     for (PetscInt k = 0; k < side->part->nports; k++) {
+      size_t have, more;
+      PetscCall(PetscStrlen(avail, &have));
+      PetscCall(PetscStrlen(side->part->ports[k].name, &more));
+      if (have + more + 8 >= sizeof(avail)) { /* a long list: the first ones */
+        PetscCall(PetscStrlcat(avail, ", ...", sizeof(avail)));
+        break;
+      }
       PetscCall(PetscStrlcat(avail, k ? ", " : "", sizeof(avail)));
       PetscCall(PetscStrlcat(avail, side->part->ports[k].name, sizeof(avail)));
     }

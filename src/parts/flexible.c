@@ -48,13 +48,14 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
   char         *rptr[PHLEX_MAX_MATERIALS], **pptr;
-  PetscInt      nregions = PHLEX_MAX_MATERIALS, nports = 256;
+  PetscInt      nregions = PHLEX_MAX_MATERIALS, nports;
   PetscBool     flg, flg_mesh = PETSC_FALSE, has_body_material, fcond = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE;
   PetscInt      motion = 0, inertia = 0, cond = PHLEX_FRAME_PATCH;
   const char   *given = NULL;
   char          who[PHLEX_NAME_LEN + 8];
 
   PetscFunctionBeginUser;
+  PetscCall(PhlexOptionsListLength(b->prefix, "-ports", &nports));
   PetscCall(PetscMalloc1(nports, &pptr));
   for (PetscInt i = 0; i < PHLEX_MAX_MATERIALS; i++) rptr[i] = NULL;
   for (PetscInt i = 0; i < nports; i++) pptr[i] = NULL;
@@ -64,7 +65,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCall(PetscOptionsInt("-petscspace_degree", "Velocity degree k (1 or 2); stress: discontinuous degree k-1", "PhlexFlexibleSetFromOptions", b->degree, &b->degree, NULL));
   PetscCall(PetscOptionsEList("-motion", "Rigid motion of the body frame: fixed (clamped patch held) or floating (the frame moves)", "PhlexFlexibleSetFromOptions", PhlexMotionTypes, 2, PhlexMotionTypes[motion], &motion, NULL));
   PetscCall(PetscOptionsString("-frame_patch", "Physical surface where u_f = v_f = 0: the clamp of a fixed body, the frame patch of a floating one", "PhlexFlexibleSetFromOptions", b->frame_patch, b->frame_patch, sizeof(b->frame_patch), NULL));
-  PetscCall(PetscOptionsEList("-frame", "Floating body: frame fixed by a patch (-frame_patch, a rigid inclusion) or by mean axes (Tisserand: int rho u_f = 0, int rho x x u_f = 0)", "PhlexFlexibleSetFromOptions", PhlexFrameConditions, 2, PhlexFrameConditions[cond], &cond, &fcond));
+  PetscCall(PetscOptionsEList("-frame", "Floating body: frame fixed by a patch (-frame_patch, a rigid inclusion) or by mean axes (Tisserand: int rho u_f = 0, int rho (x - P) x u_f = 0)", "PhlexFlexibleSetFromOptions", PhlexFrameConditions, 2, PhlexFrameConditions[cond], &cond, &fcond));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_origin", "Floating body with mean axes: frame origin P (default: the centre of mass) [m]", "PhlexFlexibleSetFromOptions", 3, b->origin, &b->origin_given));
   PetscCall(PetscOptionsEList("-inertia", "Floating body: inertia with x + u_f (full) or at u_f = 0 (frozen, quadratic Hamiltonian)", "PhlexFlexibleSetFromOptions", PhlexInertiaTypes, 2, PhlexInertiaTypes[inertia], &inertia, NULL));
   PetscCall(PetscOptionsStringArray("-regions", "Physical volumes with their own material (-region_<name>_youngs_modulus ...)", "PhlexFlexibleSetFromOptions", rptr, &nregions, &flg));
@@ -381,7 +382,7 @@ static PetscErrorCode FlexRigidMass(PhlexPart part, PetscReal M[36])
 static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool fields)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
-  char          name[PHLEX_NAME_LEN + 16], header[4096] = "time";
+  char          name[PHLEX_NAME_LEN + 16], header[1024];
 
   PetscFunctionBeginUser;
   if (fields) {
@@ -389,22 +390,22 @@ static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool 
     if (b->floating) PetscCall(PhlexFieldWriterSetGeometryField((PhlexFieldWriter)b->writer, "inertial_position"));
   }
   if (b->nports || b->floating) {
+    PetscViewer csv;
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", b->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, NULL, &csv));
+    b->ports_csv = csv;
+    PetscCall(PetscViewerASCIIPrintf(csv, "time"));
     /* the frame of a floating body first (its patch, or "frame" with mean axes), then the ports */
     for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
       const char *n = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      char        cols[1024];
-      PetscCall(PetscSNPrintf(cols, sizeof(cols), ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
-      PetscCall(PetscStrlcat(header, cols, sizeof(header)));
+      PetscCall(PetscViewerASCIIPrintf(csv, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
     }
     /* then the inertial positions of the port points (the mean of the patch's displaced points) */
     for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
       const char *n = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      char        cols[256];
-      PetscCall(PetscSNPrintf(cols, sizeof(cols), ",%s_x,%s_y,%s_z", n, n, n));
-      PetscCall(PetscStrlcat(header, cols, sizeof(header)));
+      PetscCall(PetscViewerASCIIPrintf(csv, ",%s_x,%s_y,%s_z", n, n, n));
     }
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", b->name));
-    PetscCall(PhlexOutputCSVOpen(out, name, header, (PetscViewer *)&b->ports_csv));
+    PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
   }
   if (b->floating) {
     PetscCall(PhlexFrameWriteHeader(header, sizeof(header)));
@@ -437,7 +438,7 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
     }
     for (PetscInt p = 0; p < b->nports; p++) {
       PetscReal in[6];
-      PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, NULL, in));
+      PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, b->floating ? b->fs.R : NULL, in)); /* body frame */
       for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force)));
       for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force * u->length)));
       for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->port_y[p][c] * u->velocity)));
@@ -445,7 +446,9 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
     }
     for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
       PetscReal x[3], R[9];
-      PetscCall((*part->ops.portplacement)(part, p >= 0 ? p : part->nports - 1, X, x, R));
+      if (p >= 0) PetscCall((*part->ops.portplacement)(part, p, X, x, R));
+      else
+        for (PetscInt c = 0; c < 3; c++) x[c] = b->fs.r[c]; /* the frame: its origin P */
       for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
     }
     PetscCall(PetscViewerASCIIPrintf(csv, "\n"));

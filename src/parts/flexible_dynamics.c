@@ -237,13 +237,33 @@ static PetscErrorCode FlexPortLinearBlock(PhlexPart part, PetscInt q, Mat Y, Pet
     PetscCall(MatGetLocalSize(Y, &n, NULL));
     PetscCall(MatDenseGetLDA(Y, &ld));
     PetscCall(MatDenseGetArrayRead(Y, &Ya));
-    for (PetscInt c = 0; c < 6; c++) PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da[c]));
-    for (PetscInt j = 0; j < k; j++) {
-      const PetscScalar *y = Ya + j * ld;
-      for (PetscInt i = 0; i < n; i++)
-        for (PetscInt c = 0; c < 6; c++) loc[6 * j + c] += PetscRealPart(da[c][i] * y[i]);
+    if (n > 0) {
+      /* loc = D^T Y (6 x k), D the port's six distribution vectors (n x 6): one BLAS product; D is a block of the
+         border basis W when a joint uses the port */
+      const PetscScalar *Wa = NULL;
+      PetscScalar       *D  = NULL;
+      PetscInt           ldd = n;
+      PetscBLASInt       bn, bk, bld, bldd, six = 6;
+      PetscScalar        one = 1.0, zero = 0.0;
+      if (b->W && b->port_basis_col[q] >= 0) {
+        PetscCall(MatDenseGetLDA(b->W, &ldd));
+        PetscCall(MatDenseGetArrayRead(b->W, &Wa));
+      } else {
+        PetscCall(PetscMalloc1(6 * n, &D));
+        for (PetscInt c = 0; c < 6; c++) {
+          PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da[c]));
+          PetscCall(PetscArraycpy(D + c * n, da[c], n));
+          PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da[c]));
+        }
+      }
+      PetscCall(PetscBLASIntCast(n, &bn));
+      PetscCall(PetscBLASIntCast(k, &bk));
+      PetscCall(PetscBLASIntCast(ld, &bld));
+      PetscCall(PetscBLASIntCast(ldd, &bldd));
+      PetscCallBLAS("BLASgemm", BLASgemm_("T", "N", &six, &bk, &bn, &one, Wa ? Wa + b->port_basis_col[q] * ldd : D, &bldd, Ya, &bld, &zero, loc, &six));
+      if (Wa) PetscCall(MatDenseRestoreArrayRead(b->W, &Wa));
+      PetscCall(PetscFree(D));
     }
-    for (PetscInt c = 0; c < 6; c++) PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da[c]));
     PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
   }
   PetscCall(MPIU_Allreduce(loc, out, 6 * k, MPIU_REAL, MPI_SUM, b->comm));
@@ -711,12 +731,16 @@ static PetscErrorCode FlexBorderRows(PhlexPart part, Mat Y, PetscReal *out, Pets
   PetscCall(MatDenseGetLDA(Y, &ldy));
   PetscCall(PetscCalloc2(nq * k, &loc, nq * k, &glob));
   PetscCall(MatDenseGetArrayRead(Y, &Ya));
-  for (PetscInt j = 0; j < k; j++)
-    for (PetscInt i = 0; i < nq; i++) {
-      PetscReal s = 0;
-      for (PetscInt r = 0; r < n; r++) s += b->Cpre[i * n + r] * PetscRealPart(Ya[j * ldy + r]);
-      loc[i + nq * j] = s;
-    }
+  if (n > 0) {
+    /* loc = Cpre^T Y (nq x k): one BLAS product */
+    PetscBLASInt bn, bnq, bk, bld;
+    PetscScalar  one = 1.0, zero = 0.0;
+    PetscCall(PetscBLASIntCast(n, &bn));
+    PetscCall(PetscBLASIntCast(nq, &bnq));
+    PetscCall(PetscBLASIntCast(k, &bk));
+    PetscCall(PetscBLASIntCast(ldy, &bld));
+    PetscCallBLAS("BLASgemm", BLASgemm_("T", "N", &bnq, &bk, &bn, &one, b->Cpre, &bn, Ya, &bld, &zero, loc, &bnq));
+  }
   PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
   PetscCall(MPIU_Allreduce(loc, glob, nq * k, MPIU_REAL, MPI_SUM, b->comm));
   for (PetscInt j = 0; j < k; j++)
@@ -741,12 +765,16 @@ static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, Pe
   PetscCall(MatDenseGetLDA(b->W, &ldw));
   PetscCall(PetscCalloc2(k * nq, &loc, k * nq, &glob));
   PetscCall(MatDenseGetArrayRead(b->W, &Wa));
-  for (PetscInt j = 0; j < nq; j++)
-    for (PetscInt i = 0; i < k; i++) {
-      PetscScalar s = 0;
-      for (PetscInt r = 0; r < n; r++) s += Wa[i * ldw + r] * b->Bc[j * n + r];
-      loc[i + k * j] = s;
-    }
+  if (n > 0) {
+    /* loc = W^T Bc (k x nq): one BLAS product */
+    PetscBLASInt bn, bk, bnq, bldw;
+    PetscScalar  one = 1.0, zero = 0.0;
+    PetscCall(PetscBLASIntCast(n, &bn));
+    PetscCall(PetscBLASIntCast(k, &bk));
+    PetscCall(PetscBLASIntCast(nq, &bnq));
+    PetscCall(PetscBLASIntCast(ldw, &bldw));
+    PetscCallBLAS("BLASgemm", BLASgemm_("T", "N", &bk, &bnq, &bn, &one, Wa, &bldw, b->Bc, &bn, &zero, loc, &bk));
+  }
   PetscCall(MatDenseRestoreArrayRead(b->W, &Wa));
   PetscCall(MPIU_Allreduce(loc, glob, k * nq, MPIU_SCALAR, MPIU_SUM, b->comm));
   PetscCall(PetscBLASIntCast(k, &kb));

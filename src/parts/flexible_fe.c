@@ -458,7 +458,9 @@ static PetscErrorCode CheckCondensation(PhlexFlexible b, const PhlexUnits *u)
   PetscBool                             check = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-phlex_check_condensation", &check, NULL));
+  PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
+  PetscCall(PetscOptionsBool("-phlex_check_condensation", "Compare the element-wise stress elimination G^T Ms^-1 G with the stiffness, every cell", "PhlexFlexibleSetUpMixed", check, &check, NULL));
+  PetscOptionsEnd();
   if (!check) PetscFunctionReturn(0);
   PetscCall(PetscMalloc5(ns * nv, &Ge, ns * ns, &Mse, nv * nv, &Ke, nv * nv, &Kc, ns * nv, &work));
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {

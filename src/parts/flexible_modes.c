@@ -155,7 +155,9 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
   want  = nev + (free_body ? 6 : 0);
   sigma = free_body ? -PetscSqr(1e-2 * omega) : 0.0;
-  PetscCall(PetscOptionsGetReal(NULL, "modes_", "-target_frequency", &ftarget, &flg));
+  PetscOptionsBegin(b->comm, "modes_", "Modal analysis options", NULL);
+  PetscCall(PetscOptionsReal("-target_frequency", "Look for the modes nearest this frequency [Hz] (default: the lowest)", "PhlexFlexibleComputeModes", ftarget, &ftarget, &flg));
+  PetscOptionsEnd();
   if (flg) {
     PetscCheck(ftarget >= 0, b->comm, PETSC_ERR_USER_INPUT, "-modes_target_frequency must be >= 0 Hz, got %g", (double)ftarget);
     sigma = PetscSqr(2.0 * PETSC_PI * ftarget * units->time);

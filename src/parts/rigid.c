@@ -24,12 +24,13 @@ static PetscErrorCode RigidSetFromOptions(PhlexPart part)
 {
   Rigid    *r = (Rigid *)part->data;
   char      who[PHLEX_NAME_LEN + 8], **names;
-  PetscInt  n = 6, nports = 256;
+  PetscInt  n = 6, nports;
   PetscReal J[6] = {0, 0, 0, 0, 0, 0};
   PetscBool fm = PETSC_FALSE, fJ = PETSC_FALSE, ff = PETSC_FALSE, fmo = PETSC_FALSE, flg;
 
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", part->name));
+  PetscCall(PhlexOptionsListLength(part->prefix, "-ports", &nports));
   PetscCall(PetscMalloc1(nports, &names));
   PetscOptionsBegin(part->comm, part->prefix, "Rigid body options", NULL);
   PetscCall(PetscOptionsReal("-mass", "Mass [kg]", "RigidSetFromOptions", r->mass, &r->mass, &fm));
@@ -358,22 +359,22 @@ static PetscErrorCode RigidRigidMass(PhlexPart part, PetscReal M[36])
 static PetscErrorCode RigidOutputOpen(PhlexPart part, PhlexOutput out, PetscBool fields)
 {
   Rigid *r = (Rigid *)part->data;
-  char   name[PHLEX_NAME_LEN + 16], header[4096] = "time";
+  char   name[PHLEX_NAME_LEN + 16], header[1024];
 
   PetscFunctionBeginUser;
   PetscCall(PhlexFrameWriteHeader(header, sizeof(header)));
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_rigid.csv", part->name));
   PetscCall(PhlexOutputCSVOpen(out, name, header, &r->rigid_csv));
   if (r->nports) {
-    PetscCall(PetscStrcpy(header, "time"));
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, NULL, &r->ports_csv));
+    PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "time"));
     for (PetscInt p = 0; p < r->nports; p++) {
       const char *n = r->port_name[p];
-      char        cols[1024];
-      PetscCall(PetscSNPrintf(cols, sizeof(cols), ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
-      PetscCall(PetscStrlcat(header, cols, sizeof(header)));
+      PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
     }
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part->name));
-    PetscCall(PhlexOutputCSVOpen(out, name, header, &r->ports_csv));
+    for (PetscInt p = 0; p < r->nports; p++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%s_x,%s_y,%s_z", r->port_name[p], r->port_name[p], r->port_name[p]));
+    PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "\n"));
   }
   PetscFunctionReturn(0);
 }
@@ -391,12 +392,17 @@ static PetscErrorCode RigidOutputStep(PhlexPart part, PetscInt step, PetscReal t
     PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "%.12e", (double)t));
     for (PetscInt p = 0; p < r->nports; p++) {
       PetscReal in[6], y[6];
-      PetscCall(PhlexPortLoadEvaluate(&r->load[p], t, u, NULL, in));
+      PetscCall(PhlexPortLoadEvaluate(&r->load[p], t, u, r->fs.R, in)); /* body frame */
       PetscCall(RigidPortOutput(part, p, y));
       for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(in[c] * u->force)));
       for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(in[c] * u->force * u->length)));
       for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(y[c] * u->velocity)));
       for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(y[c] / u->time)));
+    }
+    for (PetscInt p = 0; p < r->nports; p++) {
+      PetscReal x[3], R[9];
+      PetscCall((*part->ops.portplacement)(part, p, X, x, R));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(x[c] * u->length)));
     }
     PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "\n"));
   }

@@ -277,7 +277,9 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(PetscFree(blocks));
   }
   PetscCall(PetscObjectSetName((PetscObject)sys->J, "Jacobian"));
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-phlex_jacobian_aij", &sys->use_aij, NULL));
+  PetscOptionsBegin(sys->comm, NULL, "System options", NULL);
+  PetscCall(PetscOptionsBool("-phlex_jacobian_aij", "Also assemble the Jacobian as one AIJ matrix (monolithic factorisations, -snes_test_jacobian)", "PhlexSystemCreate", sys->use_aij, &sys->use_aij, NULL));
+  PetscOptionsEnd();
   PetscCall(PetscMalloc2(PetscMax(sys->nfparts, 1), &sys->xu, PetscMax(sys->nfparts, 1), &sys->xv));
   PetscCall(PetscFree(ops));
   PetscCall(PhlexSystemSetUpBorder(sys));

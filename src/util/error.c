@@ -75,3 +75,21 @@ PetscErrorCode PhlexOptionsRealN(PetscOptionItems *PetscOptionsObject, MPI_Comm 
   if (set) *set = flg;
   PetscFunctionReturn(0);
 }
+
+/*@C
+  PhlexOptionsListLength - the number of entries of a comma-separated option value (at least 1; 1 when unset), to
+  size the array handed to PetscOptionsStringArray (no fixed cap on the number of ports)
+@*/
+PetscErrorCode PhlexOptionsListLength(const char prefix[], const char name[], PetscInt *n)
+{
+  const char *value = NULL;
+  PetscBool   set;
+
+  PetscFunctionBeginUser;
+  *n = 1;
+  PetscCall(PetscOptionsFindPair(NULL, prefix, name, &value, &set));
+  if (set && value)
+    for (const char *c = value; *c; c++)
+      if (*c == ',') (*n)++;
+  PetscFunctionReturn(0);
+}

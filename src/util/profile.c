@@ -102,7 +102,7 @@ static PetscErrorCode PhlexProfileReadTableFile(PhlexProfile p, const char file[
 @*/
 PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile p)
 {
-  PetscReal table[512];
+  PetscReal table[512] = {0};
   PetscInt  ntable = 512;
   PetscBool flg_table = PETSC_FALSE, flg_file = PETSC_FALSE;
   char      file[PETSC_MAX_PATH_LEN] = "";
