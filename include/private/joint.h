@@ -36,7 +36,7 @@ typedef struct {
   PetscInt  port;                         /* port index, -1 for the ground */
   PetscReal offset[3];                    /* joint point relative to the port point, port frame (ground: the inertial point) */
   PetscReal arm[3];                       /* the offset in the body frame: turned by the port's own rotation relative to
-                                             the body frame (a flexible port's mean rotation) at the last accepted state */
+                                             the body frame (a flexible port's mean rotation), held over a step (PhlexJointUpdateGeometry) */
   PetscBool rotation;                     /* the side has an orientation (not a point mass, not the ground... ground: yes) */
 } PhlexJointSide;
 
@@ -61,7 +61,7 @@ struct _p_PhlexJoint {
   PetscReal     frame[9];  /* rows e1, e2, e3 of a's joint frame, in a's port frame */
   PetscReal     axis_b[3]; /* universal: second axis in b's port frame */
   PetscReal     dir[9];    /* e1, e2, e3 in a's body frame and */
-  PetscReal     eb[3];     /* the second axis in b's body frame, at the last accepted state (PhlexJointUpdateGeometry) */
+  PetscReal     eb[3];     /* the second axis in b's body frame, held over a step (PhlexJointUpdateGeometry) */
   PetscReal     Rrel0[9];  /* R~_a^T R~_b at the drawn configuration (port orientations) */
   PetscInt      ndropped;  /* rows removed as redundant */
   char          dropped[7][8];

@@ -63,6 +63,7 @@ struct _p_PhlexSystem {
   IS       *fis[3]; /* per field part: its block in the numbering of the displacement, stress, velocity fields */
   PhlexBorderedData border;
   Vec       *xu, *xv; /* work: per field part */
+  Vec        Xwork;    /* work: a whole state (the joints' mid-step geometry) */
   PetscReal  fprev;    /* Newton: the previous residual norm (round-off floor test) */
 };
 

@@ -5,8 +5,9 @@
    one-step scheme the multiplier it uses over a step is (Lambda_{n+1} - Lambda_n)/dt: for the implicit midpoint rule
    exactly the midpoint multiplier, for the others the step average of lambda (for BDF the average of the
    backward-difference rate, converging to lambda(t_{n+1/2})). The joint series write this step average (time t_{n+1}),
-   which has no step-to-step oscillation; the power through a joint is lambda . (c + g) at the state where the scheme
-   enforces the constraints (its stage). */
+   which has no step-to-step oscillation. The power through a joint is lambda . (c + g) measured at the stage of the
+   theta methods (where the scheme enforces the constraints); for the other schemes lambda . g(t), the scheme holding
+   c = g. */
 #include <phlex_impl.h>
 
 typedef struct {
@@ -398,8 +399,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   /* Adaptive steppers (-ts_adapt_type basic, the default of BDF): weights atol + rtol |x| per unknown, rtol from
      -ts_rtol (1e-6). The fields are non-dimensional (velocities ~ 1e-4 of the wave speed), so PETSc's default absolute
      tolerance 1e-4 would accept anything: atol from -ts_atol (1e-12). The frames' positions and rotations are O(1)
-     (lengths in L, rotation entries, some of which start at 0): atol = rtol. Their velocities: rtol times the larger
-     of the initial speeds and sqrt(|g| L). The impulses (whose rates are the multipliers of an index-2 system) are
+     (lengths in L, rotation entries, some of which start at 0): atol = rtol. Their velocities: rtol times the largest
+     of the initial speeds, the drives' and prescribed speeds and sqrt(|g| L) (1e-3 if all are zero). The impulses (whose rates are the multipliers of an index-2 system) are
      left out of the error norm. PETSc takes vector tolerances over -ts_rtol/-ts_atol, hence they are read here. */
   {
     Vec        vatol, vrtol;
@@ -417,7 +418,11 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(PhlexSystemGather(sys, X, sys->q));
       for (PetscInt k = 0; k < sys->nq; k++)
         if (sys->qkind[k] == PHLEX_DOF_VELOCITY) vchar = PetscMax(vchar, PetscAbsReal(sys->q[k]));
-      if (vchar == 0) vchar = 1.0;
+      for (PetscInt k = 0; k < sys->njoints; k++) {
+        const PhlexJoint j = sys->joints[k];
+        vchar = PetscMax(vchar, PetscMax(PetscAbsReal(j->drive_velocity) * (j->drive_row >= 0 && j->row[j->drive_row] == PHLEX_ROW_R3 ? scene->units.length : 1.0), PetscMax(PhlexNorm3(j->presc_velocity), PhlexNorm3(j->presc_angular) * scene->units.length)) / scene->units.velocity);
+      }
+      if (vchar == 0) vchar = 1e-3; /* a scene at rest moved by loads only */
       PetscCall(PetscMalloc1(sys->nq, &a));
       for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 1e300 : (sys->qkind[k] == PHLEX_DOF_VELOCITY ? rtol * vchar : rtol);
       PetscCall(PhlexSystemScatter(sys, a, vatol));

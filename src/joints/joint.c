@@ -161,13 +161,16 @@ PetscErrorCode PhlexJointCreate(PhlexScene scene, PetscInt index, PhlexJoint *jo
 @*/
 PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
 {
-  char     *ports[3] = {NULL, NULL, NULL};
-  PetscInt  nports = 3, type = PHLEX_JOINT_REVOLUTE, comp = 0;
+  char    **ports;
+  PetscInt  nports, nalloc, type = PHLEX_JOINT_REVOLUTE, comp = 0;
   PetscBool ftype = PETSC_FALSE, fports = PETSC_FALSE, fdrive = PETSC_FALSE, fcomp = PETSC_FALSE, fdi = PETSC_FALSE;
   char      who[PHLEX_NAME_LEN + 16];
   const char *const comps[] = {"rotation", "translation", "PhlexDriveComponent", "", NULL};
 
   PetscFunctionBeginUser;
+  PetscCall(PhlexOptionsListLength(j->prefix, "-ports", &nalloc)); /* the count a wrong list really has */
+  nports = nalloc;
+  PetscCall(PetscCalloc1(nalloc, &ports));
   PetscOptionsBegin(j->comm, j->prefix, "Joint options", NULL);
   PetscCall(PetscOptionsString("-name", "Name of the joint (messages, output files)", "PhlexJointSetFromOptions", j->name, j->name, sizeof(j->name), NULL));
   PetscCall(PetscSNPrintf(who, sizeof(who), "joint %s", j->name));
@@ -198,6 +201,7 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
     PetscCheck(!j->presc_v && !j->presc_w, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%svelocity and -%sangular_velocity belong to a prescribed motion (-%stype prescribed)", j->name, j->prefix, j->prefix, j->prefix);
   }
   for (PetscInt k = 0; k < nports; k++) PetscCall(PetscFree(ports[k]));
+  PetscCall(PetscFree(ports));
   {
     const PetscBool needs_axis = (j->type == PHLEX_JOINT_REVOLUTE || j->type == PHLEX_JOINT_PRISMATIC || j->type == PHLEX_JOINT_CYLINDRICAL || j->type == PHLEX_JOINT_UNIVERSAL || j->type == PHLEX_JOINT_PLANAR) ? PETSC_TRUE : PETSC_FALSE;
     PetscCheck(!needs_axis || j->axis_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a %s joint needs its axis: -%saxis x,y,z", j->name, PhlexJointTypes[j->type], j->prefix);
@@ -365,16 +369,18 @@ PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const Phlex
 }
 
 /*@C
-  PhlexJointUpdateGeometry - the joint's directions and arms in the body frames at an accepted state X: the port
-  frame relative to the body frame, P = R_f^T Rp (identity but on a flexible port: its mean rotation), turns the
-  joint frame, the universal's second axis and the offsets
+  PhlexJointUpdateGeometry - the joint's directions and arms in the body frames at a state X: the port frame
+  relative to the body frame, P = R_f^T Rp (identity but on a flexible port: its mean rotation), turns the joint
+  frame, the universal's second axis and the offsets
 
   Collective
 
   Notes:
-  Called at set-up and after every step. Within a step P is held (lagged by one step): the rows and the wrenches
-  use the same directions, so the joint stays exactly workless, and the Jacobian has no term from P; the joint
-  frame follows the port's elastic rotation up to its change over one step.
+  Called at set-up and before every step, at the displacements extrapolated to the middle of the step
+  (PhlexSystemUpdateJoints). Within a step P is held: the rows and the wrenches use the same directions, so the
+  joint stays exactly workless, and the Jacobian has no term from P; the joint frame follows the port's elastic
+  rotation up to a lag of second order in the step. A step retried with a smaller step size (adaptive steps,
+  Newton failure) keeps the directions of the first try.
 @*/
 PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb)
 {

@@ -108,7 +108,7 @@ static PetscErrorCode AddJointLoads(PhlexPart part)
       for (PetscInt k = 0; k < 6; k++) {
         if (w[k] == 0.0) continue;
         PetscCall(VecAXPY(bext, w[k], b->ports[q].dist[k]));
-        if (b->floating && k < 3) PetscCall(VecAXPY(f->barm, w[k], b->ports[q].dist[k])); /* the Jacobian's arms */
+        if (b->floating && !b->frozen_inertia && k < 3) PetscCall(VecAXPY(f->barm, w[k], b->ports[q].dist[k])); /* the Jacobian's arms */
       }
     if (b->floating) {
       PetscReal a[3], c[3];
@@ -130,11 +130,12 @@ static PetscErrorCode AddJointLoads(PhlexPart part)
 /* Port q's output, the velocity of its mean motion (body frame): translation B_t^T V of the material velocity
    V = v [+ v_P + w x (x - P + u)], rotation w + B_r^T v. A port turns with its mean rotation theta = B_r^T u, so its
    angular velocity has no w x u term (to first order in theta); its position r + R (c - P + ubar) has exactly the
-   rate of the translation, so a joint's position-level gap follows its velocity constraint (midpoint rule: exactly
-   for translations). The wrench distribution is the transpose: B w on the elastic rows; F and
+   rate of the translation (full inertia), so a joint's position-level gap follows its velocity constraint (midpoint
+   rule: exactly for translations). With frozen inertia the kinematics are those at u = 0 (no w x ubar): a joint on
+   such a port drifts at |w x ubar|, the model's own approximation. The wrench distribution is the transpose: B w on the elastic rows; F and
    (c - P + ubar) x F + T on the frame. The ubar terms appear in the full-inertia model only (as the inertia terms). */
 
-/* the mean displacements of the ports (full model; every port: loads in the inertial frame need them too) and the
+/* the mean displacements of the ports (full model; the ports with joints or loads: the arms of their forces) and the
    outputs of the ports (all, or those a joint uses) at the evaluated state */
 static PetscErrorCode PortOutputs(PhlexPart part, const PhlexPartVec *X, PetscBool all)
 {
@@ -145,7 +146,7 @@ static PetscErrorCode PortOutputs(PhlexPart part, const PhlexPartVec *X, PetscBo
   for (PetscInt q = 0; q < part->nports; q++) {
     PetscScalar d[6] = {0, 0, 0, 0, 0, 0}, du[3] = {0, 0, 0};
     PetscReal   ub[3] = {0, 0, 0};
-    if (full && q < b->nports) {
+    if (full && q < b->nports && (part->port_used[q] || b->ports[q].load.loaded)) {
       PetscCall(VecMDot(X->u, 3, b->ports[q].dist, du));
       for (PetscInt k = 0; k < 3; k++) ub[k] = b->port_ubar[q][k] = PetscRealPart(du[k]);
     }

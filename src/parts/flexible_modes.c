@@ -128,7 +128,9 @@ static PetscErrorCode FloatingPencil(PhlexFlexible b, Mat *A, Mat *B, IS is[2])
   free-free modes. With mean axes the field's rigid content is constrained away, T^T v = 0 with T = Mv Phi (Phi: the
   six rigid fields; int rho v = 0, int rho (x - P) x v = 0), so the kinetic energy splits into the frame's and the
   field's: the six rigid modes are the frame's own (v = 0), and the elastic ones solve K v = lambda Mv v on the
-  Mv-orthogonal complement of Phi (SLEPc's deflation space), i.e. they are the unconstrained free body's.
+  Mv-orthogonal complement of Phi (SLEPc's deflation space), i.e. they are the unconstrained free body's. The frame
+  modes come first, with zero elastic vectors and unit rigid parts; -modes_eps_nev then counts the elastic modes
+  only (with a frame patch it counts all, rigid ones included).
 
   Options Database Keys:
 + -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)

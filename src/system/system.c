@@ -598,11 +598,17 @@ PetscErrorCode PhlexSystemJointSidesRestore(PhlexSystem sys, PhlexJoint j, Vec X
 @*/
 PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem sys, Vec X, PetscReal dt)
 {
-  Vec Xm;
+  Vec       Xm;
+  PetscBool flexible = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  if (!sys->njoints) PetscFunctionReturn(0);
-  PetscCall(VecDuplicate(X, &Xm));
+  /* only a flexible port turns relative to its body frame */
+  for (PetscInt k = 0; k < sys->njoints; k++)
+    for (PetscInt s = 0; s < 2; s++)
+      if (sys->joints[k]->side[s].part->nv) flexible = PETSC_TRUE;
+  if (!flexible) PetscFunctionReturn(0);
+  if (!sys->Xwork) PetscCall(VecDuplicate(X, &sys->Xwork));
+  Xm = sys->Xwork;
   PetscCall(VecCopy(X, Xm));
   if (sys->nfparts) {
     Vec um, v;
@@ -619,7 +625,6 @@ PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem sys, Vec X, PetscReal dt)
     PetscCall(PhlexJointUpdateGeometry(sys->joints[k], &pv[0], &pv[1]));
     PetscCall(PhlexSystemJointSidesRestore(sys, sys->joints[k], Xm, pv));
   }
-  PetscCall(VecDestroy(&Xm));
   PetscFunctionReturn(0);
 }
 
@@ -654,6 +659,7 @@ PetscErrorCode PhlexSystemDestroy(PhlexSystem *system)
 
   PetscFunctionBeginUser;
   if (!sys) PetscFunctionReturn(0);
+  PetscCall(VecDestroy(&sys->Xwork));
   for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++) PetscCall(ISDestroy(&sys->is[f]));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PetscCall(ISDestroy(&sys->fparts[i]->isu));
