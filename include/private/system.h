@@ -80,6 +80,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemInitialState(PhlexSystem, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemPostStep(PhlexSystem, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexSystemJointSides(PhlexSystem, PhlexJoint, Vec, PetscReal *, PhlexPartVec[2]);
 PETSC_INTERN PetscErrorCode PhlexSystemJointSidesRestore(PhlexSystem, PhlexJoint, Vec, PhlexPartVec[2]);
+PETSC_INTERN PetscErrorCode PhlexSystemEnergy(PhlexSystem, PetscReal, Vec, PetscReal *, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem, Vec, PetscReal);
 PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);

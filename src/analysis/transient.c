@@ -66,15 +66,11 @@ static PetscErrorCode EnergyAndOutputs(MonitorContext *m, PetscInt step, PetscRe
   PhlexSystem sys = m->sys;
 
   PetscFunctionBeginUser;
-  PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
-  *kin = *strain = *pot = 0.0;
+  PetscCall(PhlexSystemEnergy(sys, t, X, kin, strain, pot));
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart    p = sys->parts[i];
     PhlexPartVec pv;
-    PetscReal    k, s, v;
     PetscCall(PhlexPartGetVec(p, X, sys->q, &pv));
-    PetscCall((*p->ops.energy)(p, &pv, &k, &s, &v));
-    *kin += k, *strain += s, *pot += v;
     PetscCall((*p->ops.outputstep)(p, step, t, &pv, fields));
     PetscCall(PhlexPartRestoreVec(p, X, &pv));
     if (p->frame.R >= 0) m->max_orth = PetscMax(m->max_orth, PhlexOrthogonalityError(sys->q + p->qoff + p->frame.R));

@@ -177,19 +177,11 @@ static PetscErrorCode Gaps(PhlexSystem sys, PetscReal t, Vec X, PetscReal *gap, 
 /* the total energy at X (non-dimensional) */
 static PetscErrorCode Energy(PhlexSystem sys, PetscReal t, Vec X, PetscReal *H, PetscReal *kin)
 {
+  PetscReal s, v;
+
   PetscFunctionBeginUser;
-  PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
-  *H = *kin = 0.0;
-  for (PetscInt i = 0; i < sys->nparts; i++) {
-    PhlexPart    p = sys->parts[i];
-    PhlexPartVec pv;
-    PetscReal    k, s, v;
-    PetscCall(PhlexPartGetVec(p, X, sys->q, &pv));
-    PetscCall((*p->ops.energy)(p, &pv, &k, &s, &v));
-    PetscCall(PhlexPartRestoreVec(p, X, &pv));
-    *H += k + s + v;
-    *kin += k;
-  }
+  PetscCall(PhlexSystemEnergy(sys, t, X, kin, &s, &v));
+  *H = *kin + s + v;
   PetscFunctionReturn(0);
 }
 

@@ -464,6 +464,22 @@ static void PortWrenches(PhlexJoint j, const PetscReal wJ[6], const PetscReal *d
   MoveToPort(j->side[1].arm, wbJ, wb);
 }
 
+/* the change of both port wrenches for a unit change of the entry m of side t's R (R_ab and G turn with it, and
+   so does the universal's cross direction); also returns dR_ab and dG */
+static void WrenchesRDerivative(PhlexJoint j, PetscInt t, PetscInt m, const PetscReal wJ[6], PetscReal dRab[9], PetscReal dG[9], PetscReal w[2][6])
+{
+  PetscReal dwJ[6] = {0, 0, 0, 0, 0, 0};
+
+  RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
+  for (PetscInt k = 0; k < j->nc; k++)
+    if (j->row[k] == PHLEX_ROW_CROSS) {
+      PetscReal dsk[6];
+      RowDirection(j, k, j->Rab, dRab, dsk);
+      for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
+    }
+  PortWrenches(j, wJ, dwJ, dRab, dG, w[0], w[1]);
+}
+
 /*@C
   PhlexJointApplyWrenches - adds the joint's wrenches to its two ports (part->wrench)
 @*/
@@ -638,8 +654,8 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
     if (PhlexPartIsGround(p) || p->frame.R < 0) continue;
     for (PetscInt m = 0; m < 9; m++) {
       const PetscInt col = QIndex(p, p->frame.R + m);
-      PetscReal      dRab[9], dG[9], r[6], ra[6], dwJ[6], w[2][6];
-      RabDerivative(s, m, j->Ra, j->Rb, dRab, dG);
+      PetscReal      dRab[9], dG[9], r[6], ra[6], w[2][6];
+      WrenchesRDerivative(j, s, m, wJ, dRab, dG, w);
       Rotate6(dRab, PETSC_FALSE, j->yb, r);
       Rotate6(dG, PETSC_FALSE, j->ya, ra);
       for (PetscInt c = 0; c < 6; c++) r[c] -= ra[c];
@@ -649,14 +665,6 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
         RowDirection(j, k, j->Rab, dRab, dsk);
         D[ld * (j->qoff + k) + col] += Dot6(sk, r) + (j->row[k] == PHLEX_ROW_CROSS ? Dot6(dsk, Dl) : 0.0);
       }
-      for (PetscInt c = 0; c < 6; c++) dwJ[c] = 0.0;
-      for (PetscInt k = 0; k < j->nc; k++)
-        if (j->row[k] == PHLEX_ROW_CROSS) {
-          PetscReal dsk[6];
-          RowDirection(j, k, j->Rab, dRab, dsk);
-          for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
-        }
-      PortWrenches(j, wJ, dwJ, dRab, dG, w[0], w[1]);
       for (PetscInt t = 0; t < 2; t++) {
         PhlexPart  pt = j->side[t].part;
         PetscReal *fq;
@@ -689,16 +697,9 @@ static PetscErrorCode WrenchChange(PhlexJoint j, PetscInt s, PetscReal shift, co
     if (PhlexPartIsGround(p) || p->frame.R < 0) continue;
     for (PetscInt m = 0; m < 9; m++) {
       const PetscReal xm = x[QIndex(p, p->frame.R + m)];
-      PetscReal       dRab[9], dG[9], dwJ[6] = {0, 0, 0, 0, 0, 0};
+      PetscReal       dRab[9], dG[9];
       if (xm == 0.0) continue;
-      RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
-      for (PetscInt k = 0; k < j->nc; k++)
-        if (j->row[k] == PHLEX_ROW_CROSS) {
-          PetscReal dsk[6];
-          RowDirection(j, k, j->Rab, dRab, dsk);
-          for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
-        }
-      PortWrenches(j, wJ, dwJ, dRab, dG, w[0], w[1]);
+      WrenchesRDerivative(j, t, m, wJ, dRab, dG, w);
       for (PetscInt c = 0; c < 6; c++) dw[c] += xm * w[s][c];
     }
   }
@@ -794,15 +795,8 @@ PetscErrorCode PhlexJointBorderCoefficients(PhlexJoint j, PhlexPart part, PetscR
       PhlexPart p = j->side[t].part;
       if (PhlexPartIsGround(p) || p->frame.R < 0) continue;
       for (PetscInt m = 0; m < 9; m++) {
-        PetscReal dRab[9], dG[9], dwJ[6] = {0, 0, 0, 0, 0, 0}, w[2][6];
-        RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
-        for (PetscInt k = 0; k < j->nc; k++)
-          if (j->row[k] == PHLEX_ROW_CROSS) {
-            PetscReal dsk[6];
-            RowDirection(j, k, j->Rab, dRab, dsk);
-            for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
-          }
-        PortWrenches(j, wJ, dwJ, dRab, dG, w[0], w[1]);
+        PetscReal dRab[9], dG[9], w[2][6];
+        WrenchesRDerivative(j, t, m, wJ, dRab, dG, w);
         for (PetscInt c = 0; c < 6; c++) beta[c0 + c + ld * QIndex(p, p->frame.R + m)] -= w[s][c];
       }
     }

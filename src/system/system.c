@@ -553,6 +553,29 @@ PetscErrorCode PhlexSystemInitialState(PhlexSystem sys, Vec X)
 }
 
 /*@C
+  PhlexSystemEnergy - kinetic, strain and potential energy of all parts at (t, X) (non-dimensional); the parts are
+  left evaluated at X
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemEnergy(PhlexSystem sys, PetscReal t, Vec X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
+  *kin = *strain = *pot = 0.0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart    p = sys->parts[i];
+    PhlexPartVec pv;
+    PetscReal    k, s, v;
+    PetscCall(PhlexPartGetVec(p, X, sys->q, &pv));
+    PetscCall((*p->ops.energy)(p, &pv, &k, &s, &v));
+    PetscCall(PhlexPartRestoreVec(p, X, &pv));
+    *kin += k, *strain += s, *pot += v;
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexSystemJointSides - the part vectors of both sides of joint j at X (q: the replicated discrete unknowns of X);
   the ground's are empty, a joint between two ports of one part shares one view
 
