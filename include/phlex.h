@@ -36,11 +36,45 @@ typedef struct {
 /* log.c */
 PETSC_EXTERN PetscClassId  PHLEX_CLASSID;
 PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly;
-PETSC_EXTERN PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes, PHLEX_StageOutput;
+PETSC_EXTERN PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes;
 PETSC_EXTERN PetscErrorCode PhlexLogRegister(void);
+PETSC_EXTERN PetscErrorCode PhlexLogStagePush(const char[], PetscLogStage *);
 
-/* error.c */
+/* error.c: exit codes of bin/phlex (README "Exit codes"), the same on every rank */
+enum {
+  PHLEX_EXIT_SUCCESS   = 0,
+  PHLEX_EXIT_INTERNAL  = 1,   /* an unexpected error (a library failure, out of memory, a bug): PETSc's traceback */
+  PHLEX_EXIT_INPUT     = 2,   /* bad input: options, scene, mesh, joints, unused (misspelt) options */
+  PHLEX_EXIT_NUMERICAL = 3,   /* a numerical failure: Newton or the linear solver diverged, NaN/Inf */
+  PHLEX_EXIT_IO        = 4,   /* the output could not be written */
+  PHLEX_EXIT_SELFCHECK = 5,   /* a -expect_* self-check failed (the results were written) */
+  PHLEX_EXIT_SIGINT    = 130, /* interrupted by SIGINT (128 + 2), SIGTERM gives 143 (128 + 15) */
+};
 PETSC_EXTERN PetscErrorCode PhlexErrorHandlerPush(void);
+PETSC_EXTERN int            PhlexExitCode(void);
+
+/* help.c: -help prints the options and runs nothing */
+typedef enum {
+  PHLEX_HELP_NONE,
+  PHLEX_HELP_OPTIONS,
+  PHLEX_HELP_SOLVERS
+} PhlexHelpMode;
+PETSC_EXTERN const char     PhlexUsage[];
+PETSC_EXTERN PhlexHelpMode  PhlexHelpParseArgs(int *, char **);
+PETSC_EXTERN PhlexHelpMode  PhlexHelpGetMode(void);
+PETSC_EXTERN PetscErrorCode PhlexHelpActivate(MPI_Comm);
+PETSC_EXTERN PetscErrorCode PhlexHelpEnd(MPI_Comm, PetscBool);
+PETSC_EXTERN PetscErrorCode PhlexHelpCaptureBegin(void);
+PETSC_EXTERN PetscErrorCode PhlexHelpCaptureEnd(PetscInt *, char ***);
+
+/* options_check.c: misspelt options fail before the run */
+PETSC_EXTERN PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm, PetscErrorCode (*)(void *), void *);
+PETSC_EXTERN PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm);
+
+/* interrupt.c: SIGINT/SIGTERM end the run at the next step */
+PETSC_EXTERN PetscErrorCode PhlexInterruptPush(void);
+PETSC_EXTERN PetscErrorCode PhlexInterruptCheck(MPI_Comm, const char[]);
+PETSC_EXTERN int            PhlexInterruptExitCode(void);
 
 /* profile.c: scalar time profiles f(t) multiplying an input */
 PETSC_EXTERN PetscErrorCode PhlexProfileCreate(MPI_Comm, const char[], const char[], PhlexProfile *);

@@ -35,6 +35,8 @@ struct _p_PhlexOutput {
   PetscBool fields;   /* write HDF5/XDMF */
   PetscInt  nfiles, maxfiles;
   char    (*tmp)[PETSC_MAX_PATH_LEN], (*final)[PETSC_MAX_PATH_LEN];
+  PetscInt  ncommitted; /* files renamed to their final names so far */
+  PetscBool made_dir;   /* this run created the directory (rank 0) */
 };
 
 /* What to do with redundant constraint components found at set-up. */
@@ -110,6 +112,22 @@ PETSC_INTERN PetscErrorCode PhlexOptionsListLength(const char[], const char[], P
 /* expect.c: self-verification */
 PETSC_INTERN PetscErrorCode PhlexExpectMax(MPI_Comm, const char[], const char[], PetscReal, PetscReal, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexExpectValues(MPI_Comm, const char[], const char[], PetscInt, const PetscReal[], PetscInt, const PetscReal[], PetscReal);
+
+/* format.c: numbers echoed to the user at full precision */
+PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);
+
+/* progress.c: progress lines of long runs (and the interrupt check) */
+typedef struct {
+  PetscLogDouble start, last; /* wall clock: start of the run, last line */
+  char           what[64];    /* what the eigensolver solves, e.g. "body arm" */
+} PhlexProgress;
+PETSC_INTERN PetscErrorCode PhlexProgressSetFromOptions(MPI_Comm);
+PETSC_INTERN PetscErrorCode PhlexProgressStart(PhlexProgress *);
+PETSC_INTERN PetscErrorCode PhlexProgressStep(PhlexProgress *, MPI_Comm, PetscInt, PetscReal, PetscReal, const char[]);
+PETSC_INTERN PetscErrorCode PhlexProgressEPSMonitor(EPS, PetscInt, PetscInt, PetscScalar *, PetscScalar *, PetscReal *, PetscInt, void *);
+
+/* flexible_modes.c: the eigensolver of the modal analysis with its defaults (also read by -help) */
+PETSC_INTERN PetscErrorCode PhlexModesEPSCreate(MPI_Comm, EPS *, PetscReal *, PetscBool *);
 
 /* scene.c */
 PETSC_INTERN PetscErrorCode PhlexSceneFindPart(PhlexScene, const char[], PhlexPart *);

@@ -12,16 +12,66 @@ static PetscReal Frequency(PetscReal lambda, const PhlexUnits *u)
 /* -modes_convergence_refinements n: the elastic frequencies of a body on n further uniform refinements of its
    discretisation, the observed order of the eigenvalues p = log2((l0 - l1)/(l1 - l2)) over the last three levels
    (2k for P_k elements) and the Richardson-extrapolated frequencies. */
-static PetscErrorCode ConvergenceStudy(PhlexScene scene, PhlexPart part, PetscInt nlevels, PetscInt nmodes, const PetscReal *lambda0, PetscInt nrigid0)
+/* the options of the modal analysis (the eigensolver's are read by PhlexModesEPSCreate and EPSSetFromOptions) */
+typedef struct {
+  PetscInt  nev, nexp, nrefine;
+  PetscReal expected[64], rtol, rmax, order_expect, order_tol;
+  PetscBool has_exp;
+} ModesOptions;
+
+static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
 {
-  PetscReal *lam, order_expect = -1, order_tol = 0.25, worst = 0;
+  PetscFunctionBeginUser;
+  o->nev          = 10;
+  o->nexp         = 64;
+  o->nrefine      = 0;
+  o->rtol         = 1e-6;
+  o->rmax         = -1;
+  o->order_expect = -1;
+  o->order_tol    = 0.25;
+  PetscCall(PetscArrayzero(o->expected, 64));
+  PetscOptionsBegin(comm, NULL, "Modal analysis options", NULL);
+  PetscCall(PetscOptionsInt("-modes_nev", "Number of elastic modes wanted", "PhlexSceneSolveModes", o->nev, &o->nev, NULL));
+  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", o->expected, &o->nexp, &o->has_exp));
+  PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveModes", o->rtol, &o->rtol, NULL));
+  PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveModes", o->rmax, &o->rmax, NULL));
+  PetscCall(PetscOptionsInt("-modes_convergence_refinements", "Also solve on this many uniform refinements and report the observed order", "PhlexSceneSolveModes", o->nrefine, &o->nrefine, NULL));
+  PetscCall(PetscOptionsReal("-expect_convergence_order", "Self-check: expected observed order of the eigenvalues", "PhlexSceneSolveModes", o->order_expect, &o->order_expect, NULL));
+  PetscCall(PetscOptionsReal("-expect_convergence_order_tol", "Tolerance of that check (absolute, on the order)", "PhlexSceneSolveModes", o->order_tol, &o->order_tol, NULL));
+  PetscOptionsEnd();
+  PetscCheck(o->nev >= 1, comm, PETSC_ERR_USER_INPUT, "-modes_nev must be >= 1, got %" PetscInt_FMT, o->nev);
+  if (!o->has_exp) o->nexp = 0;
+  PetscFunctionReturn(0);
+}
+
+/* every option of a modal run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's, the
+   analysis', the eigensolver's */
+static PetscErrorCode ModesRereadOptions(void *ctx)
+{
+  MPI_Comm     comm = *(MPI_Comm *)ctx;
+  PhlexScene   scene;
+  ModesOptions o;
+  EPS          eps;
+  PetscReal    ftarget = -1;
+  PetscBool    flg;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSceneCreate(comm, &scene));
+  PetscCall(PhlexSceneSetFromOptions(scene));
+  PetscCall(PhlexSceneDestroy(&scene));
+  PetscCall(ModesSetFromOptions(comm, &o));
+  PetscCall(PhlexModesEPSCreate(comm, &eps, &ftarget, &flg));
+  PetscCall(EPSSetFromOptions(eps));
+  PetscCall(EPSDestroy(&eps));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ConvergenceStudy(PhlexScene scene, PhlexPart part, PetscInt nlevels, PetscInt nmodes, const PetscReal *lambda0, PetscInt nrigid0, PetscReal order_expect, PetscReal order_tol)
+{
+  PetscReal *lam, worst = 0;
   PetscInt   worst_mode = -1;
 
   PetscFunctionBeginUser;
-  PetscOptionsBegin(scene->comm, NULL, "Convergence study options", NULL);
-  PetscCall(PetscOptionsReal("-expect_convergence_order", "Self-check: expected observed order of the eigenvalues", "PhlexSceneSolveModes", order_expect, &order_expect, NULL));
-  PetscCall(PetscOptionsReal("-expect_convergence_order_tol", "Tolerance of that check (absolute, on the order)", "PhlexSceneSolveModes", order_tol, &order_tol, NULL));
-  PetscOptionsEnd();
   PetscCall(PetscCalloc1((nlevels + 1) * nmodes, &lam));
   for (PetscInt m = 0; m < nmodes; m++) lam[m] = lambda0[nrigid0 + m];
   for (PetscInt l = 1; l <= nlevels; l++) {
@@ -85,21 +135,26 @@ static PetscErrorCode ConvergenceStudy(PhlexScene scene, PhlexPart part, PetscIn
 @*/
 PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
 {
-  PetscInt    nev = 10, nexp = 64, nrefine = 0, nbodies = 0, nfexp = 0;
-  PetscReal   expected[64], rtol = 1e-6, rmax = -1, worst = 0, *fexp = NULL;
-  PetscBool   has_exp;
-  PetscViewer csv;
+  ModesOptions o;
+  PetscInt     nbodies = 0, nfexp = 0, nev, nexp;
+  PetscReal    worst = 0, *fexp = NULL;
+  PetscViewer  csv;
 
   PetscFunctionBeginUser;
-  PetscOptionsBegin(scene->comm, NULL, "Modal analysis options", NULL);
-  PetscCall(PetscOptionsInt("-modes_nev", "Number of elastic modes wanted", "PhlexSceneSolveModes", nev, &nev, NULL));
-  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", expected, &nexp, &has_exp));
-  PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveModes", rtol, &rtol, NULL));
-  PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveModes", rmax, &rmax, NULL));
-  PetscCall(PetscOptionsInt("-modes_convergence_refinements", "Also solve on this many uniform refinements and report the observed order", "PhlexSceneSolveModes", nrefine, &nrefine, NULL));
-  PetscOptionsEnd();
-  PetscCheck(nev >= 1, scene->comm, PETSC_ERR_USER_INPUT, "-modes_nev must be >= 1, got %" PetscInt_FMT, nev);
-  if (!has_exp) nexp = 0;
+  PetscCall(ModesSetFromOptions(scene->comm, &o));
+  nev  = o.nev;
+  nexp = o.nexp;
+  {
+    /* the eigensolver's options, read (and printed by -help solvers) before any solve */
+    EPS       eps;
+    PetscReal ftarget = -1;
+    PetscBool flg;
+    PetscCall(PhlexModesEPSCreate(scene->comm, &eps, &ftarget, &flg));
+    if (PhlexHelpGetMode() != PHLEX_HELP_OPTIONS) PetscCall(EPSSetFromOptions(eps));
+    PetscCall(EPSDestroy(&eps));
+  }
+  if (PhlexHelpGetMode() != PHLEX_HELP_NONE) PetscFunctionReturn(0);
+  PetscCall(PhlexOptionsCheckUnused(scene->comm, ModesRereadOptions, &scene->comm));
   for (PetscInt k = 0; k < scene->nparts; k++)
     if (scene->parts[k]->ops.modes) nbodies++;
   PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible body)");
@@ -113,7 +168,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     Vec       *vecs;
     char       kind[64];
     if (!part->ops.modes) continue;
-    PetscCall(PetscLogStagePush(PHLEX_StageModes));
+    PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
     PetscCall((*part->ops.modes)(part, nev, &nconv, &nrigid, &lambda, &vecs, &rigid, &resid));
     PetscCall(PetscLogStagePop());
     PetscCall(PetscMalloc1(nconv, &freq));
@@ -132,7 +187,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
       PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d,%s\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0, part->name));
     }
     if (scene->output->fields && part->ops.modesoutput) PetscCall((*part->ops.modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid));
-    if (nrefine > 0) PetscCall(ConvergenceStudy(scene, part, nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid));
+    if (o.nrefine > 0) PetscCall(ConvergenceStudy(scene, part, o.nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid, o.order_expect, o.order_tol));
     if (nexp) {
       nfexp = nconv - nrigid;
       PetscCall(PetscMalloc1(PetscMax(nfexp, 1), &fexp));
@@ -147,8 +202,8 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   }
   PetscCall(PetscViewerDestroy(&csv));
   PetscCall(PhlexOutputCommit(scene->output));
-  if (rmax > 0) PetscCall(PhlexExpectMax(scene->comm, "eigenpair residuals (max relative)", "-expect_residual_max", worst, rmax, PETSC_TRUE));
-  if (nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nfexp, fexp, nexp, expected, rtol));
+  if (o.rmax > 0) PetscCall(PhlexExpectMax(scene->comm, "eigenpair residuals (max relative)", "-expect_residual_max", worst, o.rmax, PETSC_TRUE));
+  if (nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nfexp, fexp, nexp, o.expected, o.rtol));
   PetscCall(PetscFree(fexp));
   PetscFunctionReturn(0);
 }

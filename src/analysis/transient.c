@@ -29,7 +29,10 @@ typedef struct {
   /* joints */
   PetscReal   max_gap, project_dH;
   PetscInt    nprojections;
+  PhlexProgress progress;
 } MonitorContext;
+
+static PetscErrorCode TransientProgress(TS, MonitorContext *, PetscInt, PetscReal);
 
 /* ---------------------------------------------------------------------------------------------------------- */
 /* Energy and power-balance monitor                                                                            */
@@ -234,6 +237,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   m->tprev      = t;
   m->have_stage = PETSC_FALSE;
   PetscCall(PetscLogEventEnd(PHLEX_MonitorEnergy, 0, 0, 0, 0));
+  if (step > 0) PetscCall(TransientProgress(ts, m, step, t));
   PetscFunctionReturn(0);
 }
 
@@ -241,6 +245,15 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
    command line again (with its -options_file scenes) so that they keep precedence. The default follows the
    system: one fixed flexible body (no discrete unknowns): exact.opts; flexible bodies with discrete unknowns:
    bordered.opts; no flexible body: rigid.opts. */
+static PetscErrorCode SolverPresetOption(MPI_Comm comm, char file[])
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Solver preset", NULL);
+  PetscCall(PetscOptionsString("-solver_options_file", "Solver preset (options file) under the scene and command-line options; empty for none (default: options/solver/exact.opts for fixed flexible bodies without discrete unknowns, bordered.opts with them, rigid.opts without flexible body)", "PhlexSceneSolveTransient", file, file, PETSC_MAX_PATH_LEN, NULL));
+  PetscOptionsEnd();
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys)
 {
   char      file[PETSC_MAX_PATH_LEN];
@@ -250,9 +263,7 @@ static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys)
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrcpy(file, !sys->nfparts ? "options/solver/rigid.opts" : (sys->nq ? "options/solver/bordered.opts" : "options/solver/exact.opts")));
-  PetscOptionsBegin(comm, NULL, "Solver preset", NULL);
-  PetscCall(PetscOptionsString("-solver_options_file", "Solver preset (options file) under the scene and command-line options; empty for none", "PhlexSceneSolveTransient", file, file, sizeof(file), NULL));
-  PetscOptionsEnd();
+  PetscCall(SolverPresetOption(comm, file));
   if (!file[0]) PetscFunctionReturn(0);
   PetscCall(PetscTestFile(file, 'r', &exists));
   PetscCheck(exists, comm, PETSC_ERR_FILE_OPEN, "cannot read the solver preset '%s' (option -solver_options_file; presets are in options/solver/)", file);
@@ -320,6 +331,81 @@ static PetscErrorCode CreateSystem(PhlexScene scene, PhlexSystem *sys, Vec *X)
   PetscFunctionReturn(0);
 }
 
+/* the options of the transient analysis (the self-checks and the energy monitor; TS, SNES and KSP read theirs) */
+typedef struct {
+  PetscReal   drift_max, drift_abs_max, balance_rtol, momentum_max, linear_max, angular_max, orth_max, gap_max;
+  PetscViewer monitor;
+} TransientOptions;
+
+static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o)
+{
+  PetscBool flg;
+
+  PetscFunctionBeginUser;
+  o->drift_max = o->drift_abs_max = o->balance_rtol = o->momentum_max = o->linear_max = o->angular_max = o->orth_max = o->gap_max = -1;
+  o->monitor                                                                                                             = NULL;
+  PetscOptionsBegin(comm, NULL, "Transient analysis options", NULL);
+  PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", o->drift_max, &o->drift_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_energy_drift_abs_max", "Self-check: bound on max |H - H0| [J] (when H0 is no scale: a mechanism starting at rest)", "PhlexSceneSolveTransient", o->drift_abs_max, &o->drift_abs_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_power_balance_rtol", "Self-check: bound on max |H_{n+1} - H_n - W_step| / max |supplied work|", "PhlexSceneSolveTransient", o->balance_rtol, &o->balance_rtol, NULL));
+  PetscCall(PetscOptionsReal("-expect_momentum_drift_max", "Self-check (a free system, no loads): bound on the drift of the inertial linear and angular momenta, relative to their scale", "PhlexSceneSolveTransient", o->momentum_max, &o->momentum_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_linear_momentum_drift_max", "Self-check (a free system): bound on the drift of the inertial linear momentum alone, relative to its scale", "PhlexSceneSolveTransient", o->linear_max, &o->linear_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_angular_momentum_drift_max", "Self-check (a free system): bound on the drift of the inertial angular momentum alone, relative to its scale", "PhlexSceneSolveTransient", o->angular_max, &o->angular_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_orthogonality_max", "Self-check (moving frames): bound on max ||R^T R - I||_F", "PhlexSceneSolveTransient", o->orth_max, &o->orth_max, NULL));
+  PetscCall(PetscOptionsReal("-expect_joint_drift_max", "Self-check (joints): bound on the largest position-level violation of any joint [m, rad]", "PhlexSceneSolveTransient", o->gap_max, &o->gap_max, NULL));
+  PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
+  PetscOptionsEnd();
+  PetscFunctionReturn(0);
+}
+
+/* every option of a transient run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
+   the analysis', the solver preset's, and those of TS, SNES, KSP and PC */
+static PetscErrorCode TransientRereadOptions(void *ctx)
+{
+  MPI_Comm         comm = *(MPI_Comm *)ctx;
+  PhlexScene       scene;
+  TransientOptions o;
+  char             file[PETSC_MAX_PATH_LEN] = "";
+  TS               ts;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSceneCreate(comm, &scene));
+  PetscCall(PhlexSceneSetFromOptions(scene));
+  PetscCall(PhlexSceneDestroy(&scene));
+  PetscCall(TransientSetFromOptions(comm, &o));
+  PetscCall(PetscViewerDestroy(&o.monitor));
+  PetscCall(SolverPresetOption(comm, file));
+  /* a new TS: the run's own prints its options once only */
+  PetscCall(TSCreate(comm, &ts));
+  PetscCall(TSSetFromOptions(ts));
+  PetscCall(TSDestroy(&ts));
+  PetscFunctionReturn(0);
+}
+
+/* after the first step, every option has been read, the solvers' included (a field split reads its blocks' options
+   when it is set up): a misspelt one stops the run here; the time and energy drift of a progress line */
+static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step, PetscReal t)
+{
+  PetscReal tmax, done;
+  PetscInt  smax;
+  char      drift[96] = "";
+
+  PetscFunctionBeginUser;
+  if (step == 1) PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
+  PetscCall(TSGetMaxTime(ts, &tmax));
+  PetscCall(TSGetMaxSteps(ts, &smax));
+  done = PetscMax(tmax < PETSC_MAX_REAL ? t / tmax : 0.0, smax < PETSC_MAX_INT ? (PetscReal)step / smax : 0.0);
+  if (m->H0 > 1e-6 * m->Emax) PetscCall(PetscSNPrintf(drift, sizeof(drift), "max |H - H0|/H0 %.1e", (double)(m->max_drift / m->H0)));
+  else PetscCall(PetscSNPrintf(drift, sizeof(drift), "max |H - H0| %.1e J", (double)(m->max_drift * m->scene->units.energy)));
+  if (m->sys->njoints) {
+    size_t len;
+    PetscCall(PetscStrlen(drift, &len));
+    PetscCall(PetscSNPrintf(drift + len, sizeof(drift) - len, ", joints %.1e", (double)m->max_gap));
+  }
+  PetscCall(PhlexProgressStep(&m->progress, m->scene->comm, step, t, PetscMin(done, 1.0), drift));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSceneSolveTransient - integrates the scene in time with TS and reports energy, power balance and joints
 
@@ -344,24 +430,22 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   TS                 ts;
   Vec                X;
   MonitorContext     m;
-  PetscReal          dt = -1, drift_max = -1, drift_abs_max = -1, balance_rtol = -1, momentum_max = -1, linear_max = -1, angular_max = -1, orth_max = -1, gap_max = -1, tfinal;
+  TransientOptions   o;
+  PetscReal          dt = -1, dtlast, tfinal;
   PetscInt           nsteps;
-  PetscBool          flg;
+  TSConvergedReason  reason;
   const PhlexUnits  *u = &scene->units;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(&m, sizeof(m)));
-  PetscOptionsBegin(scene->comm, NULL, "Transient analysis options", NULL);
-  PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", drift_max, &drift_max, NULL));
-  PetscCall(PetscOptionsReal("-expect_energy_drift_abs_max", "Self-check: bound on max |H - H0| [J] (when H0 is no scale: a mechanism starting at rest)", "PhlexSceneSolveTransient", drift_abs_max, &drift_abs_max, NULL));
-  PetscCall(PetscOptionsReal("-expect_power_balance_rtol", "Self-check: bound on max |H_{n+1} - H_n - W_step| / max |supplied work|", "PhlexSceneSolveTransient", balance_rtol, &balance_rtol, NULL));
-  PetscCall(PetscOptionsReal("-expect_momentum_drift_max", "Self-check (a free system, no loads): bound on the drift of the inertial linear and angular momenta, relative to their scale", "PhlexSceneSolveTransient", momentum_max, &momentum_max, NULL));
-  PetscCall(PetscOptionsReal("-expect_linear_momentum_drift_max", "Self-check (a free system): bound on the drift of the inertial linear momentum alone, relative to its scale", "PhlexSceneSolveTransient", linear_max, &linear_max, NULL));
-  PetscCall(PetscOptionsReal("-expect_angular_momentum_drift_max", "Self-check (a free system): bound on the drift of the inertial angular momentum alone, relative to its scale", "PhlexSceneSolveTransient", angular_max, &angular_max, NULL));
-  PetscCall(PetscOptionsReal("-expect_orthogonality_max", "Self-check (moving frames): bound on max ||R^T R - I||_F", "PhlexSceneSolveTransient", orth_max, &orth_max, NULL));
-  PetscCall(PetscOptionsReal("-expect_joint_drift_max", "Self-check (joints): bound on the largest position-level violation of any joint [m, rad]", "PhlexSceneSolveTransient", gap_max, &gap_max, NULL));
-  PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &m.monitor, NULL, &flg));
-  PetscOptionsEnd();
+  PetscCall(TransientSetFromOptions(scene->comm, &o));
+  m.monitor = o.monitor;
+  if (PhlexHelpGetMode() == PHLEX_HELP_OPTIONS) {
+    char file[PETSC_MAX_PATH_LEN] = "";
+    PetscCall(SolverPresetOption(scene->comm, file));
+    PetscCall(PetscViewerDestroy(&m.monitor));
+    PetscFunctionReturn(0);
+  }
 
   PetscCall(CreateSystem(scene, &sys, &X));
   /* a free system: every part has momenta, none is held, no joint to the ground, no gravity */
@@ -370,14 +454,14 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     if (!sys->parts[i]->ops.momenta) m.free_system = PETSC_FALSE;
   for (PetscInt k = 0; k < sys->njoints; k++)
     if (PhlexPartIsGround(sys->joints[k]->side[0].part) || PhlexPartIsGround(sys->joints[k]->side[1].part)) m.free_system = PETSC_FALSE;
-  PetscCheck(m.free_system || (momentum_max < 0 && linear_max < 0 && angular_max < 0), scene->comm, PETSC_ERR_USER_INPUT, "-expect_*momentum_drift_max needs a free system: floating, rigid or lumped bodies only, none joined to the ground, no gravity");
+  PetscCheck(m.free_system || (o.momentum_max < 0 && o.linear_max < 0 && o.angular_max < 0), scene->comm, PETSC_ERR_USER_INPUT, "-expect_*momentum_drift_max needs a free system: floating, rigid or lumped bodies only, none joined to the ground, no gravity");
   {
     PetscBool frames = PETSC_FALSE;
     for (PetscInt i = 0; i < sys->nparts; i++)
       if (sys->parts[i]->frame.R >= 0) frames = PETSC_TRUE;
-    PetscCheck(frames || orth_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_orthogonality_max needs a moving frame (a floating or rigid body)");
+    PetscCheck(frames || o.orth_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_orthogonality_max needs a moving frame (a floating or rigid body)");
   }
-  PetscCheck(sys->njoints || gap_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_joint_drift_max needs joints");
+  PetscCheck(sys->njoints || o.gap_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_joint_drift_max needs joints");
   PetscCall(InsertSolverPreset(scene->comm, sys));
   PetscCall(TSCreate(scene->comm, &ts));
   PetscCall(TSSetDM(ts, sys->dm));
@@ -431,6 +515,15 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(VecDestroy(&vrtol));
   }
   PetscCall(TSSetFromOptions(ts));
+  if (PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
+    PetscCall(PetscViewerDestroy(&m.monitor));
+    PetscCall(VecDestroy(&X));
+    PetscCall(TSDestroy(&ts));
+    PetscCall(PhlexSystemDestroy(&sys));
+    PetscFunctionReturn(0);
+  }
+  /* a failed step is reported below with the time, the step and what to try */
+  PetscCall(TSSetErrorIfStepFails(ts, PETSC_FALSE));
   if (sys->nonlinear) {
     SNES snes;
     PetscCall(TSGetSNES(ts, &snes));
@@ -481,11 +574,16 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(TSSetPostStep(ts, PostStep));
   PetscCall(TSSetPostStage(ts, PostStage));
 
-  PetscCall(PetscLogStagePush(PHLEX_StageTransient));
+  PetscCall(PhlexLogStagePush("Phlex Transient", &PHLEX_StageTransient));
+  PetscCall(PhlexProgressStart(&m.progress));
   PetscCall(TSSolve(ts, X));
   PetscCall(PetscLogStagePop());
   PetscCall(TSGetStepNumber(ts, &nsteps));
   PetscCall(TSGetSolveTime(ts, &tfinal));
+  PetscCall(TSGetConvergedReason(ts, &reason));
+  PetscCall(TSGetTimeStep(ts, &dtlast));
+  PetscCheck(reason >= 0, scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s, time step %g s): %s; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast,
+             reason == TS_DIVERGED_NONLINEAR_SOLVE ? "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic), or see why with -snes_converged_reason -ksp_converged_reason" : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
   if (m.last_written != nsteps && scene->output->fields) {
     /* the last state's fields (the monitor wrote its series) */
     for (PetscInt i = 0; i < sys->nparts; i++) {
@@ -525,27 +623,27 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputClose(sys->joints[k]));
   PetscCall(PhlexOutputCommit(scene->output));
 
-  if (drift_max >= 0) {
+  if (o.drift_max >= 0) {
     PetscCheck(m.H0 > 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_energy_drift_max needs a nonzero initial energy");
-    PetscCall(PhlexExpectMax(scene->comm, "energy drift (max |H - H0| / H0)", "-expect_energy_drift_max", m.max_drift / m.H0, drift_max, PETSC_TRUE));
+    PetscCall(PhlexExpectMax(scene->comm, "energy drift (max |H - H0| / H0)", "-expect_energy_drift_max", m.max_drift / m.H0, o.drift_max, PETSC_TRUE));
   }
-  if (drift_abs_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "energy drift (max |H - H0|, J)", "-expect_energy_drift_abs_max", m.max_drift * u->energy, drift_abs_max, PETSC_TRUE));
-  if (balance_rtol >= 0) {
+  if (o.drift_abs_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "energy drift (max |H - H0|, J)", "-expect_energy_drift_abs_max", m.max_drift * u->energy, o.drift_abs_max, PETSC_TRUE));
+  if (o.balance_rtol >= 0) {
     /* no work supplied (round-off only): the largest kinetic + strain energy is the scale */
     const PetscReal scale = m.max_work > 1e-12 * m.Emax ? m.max_work : PetscMax(m.Emax, PETSC_MACHINE_EPSILON);
-    PetscCall(PhlexExpectMax(scene->comm, "power balance (max |H_{n+1} - H_n - dt y^T u| / max |supplied work|)", "-expect_power_balance_rtol", m.max_residual / scale, balance_rtol, PETSC_TRUE));
+    PetscCall(PhlexExpectMax(scene->comm, "power balance (max |H_{n+1} - H_n - dt y^T u| / max |supplied work|)", "-expect_power_balance_rtol", m.max_residual / scale, o.balance_rtol, PETSC_TRUE));
   }
-  if (momentum_max >= 0) {
-    PetscCall(PhlexExpectMax(scene->comm, "linear momentum drift (max |P - P0| / scale)", "-expect_momentum_drift_max", m.max_dP, momentum_max, PETSC_TRUE));
-    PetscCall(PhlexExpectMax(scene->comm, "angular momentum drift (max |L - L0| / scale)", "-expect_momentum_drift_max", m.max_dL, momentum_max, PETSC_TRUE));
+  if (o.momentum_max >= 0) {
+    PetscCall(PhlexExpectMax(scene->comm, "linear momentum drift (max |P - P0| / scale)", "-expect_momentum_drift_max", m.max_dP, o.momentum_max, PETSC_TRUE));
+    PetscCall(PhlexExpectMax(scene->comm, "angular momentum drift (max |L - L0| / scale)", "-expect_momentum_drift_max", m.max_dL, o.momentum_max, PETSC_TRUE));
   }
-  if (linear_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "linear momentum drift (max |P - P0| / scale)", "-expect_linear_momentum_drift_max", m.max_dP, linear_max, PETSC_TRUE));
-  if (angular_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "angular momentum drift (max |L - L0| / scale)", "-expect_angular_momentum_drift_max", m.max_dL, angular_max, PETSC_TRUE));
-  if (orth_max >= 0) {
-    PetscCall(PhlexExpectMax(scene->comm, "rotation orthogonality (max ||R^T R - I||_F)", "-expect_orthogonality_max", m.max_orth, orth_max, PETSC_TRUE));
-    PetscCall(PhlexExpectMax(scene->comm, "per-step orthogonality defect of the integrator (max ||R^T R - I||_F after a step)", "-expect_orthogonality_max", m.max_defect, orth_max, PETSC_TRUE));
+  if (o.linear_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "linear momentum drift (max |P - P0| / scale)", "-expect_linear_momentum_drift_max", m.max_dP, o.linear_max, PETSC_TRUE));
+  if (o.angular_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "angular momentum drift (max |L - L0| / scale)", "-expect_angular_momentum_drift_max", m.max_dL, o.angular_max, PETSC_TRUE));
+  if (o.orth_max >= 0) {
+    PetscCall(PhlexExpectMax(scene->comm, "rotation orthogonality (max ||R^T R - I||_F)", "-expect_orthogonality_max", m.max_orth, o.orth_max, PETSC_TRUE));
+    PetscCall(PhlexExpectMax(scene->comm, "per-step orthogonality defect of the integrator (max ||R^T R - I||_F after a step)", "-expect_orthogonality_max", m.max_defect, o.orth_max, PETSC_TRUE));
   }
-  if (gap_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "joint drift (max position-level violation, m or rad)", "-expect_joint_drift_max", m.max_gap, gap_max, PETSC_TRUE));
+  if (o.gap_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "joint drift (max position-level violation, m or rad)", "-expect_joint_drift_max", m.max_gap, o.gap_max, PETSC_TRUE));
 
   PetscCall(PetscViewerDestroy(&m.monitor));
   PetscCall(VecDestroy(&m.Xmid));

@@ -5,6 +5,7 @@
 #include <petscviewerhdf5.h>
 #include <sys/stat.h>
 #include <errno.h>
+#include <unistd.h>
 
 /*@C
   PhlexOutputCreate - creates the output manager of a run
@@ -41,8 +42,8 @@ PetscErrorCode PhlexOutputSetFromOptions(PhlexOutput out)
   PetscFunctionReturn(0);
 }
 
-/* mkdir -p on rank 0 */
-static PetscErrorCode MakeDirectory(MPI_Comm comm, const char dir[])
+/* mkdir -p on rank 0; *made: the last component was created (not there before) */
+static PetscErrorCode MakeDirectory(MPI_Comm comm, const char dir[], PetscBool *made)
 {
   PetscMPIInt rank;
   int         err = 0;
@@ -58,10 +59,13 @@ static PetscErrorCode MakeDirectory(MPI_Comm comm, const char dir[])
         if (mkdir(path, 0775) && errno != EEXIST) err = errno;
         *p = '/';
       }
-    if (!err && mkdir(path, 0775) && errno != EEXIST) err = errno;
+    if (!err) {
+      if (!mkdir(path, 0775)) *made = PETSC_TRUE;
+      else if (errno != EEXIST) err = errno;
+    }
   }
   PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));
-  PetscCheck(!err, comm, PETSC_ERR_FILE_OPEN, "cannot create output directory '%s' (option -output_dir): %s", dir, strerror(err));
+  PetscCheck(!err, comm, PETSC_ERR_FILE_WRITE, "cannot create output directory '%s' (option -output_dir): %s", dir, strerror(err));
   PetscFunctionReturn(0);
 }
 
@@ -82,7 +86,7 @@ PetscErrorCode PhlexOutputFile(PhlexOutput out, const char name[], char tmp[])
   PetscInt k = out->nfiles;
 
   PetscFunctionBeginUser;
-  if (k == 0) PetscCall(MakeDirectory(out->comm, out->dir));
+  if (k == 0 && !out->ncommitted) PetscCall(MakeDirectory(out->comm, out->dir, &out->made_dir));
   if (k == out->maxfiles) {
     char(*tmp)[PETSC_MAX_PATH_LEN], (*fin)[PETSC_MAX_PATH_LEN];
     const PetscInt n = PetscMax(16, 2 * out->maxfiles);
@@ -117,8 +121,28 @@ PetscErrorCode PhlexOutputCommit(PhlexOutput out)
   PetscCallMPI(MPI_Barrier(out->comm));
   if (rank == 0)
     for (PetscInt k = 0; k < out->nfiles; k++) PetscCheck(!rename(out->tmp[k], out->final[k]), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot rename '%s' to '%s': %s", out->tmp[k], out->final[k], strerror(errno));
-  out->nfiles = 0;
   PetscCallMPI(MPI_Barrier(out->comm));
+  /* where the results are: the directory, then the files in the order they were opened */
+  if (out->nfiles) {
+    size_t dirlen, col;
+    PetscCall(PetscStrlen(out->dir, &dirlen));
+    PetscCall(PetscPrintf(out->comm, "Results in %s/:", out->dir));
+    col = 12 + dirlen;
+    for (PetscInt k = 0; k < out->nfiles; k++) {
+      const char *name = out->final[k] + dirlen + 1;
+      size_t      len;
+      PetscCall(PetscStrlen(name, &len));
+      if (col + len + 1 > 110) {
+        PetscCall(PetscPrintf(out->comm, "\n "));
+        col = 1;
+      }
+      PetscCall(PetscPrintf(out->comm, " %s", name));
+      col += len + 1;
+    }
+    PetscCall(PetscPrintf(out->comm, "\n"));
+  }
+  out->ncommitted += out->nfiles;
+  out->nfiles = 0;
   PetscFunctionReturn(0);
 }
 
@@ -133,8 +157,11 @@ PetscErrorCode PhlexOutputAbort(PhlexOutput out)
 
   if (!out) return 0;
   MPI_Comm_rank(out->comm, &rank);
-  if (rank == 0)
+  if (rank == 0) {
     for (PetscInt k = 0; k < out->nfiles; k++) (void)remove(out->tmp[k]);
+    /* a directory this run made and left empty would look like a result: removed (rmdir fails if not empty) */
+    if (out->made_dir && !out->ncommitted) (void)rmdir(out->dir);
+  }
   out->nfiles = 0;
   return 0;
 }

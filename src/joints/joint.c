@@ -1006,7 +1006,7 @@ PetscErrorCode PhlexJointView(PhlexJoint j, PetscViewer viewer)
     PetscCall(PetscStrlcat(rows, j->rowname[k], sizeof(rows)));
   }
   PetscCall(PetscViewerASCIIPrintf(viewer, "joint %s: %s between %s and %s, constrains %s", j->name, PhlexJointTypes[j->type], j->side[0].spec, j->side[1].spec, rows));
-  if (j->drive_row >= 0) PetscCall(PetscViewerASCIIPrintf(viewer, " (%s driven at %g %s)", j->rowname[j->nc - 1], (double)j->drive_velocity, j->row[j->nc - 1] == PHLEX_ROW_R3 ? "rad/s" : "m/s"));
+  if (j->drive_row >= 0) PetscCall(PetscViewerASCIIPrintf(viewer, " (%s driven at %.15g %s)", j->rowname[j->nc - 1], (double)j->drive_velocity, j->row[j->nc - 1] == PHLEX_ROW_R3 ? "rad/s" : "m/s"));
   if (j->rot_dropped) PetscCall(PetscViewerASCIIPrintf(viewer, "; rotations free (a point mass has no orientation)"));
   if (j->ndropped) {
     PetscCall(PetscViewerASCIIPrintf(viewer, "; redundant, dropped:"));

@@ -99,7 +99,8 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
     PetscCall(PhlexProfileSetFromOptions(b->frame_profile));
   }
 
-  PetscCheck(flg_mesh && b->mesh_file[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: no mesh: set -%sdm_plex_filename <file.msh>", b->name, b->prefix);
+  /* -help reads the options of a body without a mesh */
+  PetscCheck((flg_mesh && b->mesh_file[0]) || PhlexHelpGetMode() == PHLEX_HELP_OPTIONS, b->comm, PETSC_ERR_USER_INPUT, "body %s: no mesh: set -%sdm_plex_filename <file.msh>", b->name, b->prefix);
   PetscCheck(b->degree == 1 || b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%spetscspace_degree must be 1 or 2, got %" PetscInt_FMT, b->name, b->prefix, b->degree);
 
   /* materials: either one for the whole body, or one per listed region */
@@ -286,13 +287,14 @@ static PetscErrorCode FlexView(PhlexPart part, PetscViewer viewer)
     if (b->frame_loaded) {
       char prof[256];
       PetscCall(PhlexProfileDescribe(b->frame_profile, prof, sizeof(prof)));
-      PetscCall(PetscViewerASCIIPrintf(viewer, "frame wrench at P: force (%g, %g, %g) N, moment (%g, %g, %g) N m (body frame), profile %s\n", (double)b->frame_force[0], (double)b->frame_force[1], (double)b->frame_force[2], (double)b->frame_moment[0], (double)b->frame_moment[1], (double)b->frame_moment[2], prof));
+      PetscCall(PetscViewerASCIIPrintf(viewer, "frame wrench at P: force (%.15g, %.15g, %.15g) N, moment (%.15g, %.15g, %.15g) N m (body frame), profile %s\n", (double)b->frame_force[0], (double)b->frame_force[1], (double)b->frame_force[2], (double)b->frame_moment[0], (double)b->frame_moment[1], (double)b->frame_moment[2], prof));
     }
   } else if (b->frame_patch[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "clamped patch (frame patch): %s\n", b->frame_patch));
   else PetscCall(PetscViewerASCIIPrintf(viewer, "no clamped patch: free body\n"));
   for (PetscInt m = 0; m < b->nmaterials; m++) {
     const PhlexMaterial *mat = &b->materials[m];
-    PetscCall(PetscViewerASCIIPrintf(viewer, "material %s: E = %g Pa, nu = %g, rho = %g kg/m^3\n", mat->region[0] ? mat->region : "(whole body)", (double)mat->youngs_modulus, (double)mat->poissons_ratio, (double)mat->density));
+    char                 E[32], nu[32], rho[32];
+    PetscCall(PetscViewerASCIIPrintf(viewer, "material %s: E = %s Pa, nu = %s, rho = %s kg/m^3\n", mat->region[0] ? mat->region : "(whole body)", PhlexFormatReal(mat->youngs_modulus, E, sizeof(E)), PhlexFormatReal(mat->poissons_ratio, nu, sizeof(nu)), PhlexFormatReal(mat->density, rho, sizeof(rho))));
   }
   for (PetscInt p = 0; p < b->nports; p++) {
     const PhlexFlexPort *port = &b->ports[p];

@@ -14,20 +14,29 @@ typedef struct {
 @*/
 PetscErrorCode PhlexFlexibleICSetFromOptions(PhlexFlexible b, PhlexIC *ic, const char field[], PetscInt ncomp)
 {
-  char prefix[128], who[PHLEX_NAME_LEN + 8];
+  char      prefix[128], who[PHLEX_NAME_LEN + 8];
+  PetscBool given = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sic_%s_", b->prefix, field));
   PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
   PetscOptionsBegin(b->comm, prefix, "Initial condition options", NULL);
   PetscCall(PetscOptionsEnum("-type", "Initial condition: zero, uniform, rigid (v + w x (x - origin)), beam (Euler-Bernoulli cantilever mode), mode (computed elastic mode)", "PhlexFlexibleICSetFromOptions", PhlexICTypes, (PetscEnum)ic->type, (PetscEnum *)&ic->type, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-value", ncomp == 6 ? "uniform: stress components xx,yy,zz,yz,xz,xy [Pa]" : "uniform/rigid: vector [SI]", "PhlexFlexibleICSetFromOptions", ncomp, ic->value, NULL));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-value", ncomp == 6 ? "uniform: stress components xx,yy,zz,xy,yz,xz [Pa] (the order of the output fields)" : "uniform/rigid: vector [SI]", "PhlexFlexibleICSetFromOptions", ncomp, ic->value, &given));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-angular", "rigid: angular velocity [rad/s]", "PhlexFlexibleICSetFromOptions", 3, ic->angular, NULL));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-origin", "rigid: point of the rotation axis [m]", "PhlexFlexibleICSetFromOptions", 3, ic->origin, NULL));
   PetscCall(PetscOptionsInt("-mode", "beam/mode: mode number (1 = lowest)", "PhlexFlexibleICSetFromOptions", ic->mode, &ic->mode, NULL));
   PetscCall(PetscOptionsReal("-amplitude", "beam/mode: largest value of the field [SI]", "PhlexFlexibleICSetFromOptions", ic->amplitude, &ic->amplitude, NULL));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-direction", "beam: deflection direction", "PhlexFlexibleICSetFromOptions", 3, ic->direction, NULL));
   PetscOptionsEnd();
+  if (ncomp == 6 && given) {
+    /* one order for users, on input and output (ParaView's for symmetric tensors): xx,yy,zz,xy,yz,xz; stored in the
+       Voigt order of the stress unknowns, xx,yy,zz,yz,xz,xy */
+    const PetscReal xy = ic->value[3], yz = ic->value[4], xz = ic->value[5];
+    ic->value[PHLEX_S_YZ] = yz;
+    ic->value[PHLEX_S_XZ] = xz;
+    ic->value[PHLEX_S_XY] = xy;
+  }
   PetscCheck(ic->mode >= 1, b->comm, PETSC_ERR_USER_INPUT, "body %s: option -%smode must be >= 1, got %" PetscInt_FMT, b->name, prefix, ic->mode);
   PetscCheck(ncomp == 3 || (ic->type != PHLEX_IC_RIGID && ic->type != PHLEX_IC_BEAM), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%stype %s is not available for the stress", b->name, prefix, PhlexICTypes[ic->type]);
   PetscFunctionReturn(0);

@@ -106,6 +106,44 @@ static PetscErrorCode FloatingPencil(PhlexFlexible b, Mat *A, Mat *B, IS is[2])
 }
 
 /*@C
+  PhlexModesEPSCreate - the eigensolver of a body's modes with phlex's defaults (Krylov-Schur, shift-and-invert,
+  Cholesky by MUMPS, tolerance 1e-12, no purification), options prefix modes_, and the target frequency asked for;
+  the operators, dimensions and target are the caller's. The modal analysis also creates one without operators to
+  read (and check) every eigensolver option before the first solve.
+
+  Collective
+@*/
+PetscErrorCode PhlexModesEPSCreate(MPI_Comm comm, EPS *eps, PetscReal *ftarget, PetscBool *set)
+{
+  ST  st;
+  KSP ksp;
+  PC  pc;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, "modes_", "Modal analysis options", NULL);
+  PetscCall(PetscOptionsReal("-target_frequency", "Look for the modes nearest this frequency [Hz] (default: the lowest)", "PhlexFlexibleComputeModes", *ftarget, ftarget, set));
+  PetscOptionsEnd();
+  PetscCall(EPSCreate(comm, eps));
+  PetscCall(EPSSetOptionsPrefix(*eps, "modes_"));
+  PetscCall(EPSSetProblemType(*eps, EPS_GHEP));
+  PetscCall(EPSSetType(*eps, EPSKRYLOVSCHUR));
+  PetscCall(EPSSetWhichEigenpairs(*eps, EPS_TARGET_MAGNITUDE));
+  PetscCall(EPSSetTolerances(*eps, 1e-12, PETSC_DEFAULT));
+  /* B (the velocity mass, or the body's whole kinetic-energy matrix when floating) is positive definite, so the
+     shift-and-invert eigenvectors carry no null-space component to purify; purification costs one more solve per
+     eigenvector (a fifth of the run at 2.2e5 dofs, BENCHMARKS.md) and changed no digit. -modes_eps_purify 1 restores it. */
+  PetscCall(EPSSetPurify(*eps, PETSC_FALSE));
+  PetscCall(EPSGetST(*eps, &st));
+  PetscCall(STSetType(st, STSINVERT));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexFlexibleComputeModes - lowest eigenpairs of K x = lambda Mv x of a flexible body (non-dimensional lambda = omega^2)
 
   Collective
@@ -142,10 +180,8 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PhlexFlexible     b     = (PhlexFlexible)part->data;
   const PhlexUnits *units = part->units;
   PetscBool         mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
-  EPS       eps;
-  ST        st;
-  KSP       ksp;
-  PC        pc;
+  EPS           eps;
+  PhlexProgress progress;
   PetscReal omega = FrequencyScale(b, units), sigma, ftarget = -1;
   PetscBool free_body = (!b->frame_patch[0] || b->floating) ? PETSC_TRUE : PETSC_FALSE, flg;
   PetscInt  n, want;
@@ -157,29 +193,16 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
   want  = nev + (free_body ? 6 : 0);
   sigma = free_body ? -PetscSqr(1e-2 * omega) : 0.0;
-  PetscOptionsBegin(b->comm, "modes_", "Modal analysis options", NULL);
-  PetscCall(PetscOptionsReal("-target_frequency", "Look for the modes nearest this frequency [Hz] (default: the lowest)", "PhlexFlexibleComputeModes", ftarget, &ftarget, &flg));
-  PetscOptionsEnd();
+  PetscCall(PhlexModesEPSCreate(b->comm, &eps, &ftarget, &flg));
   if (flg) {
     PetscCheck(ftarget >= 0, b->comm, PETSC_ERR_USER_INPUT, "-modes_target_frequency must be >= 0 Hz, got %g", (double)ftarget);
     sigma = PetscSqr(2.0 * PETSC_PI * ftarget * units->time);
     if (sigma == 0 && free_body) sigma = -PetscSqr(1e-2 * omega);
   }
-  PetscCall(EPSCreate(b->comm, &eps));
-  PetscCall(EPSSetOptionsPrefix(eps, "modes_"));
   if (b->floating && !mean_axes) PetscCall(FloatingPencil(b, &A, &B, is));
   PetscCall(EPSSetOperators(eps, A, B));
-  PetscCall(EPSSetProblemType(eps, EPS_GHEP));
-  PetscCall(EPSSetType(eps, EPSKRYLOVSCHUR));
   PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
-  PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
   PetscCall(EPSSetTarget(eps, sigma));
-  PetscCall(EPSSetTolerances(eps, 1e-12, PETSC_DEFAULT));
-  /* B (the velocity mass, or the body's whole kinetic-energy matrix when floating) is positive definite, so the
-     shift-and-invert eigenvectors carry no null-space component to purify; purification costs one more solve per
-     eigenvector (a fifth of the run at 2.2e5 dofs, BENCHMARKS.md) and changed no digit. -modes_eps_purify 1 restores it. */
-  PetscCall(EPSSetPurify(eps, PETSC_FALSE));
-  PetscCall(EPSGetST(eps, &st));
   if (mean_axes) {
     /* the constraint space: Mv-orthogonal to the rigid fields */
     MatNullSpace       nsp;
@@ -193,15 +216,10 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     want -= 6; /* the frame's rigid modes are added below */
     PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
   }
-  {
-    PetscCall(STSetType(st, STSINVERT));
-    PetscCall(STGetKSP(st, &ksp));
-    PetscCall(KSPSetType(ksp, KSPPREONLY));
-    PetscCall(KSPGetPC(ksp, &pc));
-    PetscCall(PCSetType(pc, PCCHOLESKY));
-    if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  }
   PetscCall(EPSSetFromOptions(eps));
+  PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "body %s", part->name));
+  PetscCall(PhlexProgressStart(&progress));
+  PetscCall(EPSMonitorSet(eps, PhlexProgressEPSMonitor, &progress, NULL));
   PetscCall(EPSSolve(eps));
   PetscCall(EPSGetDimensions(eps, &want, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &n));

@@ -62,8 +62,8 @@ static PetscErrorCode LumpedView(PhlexPart part, PetscViewer viewer)
 
   PetscFunctionBeginUser;
   PetscCall(PhlexPortLoadDescribe(&m->load, load, sizeof(load)));
-  if (m->position_given) PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: lumped mass %g kg at (%g, %g, %g) m, velocity (%g, %g, %g) m/s%s%s%s\n", part->name, (double)m->mass, (double)m->position[0], (double)m->position[1], (double)m->position[2], (double)m->velocity[0], (double)m->velocity[1], (double)m->velocity[2], part->attach[0] ? ", attached to " : "", part->attach, load));
-  else PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: lumped mass %g kg on port %s, velocity (%g, %g, %g) m/s%s\n", part->name, (double)m->mass, part->attach, (double)m->velocity[0], (double)m->velocity[1], (double)m->velocity[2], load));
+  if (m->position_given) PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: lumped mass %.15g kg at (%.15g, %.15g, %.15g) m, velocity (%.15g, %.15g, %.15g) m/s%s%s%s\n", part->name, (double)m->mass, (double)m->position[0], (double)m->position[1], (double)m->position[2], (double)m->velocity[0], (double)m->velocity[1], (double)m->velocity[2], part->attach[0] ? ", attached to " : "", part->attach, load));
+  else PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: lumped mass %.15g kg on port %s, velocity (%.15g, %.15g, %.15g) m/s%s\n", part->name, (double)m->mass, part->attach, (double)m->velocity[0], (double)m->velocity[1], (double)m->velocity[2], load));
   PetscFunctionReturn(0);
 }
 

@@ -145,14 +145,14 @@ static PetscErrorCode RigidView(PhlexPart part, PetscViewer viewer)
   PetscReal q[4];
 
   PetscFunctionBeginUser;
-  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: rigid, mass %g kg, inertia about the centre of mass [[%g, %g, %g], [%g, %g, %g], [%g, %g, %g]] kg m^2\n", part->name, (double)r->mass, (double)r->inertia[0], (double)r->inertia[1], (double)r->inertia[2], (double)r->inertia[3], (double)r->inertia[4], (double)r->inertia[5], (double)r->inertia[6], (double)r->inertia[7], (double)r->inertia[8]));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: rigid, mass %.15g kg, inertia about the centre of mass [[%.15g, %.15g, %.15g], [%.15g, %.15g, %.15g], [%.15g, %.15g, %.15g]] kg m^2\n", part->name, (double)r->mass, (double)r->inertia[0], (double)r->inertia[1], (double)r->inertia[2], (double)r->inertia[3], (double)r->inertia[4], (double)r->inertia[5], (double)r->inertia[6], (double)r->inertia[7], (double)r->inertia[8]));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PhlexRotationToQuaternion(r->pose.rotation, q);
-  PetscCall(PetscViewerASCIIPrintf(viewer, "centre of mass (%g, %g, %g) m as drawn; initial position (%g, %g, %g) m, orientation quaternion (%g, %g, %g, %g), velocity (%g, %g, %g) m/s, angular velocity (%g, %g, %g) rad/s (body frame)\n", (double)r->com[0], (double)r->com[1], (double)r->com[2], (double)r->pose.position[0], (double)r->pose.position[1], (double)r->pose.position[2], (double)q[0], (double)q[1], (double)q[2], (double)q[3], (double)r->pose.velocity[0], (double)r->pose.velocity[1], (double)r->pose.velocity[2], (double)r->pose.omega[0], (double)r->pose.omega[1], (double)r->pose.omega[2]));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "centre of mass (%.15g, %.15g, %.15g) m as drawn; initial position (%.15g, %.15g, %.15g) m, orientation quaternion (%.15g, %.15g, %.15g, %.15g), velocity (%.15g, %.15g, %.15g) m/s, angular velocity (%.15g, %.15g, %.15g) rad/s (body frame)\n", (double)r->com[0], (double)r->com[1], (double)r->com[2], (double)r->pose.position[0], (double)r->pose.position[1], (double)r->pose.position[2], (double)q[0], (double)q[1], (double)q[2], (double)q[3], (double)r->pose.velocity[0], (double)r->pose.velocity[1], (double)r->pose.velocity[2], (double)r->pose.omega[0], (double)r->pose.omega[1], (double)r->pose.omega[2]));
   for (PetscInt p = 0; p < r->nports; p++) {
     char load[512];
     PetscCall(PhlexPortLoadDescribe(&r->load[p], load, sizeof(load)));
-    PetscCall(PetscViewerASCIIPrintf(viewer, "port %s at (%g, %g, %g) m%s\n", r->port_name[p], (double)r->port_position[p][0], (double)r->port_position[p][1], (double)r->port_position[p][2], load));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "port %s at (%.15g, %.15g, %.15g) m%s\n", r->port_name[p], (double)r->port_position[p][0], (double)r->port_position[p][1], (double)r->port_position[p][2], load));
   }
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscFunctionReturn(0);

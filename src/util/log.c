@@ -3,7 +3,7 @@
 
 PetscClassId  PHLEX_CLASSID;
 PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly;
-PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes, PHLEX_StageOutput;
+PetscLogStage PHLEX_StageSetup = -1, PHLEX_StageTransient = -1, PHLEX_StageModes = -1;
 
 /*@C
   PhlexLogRegister - registers the phlex class id, log events and stages
@@ -29,9 +29,26 @@ PetscErrorCode PhlexLogRegister(void)
   PetscCall(PetscLogEventRegister("PhlexJointResid", PHLEX_CLASSID, &PHLEX_JointResidual));
   PetscCall(PetscLogEventRegister("PhlexJointJac", PHLEX_CLASSID, &PHLEX_JointJacobian));
   PetscCall(PetscLogEventRegister("PhlexAssembly", PHLEX_CLASSID, &PHLEX_Assembly));
-  PetscCall(PetscLogStageRegister("Phlex Setup", &PHLEX_StageSetup));
-  PetscCall(PetscLogStageRegister("Phlex Transient", &PHLEX_StageTransient));
-  PetscCall(PetscLogStageRegister("Phlex Modes", &PHLEX_StageModes));
-  PetscCall(PetscLogStageRegister("Phlex Output", &PHLEX_StageOutput));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexLogStagePush - pushes a log stage, registering it on first use (-log_view then lists only the stages the
+  run went through: PETSc 3.18 prints a registered but unused stage as "Unknown")
+
+  Not collective
+@*/
+PetscErrorCode PhlexLogStagePush(const char name[], PetscLogStage *stage)
+{
+  PetscFunctionBeginUser;
+  if (*stage < 0) {
+    /* PETSc 3.18 registers a stage "PCMPI" for its MPI linear-solver server (with the KSP package, i.e. before the
+       first phlex stage), which phlex never uses: -log_view would list it as an empty "Unknown" stage */
+    PetscLogStage pcmpi = -1;
+    PetscCall(PetscLogStageGetId("PCMPI", &pcmpi));
+    if (pcmpi > 0) PetscCall(PetscLogStageSetVisible(pcmpi, PETSC_FALSE));
+    PetscCall(PetscLogStageRegister(name, stage));
+  }
+  PetscCall(PetscLogStagePush(*stage));
   PetscFunctionReturn(0);
 }

@@ -1,0 +1,105 @@
+/* Progress of a long run: one compact line every -progress_interval seconds of wall time (time steps: step, time,
+   share done, elapsed, estimated time left, energy and joint drift; eigensolver: converged pairs). Both monitors
+   also stop the run when SIGINT or SIGTERM arrived (interrupt.c). */
+#include <phlex_impl.h>
+
+static PetscBool progress_on       = PETSC_TRUE;
+static PetscReal progress_interval = 5.0; /* s of wall time */
+
+/*@C
+  PhlexProgressSetFromOptions - reads the progress options
+
+  Collective
+
+  Options Database Keys:
++ -progress <bool>           - print progress lines during the run
+- -progress_interval <s>     - wall time between two lines (0: every step)
+@*/
+PetscErrorCode PhlexProgressSetFromOptions(MPI_Comm comm)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Progress options", NULL);
+  PetscCall(PetscOptionsBool("-progress", "Print a progress line during the run (step, time, share done, elapsed, time left, drift)", "PhlexProgressSetFromOptions", progress_on, &progress_on, NULL));
+  PetscCall(PetscOptionsReal("-progress_interval", "Wall time between two progress lines [s] (0: every step)", "PhlexProgressSetFromOptions", progress_interval, &progress_interval, NULL));
+  PetscOptionsEnd();
+  PetscCheck(progress_interval >= 0 && !PetscIsInfOrNanReal(progress_interval), comm, PETSC_ERR_USER_INPUT, "-progress_interval must be >= 0 s, got %g", (double)progress_interval);
+  PetscFunctionReturn(0);
+}
+
+/* "1 h 02 min", "3 min 05 s", "12.3 s" */
+static void FormatDuration(PetscReal s, char buf[], size_t len)
+{
+  if (s >= 3600) snprintf(buf, len, "%d h %02d min", (int)(s / 3600), (int)(PetscFmodReal(s, 3600) / 60));
+  else if (s >= 60) snprintf(buf, len, "%d min %02d s", (int)(s / 60), (int)PetscFmodReal(s, 60));
+  else snprintf(buf, len, "%.1f s", (double)s);
+}
+
+/*@C
+  PhlexProgressStart - starts the clock of a progress report
+
+  Not collective
+@*/
+PetscErrorCode PhlexProgressStart(PhlexProgress *p)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&p->start));
+  p->last = p->start;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProgressStep - after a time step: stops the run if interrupted, prints a progress line when due
+
+  Collective
+
+  Input Parameters:
++ p        - the progress clock
+. comm     - the run's communicator
+. step, t  - the step just taken and the time reached [s]
+. done     - the share of the run done (0..1)
+- drift    - what to say about the invariants (e.g. "|H - H0|/H0 3.1e-13"), or NULL
+@*/
+PetscErrorCode PhlexProgressStep(PhlexProgress *p, MPI_Comm comm, PetscInt step, PetscReal t, PetscReal done, const char drift[])
+{
+  PetscLogDouble now;
+  char           where[128], elapsed[32], left[32];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(where, sizeof(where), "at step %" PetscInt_FMT ", t = %g s", step, (double)t));
+  PetscCall(PhlexInterruptCheck(comm, where));
+  if (!progress_on) PetscFunctionReturn(0);
+  PetscCall(PetscTime(&now));
+  if (now - p->last < progress_interval) PetscFunctionReturn(0);
+  p->last = now;
+  FormatDuration((PetscReal)(now - p->start), elapsed, sizeof(elapsed));
+  if (done > 0) FormatDuration((PetscReal)(now - p->start) * (1 - done) / done, left, sizeof(left));
+  else PetscCall(PetscStrcpy(left, "?"));
+  PetscCall(PetscPrintf(comm, "progress: step %" PetscInt_FMT ", t = %.6g s (%.0f%%), elapsed %s, left ~%s%s%s\n", step, (double)t, (double)(100 * done), elapsed, left, drift ? ", " : "", drift ? drift : ""));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProgressEPSMonitor - EPS monitor: the converged eigenpairs of the body being solved, when due; stops the run
+  if interrupted (context: a PhlexProgress whose what names the body)
+@*/
+PetscErrorCode PhlexProgressEPSMonitor(EPS eps, PetscInt its, PetscInt nconv, PetscScalar *eigr, PetscScalar *eigi, PetscReal *errest, PetscInt nest, void *ctx)
+{
+  PhlexProgress *p = (PhlexProgress *)ctx;
+  MPI_Comm       comm;
+  PetscLogDouble now;
+  PetscInt       nev;
+  char           where[128], elapsed[32];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectGetComm((PetscObject)eps, &comm));
+  PetscCall(PetscSNPrintf(where, sizeof(where), "in the eigensolver of %s (iteration %" PetscInt_FMT ")", p->what, its));
+  PetscCall(PhlexInterruptCheck(comm, where));
+  if (!progress_on) PetscFunctionReturn(0);
+  PetscCall(PetscTime(&now));
+  if (now - p->last < progress_interval) PetscFunctionReturn(0);
+  p->last = now;
+  PetscCall(EPSGetDimensions(eps, &nev, NULL, NULL));
+  FormatDuration((PetscReal)(now - p->start), elapsed, sizeof(elapsed));
+  PetscCall(PetscPrintf(comm, "progress: modes of %s: %" PetscInt_FMT " of %" PetscInt_FMT " converged after %" PetscInt_FMT " iterations, elapsed %s\n", p->what, PetscMin(nconv, nev), nev, its, elapsed));
+  PetscFunctionReturn(0);
+}
