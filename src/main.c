@@ -87,12 +87,12 @@ int main(int argc, char **argv)
   }
   (void)PhlexHelpParseArgs(&argc, argv);
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
+  PetscCall(PhlexHelpActivate(PETSC_COMM_WORLD));
   PetscCall(PhlexErrorHandlerPush());
   PetscCall(PhlexInterruptPush());
   PetscCall(PhlexLogRegister());
   PetscCall(PhlexPCRegister());
   PetscCall(PhlexPartRegisterAll());
-  PetscCall(PhlexHelpActivate(PETSC_COMM_WORLD));
   ierr = Run(&scene);
   if (ierr) {
     /* no half-written result: remove the run's temporary files (and its directory if the run made it and it is

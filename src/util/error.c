@@ -102,7 +102,9 @@ int PhlexExitCode(void)
 PetscErrorCode PhlexErrorHandlerPush(void)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsGetBool(NULL, NULL, "-phlex_error_traceback", &phlex_traceback, NULL));
+  PetscOptionsBegin(PETSC_COMM_WORLD, NULL, "Error reporting", NULL);
+  PetscCall(PetscOptionsBool("-phlex_error_traceback", "Print PETSc's full traceback also for input errors", "PhlexErrorHandlerPush", phlex_traceback, &phlex_traceback, NULL));
+  PetscOptionsEnd();
   PetscCall(PetscPushErrorHandler(PhlexErrorHandler, NULL));
   PetscFunctionReturn(0);
 }
