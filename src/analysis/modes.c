@@ -15,7 +15,7 @@ static PetscReal Frequency(PetscReal lambda, const PhlexUnits *u)
 /* the options of the modal analysis (the eigensolver's are read by PhlexModesEPSCreate and EPSSetFromOptions) */
 typedef struct {
   PetscInt  nev, nexp, nrefine;
-  PetscReal expected[64], rtol, rmax, order_expect, order_tol;
+  PetscReal expected[65], rtol, rmax, order_expect, order_tol; /* 64 values and room for one more: a longer list is refused */
   PetscBool has_exp;
 } ModesOptions;
 
@@ -23,13 +23,13 @@ static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
 {
   PetscFunctionBeginUser;
   o->nev          = 10;
-  o->nexp         = 64;
+  o->nexp         = 65;
   o->nrefine      = 0;
   o->rtol         = 1e-6;
   o->rmax         = -1;
   o->order_expect = -1;
   o->order_tol    = 0.25;
-  PetscCall(PetscArrayzero(o->expected, 64));
+  PetscCall(PetscArrayzero(o->expected, 65));
   PetscOptionsBegin(comm, NULL, "Modal analysis options", NULL);
   PetscCall(PetscOptionsInt("-modes_nev", "Number of elastic modes wanted", "PhlexSceneSolveModes", o->nev, &o->nev, NULL));
   PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", o->expected, &o->nexp, &o->has_exp));
@@ -41,6 +41,7 @@ static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
   PetscOptionsEnd();
   PetscCheck(o->nev >= 1, comm, PETSC_ERR_USER_INPUT, "-modes_nev must be >= 1, got %" PetscInt_FMT, o->nev);
   if (!o->has_exp) o->nexp = 0;
+  PetscCheck(o->nexp <= 64, comm, PETSC_ERR_USER_INPUT, "-expect_frequencies: at most 64 values");
   PetscFunctionReturn(0);
 }
 

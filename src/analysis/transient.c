@@ -406,6 +406,31 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
   PetscFunctionReturn(0);
 }
 
+/* The time step and the end of the run, checked as given (before anything is set up): a run that would do nothing,
+   never end or jump to its end in one step is a mistake. */
+static PetscErrorCode CheckTimeOptions(MPI_Comm comm)
+{
+  PetscReal dt = -1, tmax = PETSC_MAX_REAL;
+  PetscInt  smax = PETSC_MAX_INT;
+  PetscBool fdt, ftmax, fsmax;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-ts_dt", &dt, &fdt));
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-ts_max_time", &tmax, &ftmax));
+  PetscCall(PetscOptionsGetInt(NULL, NULL, "-ts_max_steps", &smax, &fsmax));
+  PetscCheck(fdt, comm, PETSC_ERR_USER_INPUT, "transient analysis: set the time step with -ts_dt <s>");
+  PetscCheck(dt > 0 && !PetscIsInfOrNanReal(dt), comm, PETSC_ERR_USER_INPUT, "-ts_dt must be a positive, finite time step [s], got %g", (double)dt);
+  PetscCheck(ftmax || fsmax, comm, PETSC_ERR_USER_INPUT, "transient analysis: set the end of the run with -ts_max_time <s> or -ts_max_steps <n>");
+  PetscCheck(!ftmax || (tmax > 0 && !PetscIsInfOrNanReal(tmax)), comm, PETSC_ERR_USER_INPUT, "-ts_max_time must be a positive, finite end time [s], got %g", (double)tmax);
+  PetscCheck(!fsmax || smax >= 1, comm, PETSC_ERR_USER_INPUT, "-ts_max_steps must be at least 1, got %" PetscInt_FMT, smax);
+  if (ftmax) {
+    const PetscReal nsteps = PetscMin(tmax / dt, fsmax ? (PetscReal)smax : PETSC_MAX_REAL);
+    PetscCheck(nsteps <= 1e9, comm, PETSC_ERR_USER_INPUT, "-ts_dt %g s to -ts_max_time %g s is %.3g steps, more than 1e9: is -ts_dt in seconds? (bound the run with -ts_max_steps)", (double)dt, (double)tmax, (double)nsteps);
+    if (dt >= tmax && !(fsmax && smax == 1)) PetscCall(PetscFPrintf(comm, PETSC_STDERR, "phlex: warning: -ts_dt %g s is not smaller than -ts_max_time %g s: the run is one step\n", (double)dt, (double)tmax));
+  }
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSceneSolveTransient - integrates the scene in time with TS and reports energy, power balance and joints
 
@@ -446,6 +471,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PetscViewerDestroy(&m.monitor));
     PetscFunctionReturn(0);
   }
+  if (PhlexHelpGetMode() == PHLEX_HELP_NONE) PetscCall(CheckTimeOptions(scene->comm));
 
   PetscCall(CreateSystem(scene, &sys, &X));
   /* a free system: every part has momenta, none is held, no joint to the ground, no gravity */

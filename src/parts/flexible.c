@@ -47,8 +47,8 @@ static PetscErrorCode MaterialSetFromOptions(PhlexFlexible b, PhlexMaterial *m, 
 static PetscErrorCode FlexSetFromOptions(PhlexPart part)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
-  char         *rptr[PHLEX_MAX_MATERIALS], **pptr;
-  PetscInt      nregions = PHLEX_MAX_MATERIALS, nports;
+  char         *rptr[PHLEX_MAX_MATERIALS + 1], **pptr; /* room for one more region: too many are refused, not cut */
+  PetscInt      nregions = PHLEX_MAX_MATERIALS + 1, nports;
   PetscBool     flg, flg_mesh = PETSC_FALSE, has_body_material, fcond = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE;
   PetscInt      motion = 0, inertia = 0, cond = PHLEX_FRAME_PATCH;
   const char   *given = NULL;
@@ -57,7 +57,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscFunctionBeginUser;
   PetscCall(PhlexOptionsListLength(b->prefix, "-ports", &nports));
   PetscCall(PetscMalloc1(nports, &pptr));
-  for (PetscInt i = 0; i < PHLEX_MAX_MATERIALS; i++) rptr[i] = NULL;
+  for (PetscInt i = 0; i <= PHLEX_MAX_MATERIALS; i++) rptr[i] = NULL;
   for (PetscInt i = 0; i < nports; i++) pptr[i] = NULL;
   PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
   PetscOptionsBegin(b->comm, b->prefix, "Flexible body options", NULL);
@@ -104,6 +104,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCheck(b->degree == 1 || b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%spetscspace_degree must be 1 or 2, got %" PetscInt_FMT, b->name, b->prefix, b->degree);
 
   /* materials: either one for the whole body, or one per listed region */
+  PetscCheck(nregions <= PHLEX_MAX_MATERIALS, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sregions lists more than %d regions", b->name, b->prefix, PHLEX_MAX_MATERIALS);
   b->nmaterials = nregions ? nregions : 1;
   PetscCall(PetscOptionsHasName(NULL, b->prefix, "-youngs_modulus", &has_body_material));
   if (!nregions) {

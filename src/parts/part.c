@@ -234,9 +234,9 @@ PetscErrorCode PhlexPartRestoreVec(PhlexPart p, Vec X, PhlexPartVec *pv)
 @*/
 PetscErrorCode PhlexPoseSetFromOptions(PetscOptionItems *PetscOptionsObject, PhlexPart p, PhlexPose *pose, const char **given)
 {
-  PetscReal quat[4] = {1, 0, 0, 0}, aa[4] = {1, 0, 0, 0};
+  PetscReal quat[4] = {1, 0, 0, 0}, aa[5] = {1, 0, 0, 0, 0}; /* room for a fifth number: a wrong count is seen */
   PetscBool fq = PETSC_FALSE, fa = PETSC_FALSE;
-  PetscInt  n  = 4;
+  PetscInt  n  = 5;
   char      who[PHLEX_NAME_LEN + 8];
 
   PetscFunctionBeginUser;

@@ -24,8 +24,8 @@ static PetscErrorCode RigidSetFromOptions(PhlexPart part)
 {
   Rigid    *r = (Rigid *)part->data;
   char      who[PHLEX_NAME_LEN + 8], **names;
-  PetscInt  n = 6, nports;
-  PetscReal J[6] = {0, 0, 0, 0, 0, 0};
+  PetscInt  n = 7, nports; /* room for a seventh number: a wrong count is seen */
+  PetscReal J[7] = {0, 0, 0, 0, 0, 0, 0};
   PetscBool fm = PETSC_FALSE, fJ = PETSC_FALSE, ff = PETSC_FALSE, fmo = PETSC_FALSE, flg;
 
   PetscFunctionBeginUser;

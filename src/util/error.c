@@ -3,6 +3,7 @@
    file, option, body and value); any other error keeps PETSc's full traceback. The first error of a run fixes the
    exit code (PhlexExitCode): one small documented set, the same on every rank. */
 #include <phlex_impl.h>
+#include <ctype.h>
 
 static PetscBool phlex_traceback = PETSC_FALSE;
 static PetscBool phlex_short     = PETSC_FALSE; /* the error being propagated was printed as one line */
@@ -21,6 +22,7 @@ static PetscBool IsOneLineError(PetscErrorCode n)
   case PETSC_ERR_FILE_UNEXPECTED:
   case PETSC_ERR_SUP:
   case PETSC_ERR_ARG_OUTOFRANGE:
+  case PETSC_ERR_ARG_WRONG:
   case PETSC_ERR_NOT_CONVERGED:
   case PETSC_ERR_CONV_FAILED:
   case PETSC_ERR_SIG:
@@ -41,6 +43,7 @@ static int ExitCodeOf(PetscErrorCode n, PetscBool ours)
   case PETSC_ERR_FILE_UNEXPECTED:
     return PHLEX_EXIT_INPUT;
   case PETSC_ERR_ARG_OUTOFRANGE:
+  case PETSC_ERR_ARG_WRONG:
   case PETSC_ERR_SUP:
     return ours ? PHLEX_EXIT_INPUT : PHLEX_EXIT_INTERNAL;
   case PETSC_ERR_FILE_WRITE:
@@ -58,6 +61,42 @@ static int ExitCodeOf(PetscErrorCode n, PetscBool ours)
   }
 }
 
+/* PETSc's parsing of a malformed value ("Input string abc has no numeric value") does not say which option held it:
+   the options whose value it is are found in the database and named */
+static void NameMalformedOption(const char *mess, char *out, size_t len)
+{
+  const char *value = NULL, *kind = NULL, *end;
+  char        v[256], *all = NULL, *tok, *next, names[512] = "";
+  size_t      nv;
+
+  out[0] = 0;
+  if (!mess) return;
+  if (!strncmp(mess, "Input string ", 13)) {
+    value = mess + 13;
+    end   = strstr(value, " has no ");
+    kind  = strstr(mess, "integer") ? "not an integer (no '.', no exponent)" : "not a number";
+  } else if (!strncmp(mess, "Unknown logical value: ", 23)) {
+    value = mess + 23;
+    end   = value + strlen(value);
+    kind  = "not a boolean (true/false, yes/no, 1/0)";
+  }
+  if (!value || !end) return;
+  nv = PetscMin((size_t)(end - value), sizeof(v) - 1);
+  memcpy(v, value, nv);
+  v[nv] = 0;
+  if (PetscOptionsGetAll(NULL, &all)) return;
+  /* "-name value -name value ...": a name is a '-' and a letter, its value the next token unless that is a name */
+  for (tok = strtok(all, " "); tok; tok = next) {
+    next = strtok(NULL, " ");
+    if (tok[0] == '-' && isalpha((unsigned char)tok[1]) && next && !(next[0] == '-' && isalpha((unsigned char)next[1])) && !strcmp(next, v)) {
+      size_t n = strlen(names);
+      snprintf(names + n, sizeof(names) - n, "%s%s", n ? ", " : "", tok);
+    }
+  }
+  (void)PetscFree(all);
+  if (names[0]) snprintf(out, len, "option %s: '%s' is %s", names, v, kind);
+}
+
 static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
 {
   PetscBool ours = (file && !strncmp(file, "src/", 4)) ? PETSC_TRUE : PETSC_FALSE;
@@ -73,7 +112,9 @@ static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun
     if ((ours || options) && IsOneLineError(n) && !phlex_traceback) {
       phlex_short = PETSC_TRUE;
       if (rank == 0) {
-        fprintf(stderr, "phlex: error: %s\n", mess ? mess : "(no message)");
+        char named[1024] = "";
+        if (options) NameMalformedOption(mess, named, sizeof(named));
+        fprintf(stderr, "phlex: error: %s\n", named[0] ? named : (mess ? mess : "(no message)"));
         fflush(stderr);
       }
       return n;
@@ -113,12 +154,17 @@ PetscErrorCode PhlexErrorHandlerPush(void)
    PetscOptionsObject is passed on). A wrong count is an input error naming what it belongs to and the option. */
 PetscErrorCode PhlexOptionsRealN(PetscOptionItems *PetscOptionsObject, MPI_Comm comm, const char what[], const char prefix[], const char opt[], const char text[], const char man[], PetscInt n, PetscReal value[], PetscBool *set)
 {
-  PetscInt  got = n;
+  PetscReal buf[17];
+  PetscInt  got = n + 1; /* one more than needed: PETSc drops the values beyond the room given */
   PetscBool flg = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsRealArray(opt, text, man, value, &got, &flg));
-  PetscCheck(!flg || got == n, comm, PETSC_ERR_USER_INPUT, "%s: option -%s%s needs %" PetscInt_FMT " components, got %" PetscInt_FMT, what, prefix, opt + 1, n, got);
+  PetscCheck(n <= 16, comm, PETSC_ERR_PLIB, "PhlexOptionsRealN: at most 16 components");
+  PetscCall(PetscArraycpy(buf, value, n));
+  buf[n] = 0;
+  PetscCall(PetscOptionsRealArray(opt, text, man, buf, &got, &flg));
+  PetscCheck(!flg || got == n, comm, PETSC_ERR_USER_INPUT, "%s: option -%s%s needs %" PetscInt_FMT " components, got %s%" PetscInt_FMT, what, prefix, opt + 1, n, got > n ? "more than " : "", got > n ? n : got);
+  if (flg) PetscCall(PetscArraycpy(value, buf, n));
   if (set) *set = flg;
   PetscFunctionReturn(0);
 }

@@ -102,8 +102,8 @@ static PetscErrorCode PhlexProfileReadTableFile(PhlexProfile p, const char file[
 @*/
 PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile p)
 {
-  PetscReal table[512] = {0};
-  PetscInt  ntable = 512;
+  PetscReal table[513] = {0};
+  PetscInt  ntable = 513; /* 256 points, and room for one more number: a longer table is refused, not cut */
   PetscBool flg_table = PETSC_FALSE, flg_file = PETSC_FALSE;
   char      file[PETSC_MAX_PATH_LEN] = "";
   PetscReal *data = NULL;
@@ -133,6 +133,7 @@ PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile p)
     if (flg_file) PetscCall(PhlexProfileReadTableFile(p, file, &ndata, &data));
     else {
       ndata = ntable;
+      PetscCheck(ndata <= 512, p->comm, PETSC_ERR_USER_INPUT, "%s: -%sprofile_table holds at most 256 points; give longer tables with -%sprofile_file", p->what, p->prefix, p->prefix);
       PetscCall(PetscMalloc1(ndata, &data));
       PetscCall(PetscArraycpy(data, table, ndata));
     }
