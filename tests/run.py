@@ -330,6 +330,12 @@ FEATURES = {
     "mpi2": None,
 }
 
+# requirement -> a program that must be on PATH (a tool a test's filter runs besides phlex)
+TOOLS = {
+    "paraview": "pvbatch",
+    "xvfb": "Xvfb",
+}
+
 NAME_RE = re.compile(r"[A-Za-z0-9_.+-]+")
 
 
@@ -459,9 +465,9 @@ def parse_spec(name: str, text: str) -> Spec:
         raise SpecError(f"nsize: must be >= 1, got {nsize}")
     requires = [r.lower() for r in split_list(values.get("requires", ""))]
     for feature in requires:
-        if feature not in FEATURES:
+        if feature not in FEATURES and feature not in TOOLS:
             raise SpecError(f"requires: unknown feature {feature!r} "
-                            f"(known: {', '.join(sorted(FEATURES))})")
+                            f"(known: {', '.join(sorted({**FEATURES, **TOOLS}))})")
     output = values.get("output", f"{name}.out")
     stderr = None
     if "stderr" in values:
@@ -529,9 +535,14 @@ def petsc_macros() -> Optional[set]:
 
 
 def missing_features(requires: Sequence[str], macros: Optional[set]) -> List[str]:
-    """The required features that this PETSc installation lacks."""
+    """The required features that this PETSc installation lacks, and the tools not on PATH
+    (named 'feature (program not on PATH)')."""
     missing = []
     for feature in requires:
+        if feature in TOOLS:
+            if shutil.which(TOOLS[feature]) is None:
+                missing.append(f"{feature} ({TOOLS[feature]} not on PATH)")
+            continue
         macro = FEATURES[feature]
         if macro is not None and (macros is None or macro not in macros):
             missing.append(feature)
@@ -921,7 +932,7 @@ def load_case(name: str, exists: bool, cases_dir: str, macros: Optional[set]) ->
     except SpecError as err:
         return Case(name, None, f"bad spec: {err}", None)
     missing = missing_features(spec.requires, macros)
-    return Case(name, spec, None, f"missing {' '.join(missing)}" if missing else None)
+    return Case(name, spec, None, f"missing {', '.join(missing)}" if missing else None)
 
 
 class Reporter:
@@ -1083,7 +1094,7 @@ def main(argv: Sequence[str]) -> int:
         return 1
     macros = petsc_macros()
     cases = [load_case(name, exists, cfg.cases, macros) for name, exists in names]
-    if macros is None and any(c.spec and missing_features(c.spec.requires, set()) for c in cases):
+    if macros is None and any(c.spec and any(FEATURES.get(f) for f in c.spec.requires) for c in cases):
         print("# warning: petscconf.h not found (pkg-config petsc); optional features count as missing")
     if cfg.update:
         print("# --update: storing outputs as the new expected results")

@@ -7,6 +7,7 @@ Run with:  python3 tests/test_runner_selftest.py
 import os
 import sys
 import unittest
+from unittest import mock
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
@@ -230,6 +231,13 @@ files_absent: energy.csv outdir-empty
     def test_missing_features(self):
         self.assertEqual(run.missing_features(["mumps", "mpi2", "hypre"], {"PETSC_HAVE_MUMPS"}), ["hypre"])
         self.assertEqual(run.missing_features(["cholmod"], None), ["cholmod"])
+
+    def test_missing_tools(self):
+        tools = {"shell": "sh", "nothing": "phlex-selftest-no-such-program"}
+        with mock.patch.dict(run.TOOLS, tools):
+            self.assertEqual(run.missing_features(["shell", "nothing", "mpi2"], set()),
+                             ["nothing (phlex-selftest-no-such-program not on PATH)"])
+            self.assertEqual(run.parse_spec("t", "args: a\nrequires: shell\n").requires, ["shell"])
 
 
 class SelectTest(unittest.TestCase):
