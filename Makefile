@@ -6,7 +6,7 @@
 #   make meshes     regenerate the committed meshes from their .geo sources
 #   make print      show the compiler and flags
 
-PKGS      := slepc petsc hdf5-mpi
+PKGS      := slepc petsc hdf5-mpi yaml-0.1
 SCENE     ?= options/cantilever.yaml
 MPIEXEC   ?= mpiexec
 NP        ?= 1

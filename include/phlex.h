@@ -71,6 +71,9 @@ PETSC_EXTERN PetscErrorCode PhlexHelpCaptureEnd(PetscInt *, char ***);
 PETSC_EXTERN PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm, PetscErrorCode (*)(void *), void *);
 PETSC_EXTERN PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm);
 
+/* scene_file.c: the YAML syntax of the scene files, before PETSc reads them */
+PETSC_EXTERN int PhlexSceneFilesCheck(int, char **);
+
 /* interrupt.c: SIGINT/SIGTERM end the run at the next step */
 PETSC_EXTERN PetscErrorCode PhlexInterruptPush(void);
 PETSC_EXTERN PetscErrorCode PhlexInterruptCheck(MPI_Comm, const char[]);

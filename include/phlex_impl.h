@@ -37,6 +37,7 @@ struct _p_PhlexOutput {
   char    (*tmp)[PETSC_MAX_PATH_LEN], (*final)[PETSC_MAX_PATH_LEN];
   PetscInt  ncommitted; /* files renamed to their final names so far */
   PetscBool made_dir;   /* this run created the directory (rank 0) */
+  PetscBool locked;     /* this run holds <dir>/.phlex.lock */
 };
 
 /* What to do with redundant constraint components found at set-up. */

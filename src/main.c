@@ -86,6 +86,8 @@ int main(int argc, char **argv)
     return 0;
   }
   (void)PhlexHelpParseArgs(&argc, argv);
+  code = PhlexSceneFilesCheck(argc, argv);
+  if (code) return code;
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(PhlexHelpActivate(PETSC_COMM_WORLD));
   PetscCall(PhlexErrorHandlerPush());

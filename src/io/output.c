@@ -1,8 +1,12 @@
 /* Output of a run: one directory with the CSV series and, per flexible body, HDF5 fields plus an XDMF index for
    ParaView (fields.c). Every file is written under a temporary name and renamed when the run completes, so an
    error never leaves a half-written result under a final name. */
+#define _POSIX_C_SOURCE 200809L /* kill, gethostname, open flags */
 #include <phlex_impl.h>
 #include <petscviewerhdf5.h>
+#include <fcntl.h>
+#include <signal.h>
+#include <time.h>
 #include <sys/stat.h>
 #include <errno.h>
 #include <unistd.h>
@@ -69,6 +73,82 @@ static PetscErrorCode MakeDirectory(MPI_Comm comm, const char dir[], PetscBool *
   PetscFunctionReturn(0);
 }
 
+/* The lock of the output directory, <dir>/.phlex.lock ("pid host start-time"), made atomically (O_EXCL) by rank 0:
+   a second run on the same directory is refused instead of mixing its files with the first one's. A lock left by
+   a run that was killed (its process gone, same host) is taken over with a warning. */
+static PetscErrorCode Lock(PhlexOutput out)
+{
+  PetscMPIInt rank;
+  int         status = 0; /* 0 locked, 1 in use by another run, 2 cannot write */
+  char        holder[256] = "", path[PETSC_MAX_PATH_LEN + 16];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
+  PetscCall(PetscSNPrintf(path, sizeof(path), "%s/.phlex.lock", out->dir));
+  if (rank == 0) {
+    char host[128] = "";
+    (void)gethostname(host, sizeof(host) - 1);
+    for (int attempt = 0; attempt < 2; attempt++) {
+      int fd = open(path, O_WRONLY | O_CREAT | O_EXCL, 0644);
+      if (fd >= 0) {
+        char line[256];
+        int  n = snprintf(line, sizeof(line), "%ld %s %ld\n", (long)getpid(), host, (long)time(NULL));
+        status = (write(fd, line, (size_t)n) == n) ? 0 : 2;
+        close(fd);
+        break;
+      }
+      if (errno != EEXIST) {
+        status = 2;
+        PetscCall(PetscSNPrintf(holder, sizeof(holder), "%s", strerror(errno)));
+        break;
+      }
+      {
+        /* someone holds it: alive, or a killed run's leftover? */
+        FILE *fp  = fopen(path, "r");
+        long  pid = 0, since = 0;
+        char  other[128] = "";
+        if (fp) {
+          if (fscanf(fp, "%ld %127s %ld", &pid, other, &since) != 3) pid = 0;
+          fclose(fp);
+        }
+        if (pid > 0 && !strcmp(other, host) && kill((pid_t)pid, 0) && errno == ESRCH && attempt == 0) {
+          fprintf(stderr, "phlex: warning: output directory '%s': removed the lock of run %ld, which ended without releasing it\n", out->dir, pid);
+          (void)remove(path);
+          continue;
+        }
+        status = 1;
+        if (pid > 0) {
+          char      when[64] = "?";
+          time_t    t        = (time_t)since;
+          struct tm tm;
+          if (localtime_r(&t, &tm)) strftime(when, sizeof(when), "%Y-%m-%d %H:%M:%S", &tm);
+          PetscCall(PetscSNPrintf(holder, sizeof(holder), "process %ld on host %s, since %s", pid, other, when));
+        } else PetscCall(PetscSNPrintf(holder, sizeof(holder), "unreadable lock"));
+        break;
+      }
+    }
+  }
+  PetscCallMPI(MPI_Bcast(&status, 1, MPI_INT, 0, out->comm));
+  PetscCallMPI(MPI_Bcast(holder, sizeof(holder), MPI_CHAR, 0, out->comm));
+  PetscCheck(status != 1, out->comm, PETSC_ERR_FILE_WRITE, "output directory '%s' (option -output_dir) is in use by another run (%s): choose another directory, or remove %s if that run is gone", out->dir, holder, path);
+  PetscCheck(status != 2, out->comm, PETSC_ERR_FILE_WRITE, "cannot write the lock file %s of the output directory (option -output_dir): %s", path, holder[0] ? holder : "write failed");
+  out->locked = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/* releases the lock (rank 0; safe after an error) */
+static void Unlock(PhlexOutput out)
+{
+  PetscMPIInt rank = 0;
+  char        path[PETSC_MAX_PATH_LEN + 16];
+
+  if (!out->locked) return;
+  MPI_Comm_rank(out->comm, &rank);
+  snprintf(path, sizeof(path), "%s/.phlex.lock", out->dir);
+  if (rank == 0) (void)remove(path);
+  out->locked = PETSC_FALSE;
+}
+
 /*@C
   PhlexOutputFile - registers an output file and returns the temporary path to write it to
 
@@ -86,7 +166,10 @@ PetscErrorCode PhlexOutputFile(PhlexOutput out, const char name[], char tmp[])
   PetscInt k = out->nfiles;
 
   PetscFunctionBeginUser;
-  if (k == 0 && !out->ncommitted) PetscCall(MakeDirectory(out->comm, out->dir, &out->made_dir));
+  if (!out->locked) {
+    PetscCall(MakeDirectory(out->comm, out->dir, &out->made_dir));
+    PetscCall(Lock(out));
+  }
   if (k == out->maxfiles) {
     char(*tmp)[PETSC_MAX_PATH_LEN], (*fin)[PETSC_MAX_PATH_LEN];
     const PetscInt n = PetscMax(16, 2 * out->maxfiles);
@@ -157,6 +240,7 @@ PetscErrorCode PhlexOutputAbort(PhlexOutput out)
 
   if (!out) return 0;
   MPI_Comm_rank(out->comm, &rank);
+  Unlock(out);
   if (rank == 0) {
     for (PetscInt k = 0; k < out->nfiles; k++) (void)remove(out->tmp[k]);
     /* a directory this run made and left empty would look like a result: removed (rmdir fails if not empty) */
@@ -191,6 +275,7 @@ PetscErrorCode PhlexOutputDestroy(PhlexOutput *out)
 {
   PetscFunctionBeginUser;
   if (!*out) PetscFunctionReturn(0);
+  Unlock(*out);
   PetscCall(PetscFree2((*out)->tmp, (*out)->final));
   PetscCall(PetscFree(*out));
   PetscFunctionReturn(0);
