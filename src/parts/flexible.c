@@ -157,6 +157,26 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
 }
 
 /* the mesh, its checks and the scales it suggests */
+/* Legal but suspicious values, warned about once when the mesh is read: a wrong unit (a mesh in millimetres, a
+   modulus in GPa, a density in g/cm^3) or a material the scheme handles poorly (near incompressibility) runs, but
+   its results would mislead. */
+static PetscErrorCode WarnSuspicious(PhlexFlexible b)
+{
+  PetscReal extent = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < 3; d++) extent = PetscMax(extent, b->bbox_max[d] - b->bbox_min[d]);
+  if (extent > 1e3 || extent < 1e-4) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s: the mesh %s is %g m across; mesh coordinates are metres (a mesh drawn in millimetres is 1000 times too large)\n", b->name, b->mesh_file, (double)extent));
+  for (PetscInt m = 0; m < b->nmaterials; m++) {
+    const PhlexMaterial *mat   = &b->materials[m];
+    const char          *where = mat->region[0] ? mat->region : "whole body";
+    if (mat->poissons_ratio > 0.49) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s (%s): Poisson's ratio %s is nearly incompressible: the condition of the stress block grows like 1/(1 - 2 nu) = %.3g and P1 velocities lock (too stiff); prefer P2 and watch the solver's residuals\n", b->name, where, PhlexFormatReal(mat->poissons_ratio, (char[32]){0}, 32), (double)(1.0 / (1.0 - 2.0 * mat->poissons_ratio))));
+    if (mat->youngs_modulus < 1e3 || mat->youngs_modulus > 1e15) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s (%s): Young's modulus %g Pa is outside the range of solids (1e3 to 1e15 Pa, the rigid limit included): is it in Pa?\n", b->name, where, (double)mat->youngs_modulus));
+    if (mat->density < 10 || mat->density > 1e5) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s (%s): density %g kg/m^3 is outside the range of solids (10 to 1e5 kg/m^3): is it in kg/m^3 (7.8 g/cm^3 = 7800 kg/m^3)?\n", b->name, where, (double)mat->density));
+  }
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode FlexGeometry(PhlexPart part, PhlexScaleHints *h)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
@@ -165,6 +185,7 @@ static PetscErrorCode FlexGeometry(PhlexPart part, PhlexScaleHints *h)
   if (!b->dm) {
     PetscCall(PhlexMeshLoad(b));
     PetscCall(PhlexMeshCheckGeometry(b));
+    PetscCall(WarnSuspicious(b));
   }
   h->extent = h->density = h->modulus = h->mass = 0;
   for (PetscInt d = 0; d < 3; d++) h->extent = PetscMax(h->extent, b->bbox_max[d] - b->bbox_min[d]);
