@@ -4,6 +4,7 @@
 #   make check      build (installing missing packages first) and run the regression suite
 #   make deps       install the Debian packages phlex needs (only those missing)
 #   make meshes     regenerate the committed meshes from their .geo sources
+#   make memcheck   small runs under valgrind and with PETSc's -malloc_dump (a few minutes)
 #   make print      show the compiler and flags
 
 PKGS      := slepc petsc hdf5-mpi yaml-0.1
@@ -26,7 +27,7 @@ BIN       := bin/phlex
 # The dependency probe: PETSc, SLEPc and gmsh present means nothing has to be installed.
 HAVE_DEPS = $(shell pkg-config --exists $(PKGS) 2>/dev/null && command -v gmsh >/dev/null 2>&1 && command -v $(MPIEXEC) >/dev/null 2>&1 && echo yes)
 
-.PHONY: all run check check-update deps deps-if-missing meshes format clean print bench
+.PHONY: all run check check-update deps deps-if-missing meshes format clean print bench memcheck
 
 all: $(BIN)
 
@@ -59,6 +60,9 @@ check-update: $(BIN)
 
 meshes:
 	@$(MAKE) --no-print-directory -C meshes
+
+memcheck: $(BIN)
+	tests/memcheck.sh
 
 bench: $(BIN)
 	@$(MAKE) --no-print-directory -C bench

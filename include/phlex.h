@@ -51,6 +51,7 @@ enum {
   PHLEX_EXIT_SIGINT    = 130, /* interrupted by SIGINT (128 + 2), SIGTERM gives 143 (128 + 15) */
 };
 PETSC_EXTERN PetscErrorCode PhlexErrorHandlerPush(void);
+PETSC_EXTERN PetscErrorCode PhlexErrorHandlerPop(void);
 PETSC_EXTERN int            PhlexExitCode(void);
 
 /* help.c: -help prints the options and runs nothing */

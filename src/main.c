@@ -111,6 +111,7 @@ int main(int argc, char **argv)
     return code;
   }
   PetscCall(PhlexSceneDestroy(&scene));
+  PetscCall(PhlexErrorHandlerPop());
   PetscCall(SlepcFinalize());
   return 0;
 }

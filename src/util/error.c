@@ -150,6 +150,16 @@ PetscErrorCode PhlexErrorHandlerPush(void)
   PetscFunctionReturn(0);
 }
 
+/*@C
+  PhlexErrorHandlerPop - removes phlex's error handler (before PetscFinalize, so that -malloc_dump finds nothing)
+@*/
+PetscErrorCode PhlexErrorHandlerPop(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscPopErrorHandler());
+  PetscFunctionReturn(0);
+}
+
 /* A real-array option that must have exactly n numbers when given (inside PetscOptionsBegin/End, whose
    PetscOptionsObject is passed on). A wrong count is an input error naming what it belongs to and the option. */
 PetscErrorCode PhlexOptionsRealN(PetscOptionItems *PetscOptionsObject, MPI_Comm comm, const char what[], const char prefix[], const char opt[], const char text[], const char man[], PetscInt n, PetscReal value[], PetscBool *set)

@@ -1,0 +1,41 @@
+#!/bin/sh
+# make memcheck: small runs under valgrind (memory errors, uninitialised values) and with PETSc's -malloc_debug
+# -malloc_dump (PETSc memory not freed at the end). Each case is a few seconds under valgrind; the whole check a few
+# minutes. Exit status 0 when every case is clean, 1 otherwise. Needs valgrind (apt-get install valgrind).
+set -u
+cd "$(dirname "$0")/.."
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_ess_singleton_isolated=1
+command -v valgrind > /dev/null || { echo "memcheck: valgrind is not installed (apt-get install valgrind)" >&2; exit 2; }
+out=build/memcheck
+rm -rf "$out"; mkdir -p "$out"
+pass=0; fail=0
+# name | arguments | expected exit status
+cases='cantilever_p1|-options_file options/cantilever.yaml -ts_max_steps 2 -body0_petscspace_degree 1 -body0_ic_velocity_type beam -body0_ic_velocity_direction 0,0,1|0
+modes_p1|-options_file options/cantilever_modes.yaml -modes_nev 2 -body0_petscspace_degree 1|0
+floating_modes|-options_file options/free_bar_modes.yaml -modes_nev 2 -body0_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1|0
+double_pendulum|-options_file options/double_pendulum.yaml -ts_max_steps 3|0
+heavy_top|-options_file options/heavy_top.yaml -ts_max_steps 3|0
+swinging_tip_body|-options_file tests/scenes/swinging_tip_body.yaml -ts_max_steps 2|0
+help|-help|0
+help_scene|-options_file options/cantilever.yaml -help|0
+misspelt_option|-options_file options/cantilever.yaml -ts_max_steps 2 -body0_petscspace_degree 1 -body0_densty 3 -ts_typ bdf|2
+bad_time_step|-options_file options/cantilever.yaml -ts_dt nan|2'
+echo "$cases" | while IFS='|' read -r name args expect; do
+  dir="$out/$name"
+  # shellcheck disable=SC2086
+  valgrind -q --error-exitcode=99 --suppressions=tests/valgrind.supp bin/phlex $args -output_dir "$dir/run" -progress 0 > "$dir.valgrind.log" 2>&1
+  rc=$?
+  verdict=ok
+  if [ "$rc" = 99 ] || grep -q "==[0-9]*== " "$dir.valgrind.log"; then verdict="valgrind errors (see $dir.valgrind.log)"
+  elif [ "$rc" != "$expect" ]; then verdict="exit status $rc, expected $expect (see $dir.valgrind.log)"
+  elif [ "$expect" = 0 ]; then
+    rm -rf "$dir/run"
+    # shellcheck disable=SC2086
+    bin/phlex $args -output_dir "$dir/run" -progress 0 -malloc_debug -malloc_dump > "$dir.malloc.log" 2>&1
+    if grep -q "^\[ *[0-9]*\] [0-9]* bytes" "$dir.malloc.log"; then verdict="memory not freed (see $dir.malloc.log)"; fi
+  fi
+  if [ "$verdict" = ok ]; then echo "ok - $name"; echo pass >> "$out/.tally"; else echo "not ok - $name: $verdict"; echo fail >> "$out/.tally"; fi
+done
+pass=$(grep -c pass "$out/.tally" 2>/dev/null); fail=$(grep -c fail "$out/.tally" 2>/dev/null)
+echo "$pass passed, $fail failed"
+[ "$fail" = 0 ]
