@@ -133,6 +133,8 @@ struct _p_PhlexPart {
   char          (*qname)[16];
   PhlexFrameIndex frame;
   PetscBool       nonlinear; /* its residual is not linear in its unknowns (a moving frame) */
+  PetscBool       nonquadratic_energy; /* its Hamiltonian is not quadratic in its energy variables (a floating body's
+                                          full inertia): the implicit midpoint rule conserves it to O(dt^2) only */
 
   /* ports: set by setup; the wrench on each port from the joints (body frame, non-dimensional) is set by the
      system before residual and jacobian */

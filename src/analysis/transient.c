@@ -27,12 +27,16 @@ typedef struct {
   PetscBool   free_system;
   PetscReal   P0[3], L0[3], Pscale, Lscale, max_dP, max_dL, max_orth, max_defect;
   /* joints */
-  PetscReal   max_gap, project_dH;
+  PetscReal   max_gap, project_dH, step_project_dH;
   PetscInt    nprojections;
+  /* watchdogs: stop a run whose numbers went wrong (0: off) */
+  PetscReal   watch_balance, watch_gap;
+  PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
   PhlexProgress progress;
 } MonitorContext;
 
 static PetscErrorCode TransientProgress(TS, MonitorContext *, PetscInt, PetscReal);
+static PetscErrorCode Watchdogs(MonitorContext *, PetscInt, PetscReal, PetscReal, PetscReal);
 
 /* ---------------------------------------------------------------------------------------------------------- */
 /* Energy and power-balance monitor                                                                            */
@@ -167,6 +171,7 @@ static PetscErrorCode PostStep(TS ts)
     PetscCall(TSGetTime(ts, &t));
     PetscCall(PhlexAssemblyClose(m->sys, t, X, PETSC_FALSE, &dH));
     m->project_dH += dH;
+    m->step_project_dH = dH;
     m->nprojections++;
   }
   PetscFunctionReturn(0);
@@ -232,12 +237,41 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   }
   PetscCall(PetscViewerASCIIPrintf(m->energy_csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e\n", step, (double)t, (double)(kin * u->energy), (double)(strain * u->energy), (double)(pot * u->energy), (double)(H * u->energy), (double)(power * u->power), (double)(m->work_total * u->energy), (double)(residual * u->energy)));
   if (m->monitor) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(residual * u->energy)));
+  PetscCall(Watchdogs(m, step, t, H, residual - m->step_project_dH));
+  m->step_project_dH = 0;
   PetscCall(VecCopy(X, m->Xprev));
   PetscCall(PhlexSystemGather(sys, X, m->qprev));
   m->tprev      = t;
   m->have_stage = PETSC_FALSE;
   PetscCall(PetscLogEventEnd(PHLEX_MonitorEnergy, 0, 0, 0, 0));
   if (step > 0) PetscCall(TransientProgress(ts, m, step, t));
+  PetscFunctionReturn(0);
+}
+
+/* Watchdogs after each step: the state is finite; with the implicit midpoint rule and a quadratic Hamiltonian (no
+   floating body with full inertia: the discrete power balance then holds to solver tolerance) the step's balance residual stays below -watchdog_balance_rtol of the largest
+   kinetic + strain energy; every joint stays closed within -watchdog_joint_drift x min(L, 1 m) (m or rad). A run
+   that breaks one has gone wrong (Newton converged to a wrong solution, a step too large, a drift out of control):
+   it stops with exit code 3 and writes nothing. */
+static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, PetscReal H, PetscReal residual)
+{
+  const PhlexUnits *u = &m->scene->units;
+
+  PetscFunctionBeginUser;
+  if (PetscIsInfOrNanReal(H)) {
+    char e[32];
+    SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "at step %" PetscInt_FMT " (t = %g s) the energy is %s: the state holds NaN or Inf; reduce -ts_dt, or check the inputs' magnitudes; no result was written", step, (double)t, PhlexFormatReal(H * u->energy, e, sizeof(e)));
+  }
+  if (step > 0 && m->lossless_scheme && m->watch_balance > 0) {
+    const PetscReal scale = PetscMax(m->Emax, PetscAbsReal(m->H0));
+    PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently; tighten -snes_rtol/-ksp_rtol or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
+               step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance);
+  }
+  if (m->sys->njoints && m->watch_gap > 0) {
+    const PetscReal bound = m->watch_gap * PetscMin(u->length, 1.0);
+    PetscCheck(m->max_gap <= bound, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): a joint is open by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m)): the constraints drift (a dissipative scheme with large steps?); use the implicit midpoint rule, smaller steps or -joints_project_interval (-watchdog_joint_drift 0 turns this check off); no result was written",
+               step, (double)t, (double)m->max_gap, (double)bound, (double)m->watch_gap);
+  }
   PetscFunctionReturn(0);
 }
 
@@ -334,6 +368,7 @@ static PetscErrorCode CreateSystem(PhlexScene scene, PhlexSystem *sys, Vec *X)
 /* the options of the transient analysis (the self-checks and the energy monitor; TS, SNES and KSP read theirs) */
 typedef struct {
   PetscReal   drift_max, drift_abs_max, balance_rtol, momentum_max, linear_max, angular_max, orth_max, gap_max;
+  PetscReal   watch_balance, watch_gap;
   PetscViewer monitor;
 } TransientOptions;
 
@@ -344,6 +379,8 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscFunctionBeginUser;
   o->drift_max = o->drift_abs_max = o->balance_rtol = o->momentum_max = o->linear_max = o->angular_max = o->orth_max = o->gap_max = -1;
   o->monitor                                                                                                             = NULL;
+  o->watch_balance                                                                                                       = 1e-6;
+  o->watch_gap                                                                                                           = 1e-2;
   PetscOptionsBegin(comm, NULL, "Transient analysis options", NULL);
   PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", o->drift_max, &o->drift_max, NULL));
   PetscCall(PetscOptionsReal("-expect_energy_drift_abs_max", "Self-check: bound on max |H - H0| [J] (when H0 is no scale: a mechanism starting at rest)", "PhlexSceneSolveTransient", o->drift_abs_max, &o->drift_abs_max, NULL));
@@ -353,8 +390,11 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCall(PetscOptionsReal("-expect_angular_momentum_drift_max", "Self-check (a free system): bound on the drift of the inertial angular momentum alone, relative to its scale", "PhlexSceneSolveTransient", o->angular_max, &o->angular_max, NULL));
   PetscCall(PetscOptionsReal("-expect_orthogonality_max", "Self-check (moving frames): bound on max ||R^T R - I||_F", "PhlexSceneSolveTransient", o->orth_max, &o->orth_max, NULL));
   PetscCall(PetscOptionsReal("-expect_joint_drift_max", "Self-check (joints): bound on the largest position-level violation of any joint [m, rad]", "PhlexSceneSolveTransient", o->gap_max, &o->gap_max, NULL));
+  PetscCall(PetscOptionsReal("-watchdog_balance_rtol", "Watchdog (implicit midpoint rule): stop when a step's power-balance residual exceeds this share of the energy (0: off)", "PhlexSceneSolveTransient", o->watch_balance, &o->watch_balance, NULL));
+  PetscCall(PetscOptionsReal("-watchdog_joint_drift", "Watchdog: stop when a joint opens by more than this times min(L, 1 m) [m or rad] (0: off)", "PhlexSceneSolveTransient", o->watch_gap, &o->watch_gap, NULL));
   PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
   PetscOptionsEnd();
+  PetscCheck(o->watch_balance >= 0 && o->watch_gap >= 0, comm, PETSC_ERR_USER_INPUT, "-watchdog_balance_rtol and -watchdog_joint_drift must be >= 0 (0: off), got %g and %g", (double)o->watch_balance, (double)o->watch_gap);
   PetscFunctionReturn(0);
 }
 
@@ -591,6 +631,12 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(TSThetaGetTheta(ts, &m.theta_value));
     PetscCall(TSThetaGetEndpoint(ts, &m.endpoint));
   }
+  /* the implicit midpoint rule keeps the power balance to solver tolerance for a quadratic Hamiltonian */
+  m.lossless_scheme = (m.theta && !m.endpoint && m.theta_value == 0.5) ? PETSC_TRUE : PETSC_FALSE;
+  for (PetscInt i = 0; i < sys->nparts; i++)
+    if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
+  m.watch_balance   = o.watch_balance;
+  m.watch_gap       = o.watch_gap;
   PetscCall(PhlexOutputCSVOpen(scene->output, "energy.csv", "step,time,kinetic,strain,potential,total,input_power,supplied_work,balance_residual", &m.energy_csv));
   for (PetscInt i = 0; i < sys->nparts; i++) PetscCall((*sys->parts[i]->ops.outputopen)(sys->parts[i], scene->output, scene->output->fields));
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputOpen(sys->joints[k], scene->output));

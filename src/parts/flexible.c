@@ -211,8 +211,9 @@ static PetscErrorCode SetUpLayout(PhlexPart part)
   if (b->floating) {
     for (PetscInt k = 0; k < 18; k++) PetscCall(PhlexPartSetDof(part, k, k < 12 ? PHLEX_DOF_CONFIGURATION : PHLEX_DOF_VELOCITY, rn[k]));
     for (PetscInt k = 18; k < nq; k++) PetscCall(PhlexPartSetDof(part, k, PHLEX_DOF_IMPULSE, mn[k - 18]));
-    part->frame     = (PhlexFrameIndex){0, 3, 12, 15};
-    part->nonlinear = PETSC_TRUE;
+    part->frame               = (PhlexFrameIndex){0, 3, 12, 15};
+    part->nonlinear           = PETSC_TRUE;
+    part->nonquadratic_energy = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
   }
   PetscFunctionReturn(0);
 }

@@ -174,6 +174,10 @@ PetscErrorCode PhlexOptionsRealN(PetscOptionItems *PetscOptionsObject, MPI_Comm 
   buf[n] = 0;
   PetscCall(PetscOptionsRealArray(opt, text, man, buf, &got, &flg));
   PetscCheck(!flg || got == n, comm, PETSC_ERR_USER_INPUT, "%s: option -%s%s needs %" PetscInt_FMT " components, got %s%" PetscInt_FMT, what, prefix, opt + 1, n, got > n ? "more than " : "", got > n ? n : got);
+  for (PetscInt i = 0; flg && i < n; i++) {
+    char v[32];
+    PetscCheck(!PetscIsInfOrNanReal(buf[i]), comm, PETSC_ERR_USER_INPUT, "%s: option -%s%s: component %" PetscInt_FMT " is %s, not a finite number", what, prefix, opt + 1, i + 1, PhlexFormatReal(buf[i], v, sizeof(v)));
+  }
   if (flg) PetscCall(PetscArraycpy(value, buf, n));
   if (set) *set = flg;
   PetscFunctionReturn(0);
