@@ -680,10 +680,10 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PetscPrintf(scene->comm, "  supplied work: %.8e J, max power-balance residual %.3e J\n", (double)(m.work_total * u->energy), (double)(m.max_residual * u->energy)));
     for (PetscInt i = 0; i < sys->nparts; i++)
       if (sys->parts[i]->frame.R >= 0) {
-        PetscCall(PetscPrintf(scene->comm, "  rotations: max ||R^T R - I|| = %.3e (largest per-step defect removed %.3e)\n", (double)m.max_orth, (double)m.max_defect));
+        PetscCall(PetscPrintf(scene->comm, "  rotations: max ||R^T R - I||_F = %.3e (largest per-step defect removed %.3e, same norm)\n", (double)m.max_orth, (double)m.max_defect));
         break;
       }
-    if (m.free_system) PetscCall(PetscPrintf(scene->comm, "  momenta: max drift of P %.3e, of L %.3e (relative to %.6e kg m/s, %.6e kg m^2/s)\n", (double)m.max_dP, (double)m.max_dL, (double)(m.Pscale * u->mass * u->velocity), (double)(m.Lscale * u->mass * u->velocity * u->length)));
+    if (m.free_system) PetscCall(PetscPrintf(scene->comm, "  momenta: max drift of P %.3e, of L %.3e (largest component of P - P0, L - L0, relative to %.6e kg m/s, %.6e kg m^2/s)\n", (double)m.max_dP, (double)m.max_dL, (double)(m.Pscale * u->mass * u->velocity), (double)(m.Lscale * u->mass * u->velocity * u->length)));
     if (sys->njoints) {
       PetscCall(PetscPrintf(scene->comm, "  joints: max position-level violation %.3e (m or rad)", (double)m.max_gap));
       if (m.nprojections) PetscCall(PetscPrintf(scene->comm, "; %" PetscInt_FMT " projections changed the energy by %.3e J", m.nprojections, (double)(m.project_dH * u->energy)));

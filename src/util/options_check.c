@@ -128,9 +128,11 @@ PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm comm, PetscErrorCode (*reread)(v
     if (!ReadLate(names[i])) nunused++;
   if (nunused) {
     if (reread) {
+      PetscErrorCode ierr;
       PetscCall(PhlexHelpCaptureBegin());
-      PetscCall((*reread)(ctx));
-      PetscCall(PhlexHelpCaptureEnd(&nvalid, &valid));
+      ierr = (*reread)(ctx);
+      PetscCall(PhlexHelpCaptureEnd(&nvalid, &valid)); /* stdout and -help restored even if the reread failed */
+      PetscCall(ierr);
     }
     PetscCall(AddUsedNames(&nvalid, &valid));
   }
