@@ -132,5 +132,6 @@ PETSC_INTERN PetscErrorCode PhlexModesEPSCreate(MPI_Comm, EPS *, PetscReal *, Pe
 
 /* scene.c */
 PETSC_INTERN PetscErrorCode PhlexSceneFindPart(PhlexScene, const char[], PhlexPart *);
+PETSC_INTERN PetscErrorCode PhlexSceneReadOptions(MPI_Comm);
 
 #endif

@@ -50,16 +50,13 @@ static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
 static PetscErrorCode ModesRereadOptions(void *ctx)
 {
   MPI_Comm     comm = *(MPI_Comm *)ctx;
-  PhlexScene   scene;
   ModesOptions o;
   EPS          eps;
   PetscReal    ftarget = -1;
   PetscBool    flg;
 
   PetscFunctionBeginUser;
-  PetscCall(PhlexSceneCreate(comm, &scene));
-  PetscCall(PhlexSceneSetFromOptions(scene));
-  PetscCall(PhlexSceneDestroy(&scene));
+  PetscCall(PhlexSceneReadOptions(comm));
   PetscCall(ModesSetFromOptions(comm, &o));
   PetscCall(PhlexModesEPSCreate(comm, &eps, &ftarget, &flg));
   PetscCall(EPSSetFromOptions(eps));

@@ -403,15 +403,12 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
 static PetscErrorCode TransientRereadOptions(void *ctx)
 {
   MPI_Comm         comm = *(MPI_Comm *)ctx;
-  PhlexScene       scene;
   TransientOptions o;
   char             file[PETSC_MAX_PATH_LEN] = "";
   TS               ts;
 
   PetscFunctionBeginUser;
-  PetscCall(PhlexSceneCreate(comm, &scene));
-  PetscCall(PhlexSceneSetFromOptions(scene));
-  PetscCall(PhlexSceneDestroy(&scene));
+  PetscCall(PhlexSceneReadOptions(comm));
   PetscCall(TransientSetFromOptions(comm, &o));
   PetscCall(PetscViewerDestroy(&o.monitor));
   PetscCall(SolverPresetOption(comm, file));

@@ -134,6 +134,23 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
   PetscFunctionReturn(0);
 }
 
+/*@C
+  PhlexSceneReadOptions - reads every scene option (bodies, joints, output) into a scene that is then thrown away:
+  with PETSc's help printing on, this lists the scene's valid options (PhlexOptionsCheckUnused)
+
+  Collective
+@*/
+PetscErrorCode PhlexSceneReadOptions(MPI_Comm comm)
+{
+  PhlexScene scene;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSceneCreate(comm, &scene));
+  PetscCall(PhlexSceneSetFromOptions(scene));
+  PetscCall(PhlexSceneDestroy(&scene));
+  PetscFunctionReturn(0);
+}
+
 /* Scales for the whole scene unless overridden: L = the largest extent of all bodies, rho_ref and E_ref the largest
    material values of the flexible bodies. A scene without a flexible body: L from its bodies (or 1 m), the mass
    scale its largest mass, and the time scale 1 s. */
