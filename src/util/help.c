@@ -4,7 +4,7 @@
    options of every PETSc program), sets it after initialisation, and filters what goes to stdout (PETSc's
    PetscVFPrintf, through which every PETSc print passes): one line per option, "<value; default d>" instead of
    "<now v : formerly d>", no bytes that are not printable (PETSc 3.18 prints an uninitialised buffer for
-   -dm_plex_boundary_label), no repeated option line, no man-page reference of a phlex option. "-help solvers" also
+   -dm_plex_boundary_label), no repeated option line, no man-page reference ("(TSSetType)"). "-help solvers" also
    sets the scene up and reads the solver objects' options (TS, SNES, KSP, PC, EPS, ST), still without a step.
    The same filter collects the names of the valid options for the unused-option check (capture mode). */
 #include <phlex_impl.h>
