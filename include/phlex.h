@@ -15,7 +15,8 @@ typedef struct _p_PhlexOutput  *PhlexOutput;
 
 typedef enum {
   PHLEX_ANALYSIS_TRANSIENT,
-  PHLEX_ANALYSIS_MODES
+  PHLEX_ANALYSIS_MODES,
+  PHLEX_ANALYSIS_LINEARIZED
 } PhlexAnalysisType;
 PETSC_EXTERN const char *const PhlexAnalysisTypes[];
 
@@ -113,6 +114,7 @@ PETSC_EXTERN PetscErrorCode PhlexJointDestroy(PhlexJoint *);
 
 /* modes.c and transient.c: the analyses */
 PETSC_EXTERN PetscErrorCode PhlexSceneSolveModes(PhlexScene);
+PETSC_EXTERN PetscErrorCode PhlexSceneSolveLinearized(PhlexScene);
 PETSC_EXTERN PetscErrorCode PhlexSceneSolveTransient(PhlexScene);
 
 #endif

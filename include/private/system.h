@@ -69,6 +69,7 @@ struct _p_PhlexSystem {
 
 PETSC_INTERN PetscErrorCode PhlexSystemCreate(PhlexScene, PhlexSystem *);
 PETSC_INTERN PetscErrorCode PhlexSystemDestroy(PhlexSystem *);
+PETSC_INTERN PetscErrorCode PhlexSystemCreateForScene(PhlexScene, PhlexSystem *, Vec *);
 PETSC_INTERN PetscErrorCode PhlexSystemIFunction(TS, PetscReal, Vec, Vec, Vec, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemIJacobian(TS, PetscReal, Vec, Vec, PetscReal, Mat, Mat, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemGather(PhlexSystem, Vec, PetscReal *);

@@ -307,64 +307,6 @@ static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys)
   PetscFunctionReturn(0);
 }
 
-/* The system, its initial state and the joints' geometry at the drawn configuration; redundant constraint
-   components found (and dropped if asked: the layout changes, the initial state is carried over). */
-static PetscErrorCode CreateSystem(PhlexScene scene, PhlexSystem *sys, Vec *X)
-{
-  PetscInt ndropped = 0;
-
-  PetscFunctionBeginUser;
-  PetscCall(PhlexSystemCreate(scene, sys));
-  PetscCall(DMCreateGlobalVector((*sys)->dm, X));
-  PetscCall(PetscObjectSetName((PetscObject)*X, "state"));
-  PetscCall(PhlexSystemInitialState(*sys, *X));
-  if (!(*sys)->njoints) PetscFunctionReturn(0);
-  PetscCall(PhlexAssemblyPlaceAttached(*sys, *X));
-  for (PetscInt k = 0; k < (*sys)->njoints; k++) {
-    PhlexJoint   j = (*sys)->joints[k];
-    PhlexPartVec pv[2];
-    PetscCall(PhlexSystemJointSides(*sys, j, *X, (*sys)->q, pv));
-    PetscCall(PhlexJointSetUp(j, &pv[0], &pv[1]));
-    PetscCall(PhlexSystemJointSidesRestore(*sys, j, *X, pv));
-  }
-  PetscCall(PhlexAssemblyRedundancy(*sys, *X, &ndropped));
-  if (ndropped) {
-    /* the joints lost rows: a new layout; the fields and the parts' discrete unknowns are carried over (they come
-       first among the discrete unknowns and keep their places), the impulses start at zero */
-    PhlexSystem old = *sys;
-    Vec         fields[3] = {NULL, NULL, NULL};
-    PetscReal  *q;
-    PetscCall(PetscMalloc1(PetscMax(old->nq, 1), &q));
-    PetscCall(PhlexSystemGather(old, *X, q));
-    for (PetscInt f = 0; f < 3 && old->nfparts; f++) {
-      Vec a;
-      PetscCall(VecGetSubVector(*X, old->is[f], &a));
-      PetscCall(VecDuplicate(a, &fields[f]));
-      PetscCall(VecCopy(a, fields[f]));
-      PetscCall(VecRestoreSubVector(*X, old->is[f], &a));
-    }
-    PetscCall(VecDestroy(X));
-    PetscCall(PhlexSystemDestroy(&old));
-    PetscCall(PhlexSystemCreate(scene, sys));
-    PetscCall(DMCreateGlobalVector((*sys)->dm, X));
-    PetscCall(PetscObjectSetName((PetscObject)*X, "state"));
-    PetscCall(VecSet(*X, 0.0));
-    for (PetscInt f = 0; f < 3 && fields[f]; f++) {
-      Vec b;
-      PetscCall(VecGetSubVector(*X, (*sys)->is[f], &b));
-      PetscCall(VecCopy(fields[f], b));
-      PetscCall(VecRestoreSubVector(*X, (*sys)->is[f], &b));
-      PetscCall(VecDestroy(&fields[f]));
-    }
-    for (PetscInt k = 0; k < (*sys)->nq; k++) (*sys)->q[k] = 0.0;
-    for (PetscInt i = 0; i < (*sys)->nparts; i++)
-      for (PetscInt k = 0; k < (*sys)->parts[i]->nq; k++) (*sys)->q[(*sys)->parts[i]->qoff + k] = q[(*sys)->parts[i]->qoff + k];
-    PetscCall(PhlexSystemScatter(*sys, (*sys)->q, *X));
-    PetscCall(PetscFree(q));
-  }
-  PetscFunctionReturn(0);
-}
-
 /* the options of the transient analysis (the self-checks and the energy monitor; TS, SNES and KSP read theirs) */
 typedef struct {
   PetscReal   drift_max, drift_abs_max, balance_rtol, momentum_max, linear_max, angular_max, orth_max, gap_max;
@@ -510,7 +452,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   }
   if (PhlexHelpGetMode() == PHLEX_HELP_NONE) PetscCall(CheckTimeOptions(scene->comm));
 
-  PetscCall(CreateSystem(scene, &sys, &X));
+  PetscCall(PhlexSystemCreateForScene(scene, &sys, &X));
   /* a free system: every part has momenta, none is held, no joint to the ground, no gravity */
   m.free_system = (scene->gravity[0] == 0.0 && scene->gravity[1] == 0.0 && scene->gravity[2] == 0.0) ? PETSC_TRUE : PETSC_FALSE;
   for (PetscInt i = 0; i < sys->nparts; i++)

@@ -296,6 +296,69 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
 }
 
 /*@C
+  PhlexSystemCreateForScene - the system of a scene, its initial state and the joints' geometry at the drawn
+  configuration; redundant constraint components found (and dropped if asked: the layout changes, the initial state
+  is carried over). Both the transient and the linearised analysis start here.
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemCreateForScene(PhlexScene scene, PhlexSystem *sys, Vec *X)
+{
+  PetscInt ndropped = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemCreate(scene, sys));
+  PetscCall(DMCreateGlobalVector((*sys)->dm, X));
+  PetscCall(PetscObjectSetName((PetscObject)*X, "state"));
+  PetscCall(PhlexSystemInitialState(*sys, *X));
+  if (!(*sys)->njoints) PetscFunctionReturn(0);
+  PetscCall(PhlexAssemblyPlaceAttached(*sys, *X));
+  for (PetscInt k = 0; k < (*sys)->njoints; k++) {
+    PhlexJoint   j = (*sys)->joints[k];
+    PhlexPartVec pv[2];
+    PetscCall(PhlexSystemJointSides(*sys, j, *X, (*sys)->q, pv));
+    PetscCall(PhlexJointSetUp(j, &pv[0], &pv[1]));
+    PetscCall(PhlexSystemJointSidesRestore(*sys, j, *X, pv));
+  }
+  PetscCall(PhlexAssemblyRedundancy(*sys, *X, &ndropped));
+  if (ndropped) {
+    /* the joints lost rows: a new layout; the fields and the parts' discrete unknowns are carried over (they come
+       first among the discrete unknowns and keep their places), the impulses start at zero */
+    PhlexSystem old = *sys;
+    Vec         fields[3] = {NULL, NULL, NULL};
+    PetscReal  *q;
+    PetscCall(PetscMalloc1(PetscMax(old->nq, 1), &q));
+    PetscCall(PhlexSystemGather(old, *X, q));
+    for (PetscInt f = 0; f < 3 && old->nfparts; f++) {
+      Vec a;
+      PetscCall(VecGetSubVector(*X, old->is[f], &a));
+      PetscCall(VecDuplicate(a, &fields[f]));
+      PetscCall(VecCopy(a, fields[f]));
+      PetscCall(VecRestoreSubVector(*X, old->is[f], &a));
+    }
+    PetscCall(VecDestroy(X));
+    PetscCall(PhlexSystemDestroy(&old));
+    PetscCall(PhlexSystemCreate(scene, sys));
+    PetscCall(DMCreateGlobalVector((*sys)->dm, X));
+    PetscCall(PetscObjectSetName((PetscObject)*X, "state"));
+    PetscCall(VecSet(*X, 0.0));
+    for (PetscInt f = 0; f < 3 && fields[f]; f++) {
+      Vec b;
+      PetscCall(VecGetSubVector(*X, (*sys)->is[f], &b));
+      PetscCall(VecCopy(fields[f], b));
+      PetscCall(VecRestoreSubVector(*X, (*sys)->is[f], &b));
+      PetscCall(VecDestroy(&fields[f]));
+    }
+    for (PetscInt k = 0; k < (*sys)->nq; k++) (*sys)->q[k] = 0.0;
+    for (PetscInt i = 0; i < (*sys)->nparts; i++)
+      for (PetscInt k = 0; k < (*sys)->parts[i]->nq; k++) (*sys)->q[(*sys)->parts[i]->qoff + k] = q[(*sys)->parts[i]->qoff + k];
+    PetscCall(PhlexSystemScatter(*sys, (*sys)->q, *X));
+    PetscCall(PetscFree(q));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexSystemGather - the discrete unknowns of a global vector on every rank (they live on rank 0)
 
   Collective

@@ -24,7 +24,8 @@ const char PhlexUsage[] = "Usage: bin/phlex -options_file <scene>.yaml [options]
                           "\n"
                           "phlex simulates flexible multibody systems of 3D elastic bodies in port-Hamiltonian form:\n"
                           "the scene file (YAML, options/*.yaml) describes the bodies, joints, loads and the analysis\n"
-                          "(transient or modes); any option of the scene can be given or overridden on the command line.\n"
+                          "(transient, modes of each body, or the linearized assembly); any option of the scene can be given or\n"
+                          "overridden on the command line.\n"
                           "\n"
                           "  -help                  the options this scene reads, with value, default and unit; no run\n"
                           "  -help solvers          also the solver options (TS, SNES, KSP, PC, EPS, ST) after set-up\n"
@@ -282,7 +283,7 @@ PetscErrorCode PhlexHelpEnd(MPI_Comm comm, PetscBool catalogue)
   if (help_mode == PHLEX_HELP_NONE) PetscFunctionReturn(0);
   PetscCall(PetscPrintf(comm, "----------------------------------------\n"));
   if (catalogue) PetscCall(PetscPrintf(comm, "No scene was given: the options above are those of one body of each type (flexible, rigid, lumped)\nand one driven joint, with example values where an option has no default (materials, masses, ports,\njoint); with -options_file <scene>.yaml they are the scene's, with its values.\n"));
-  if (help_mode == PHLEX_HELP_OPTIONS) PetscCall(PetscPrintf(comm, "Solver options (-ts_*, -snes_*, -ksp_*, -pc_*, -modes_eps_*, -modes_st_*): add \"-help solvers\" to list those this\nscene reads (the scene is then set up, no step is taken); the presets are in options/solver/.\n"));
+  if (help_mode == PHLEX_HELP_OPTIONS) PetscCall(PetscPrintf(comm, "Solver options (-ts_*, -snes_*, -ksp_*, -pc_*, -modes_eps_*, -modes_st_*, -linearized_eps_*, -linearized_st_*): add\n\"-help solvers\" to list those this scene reads (the scene is then set up, no step is taken); the presets are in options/solver/.\n"));
   PetscCall(PetscPrintf(comm, "Nothing was run (help only).\n"));
   PetscCall(FilterPop());
   /* PETSc's finalisation prints the options it reads (-log_view, ...) while -help is set */

@@ -1,0 +1,825 @@
+/* Linearised analysis of an assembly (paper Section 5.3): the whole mechanism's pHDAE linearised about a
+   configuration at rest, its lowest frequencies and mode shapes, swept over configurations in one run.
+
+   The system's residual F(t, X, X') is linearised from its own Jacobian, jj(s) = s E + A (s the shift, E = dF/dX',
+   A = dF/dX), taken at two shifts: nothing of a part's or a joint's equations is written twice. About a state at rest
+   without loads (velocities and multipliers zero) the configuration unknowns (displacements, frame positions and
+   rotations, point positions) do not act on the dynamics: they are dropped, and the remaining pencil on the stress
+   Sigma, the velocities V (field v and discrete ones: frame v_P, w, point velocities) and the joints' impulses is
+       s E_ss Sigma + A_sv V = 0,      s (M V - B Lambda) + A_vs Sigma = 0,      C V = 0
+   with M the kinetic-energy matrix, C the constraint rows and B = -C^T their force distribution (the power-preserving
+   interconnection of the ports, paper eq. (5.x): lambda . (C V) = w . y). The stress is eliminated exactly
+   (K = -A_vs E_ss^{-1} A_sv = G^T Ms^{-1} G, element by element), which also removes the self-equilibrated stresses
+   (the Casimirs of the mixed form, each a zero eigenvalue), and with s = i omega, nu = s^2 Lambda:
+       [K  C^T] [V ]          [M  0] [V ]
+       [C   0 ] [nu] = w^2    [0  0] [nu]
+   a symmetric generalized eigenproblem with the constraints kept in a saddle point, solved by SLEPc with
+   shift-and-invert (an indefinite factorisation). Mechanism modes (zero frequency: the constrained rigid motions)
+   are counted from the rank of C on the discrete velocities, reported and deflated from the frequency list.
+
+   Everything that does not depend on the configuration is built once: K and M of the field (body frame), the
+   eigensolver and the symbolic factorisation; per configuration only the constraint rows and the frame couplings are
+   rebuilt (the joints turn), and the loop is closed by the assembly's Newton at the swept drive position. */
+#include <phlex_impl.h>
+
+typedef struct {
+  PetscInt  nev;
+  char      joint[PHLEX_NAME_LEN];
+  PetscReal values[1025];
+  PetscInt  nvalues;
+  PetscReal range[3];
+  PetscBool has_values, has_range;
+  PetscInt  fields_configuration;
+  PetscReal expected[65], rtol, rmax;
+  PetscInt  nexp;
+  PetscBool has_exp;
+} LinearizedOptions;
+
+static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions *o)
+{
+  PetscInt nrange = 3;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(o, sizeof(*o)));
+  o->nev                  = 6;
+  o->nvalues              = 1025;
+  o->nexp                 = 65;
+  o->rtol                 = 1e-6;
+  o->rmax                 = -1;
+  o->fields_configuration = 0;
+  PetscOptionsBegin(comm, NULL, "Linearised analysis of the assembly options", NULL);
+  PetscCall(PetscOptionsInt("-linearized_nev", "Number of elastic (non-zero) frequencies wanted per configuration", "PhlexSceneSolveLinearized", o->nev, &o->nev, NULL));
+  PetscCall(PetscOptionsString("-linearized_sweep_joint", "Driven joint whose position is swept (default: the scene's only driven joint)", "PhlexSceneSolveLinearized", o->joint, o->joint, sizeof(o->joint), NULL));
+  PetscCall(PetscOptionsRealArray("-linearized_sweep", "Drive positions of the configurations, as -drive_initial: angles [deg] or slides [m] relative to the drawn configuration", "PhlexSceneSolveLinearized", o->values, &o->nvalues, &o->has_values));
+  PetscCall(PetscOptionsRealArray("-linearized_sweep_range", "Drive positions start,stop,step (stop included) [deg or m]", "PhlexSceneSolveLinearized", o->range, &nrange, &o->has_range));
+  PetscCall(PetscOptionsInt("-linearized_fields_configuration", "Write the mode shapes of this configuration (0-based index; -1: none)", "PhlexSceneSolveLinearized", o->fields_configuration, &o->fields_configuration, NULL));
+  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] of the first configuration (self-check)", "PhlexSceneSolveLinearized", o->expected, &o->nexp, &o->has_exp));
+  PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveLinearized", o->rtol, &o->rtol, NULL));
+  PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveLinearized", o->rmax, &o->rmax, NULL));
+  PetscOptionsEnd();
+  PetscCheck(o->nev >= 1, comm, PETSC_ERR_USER_INPUT, "-linearized_nev must be >= 1, got %" PetscInt_FMT, o->nev);
+  PetscCheck(!(o->has_values && o->has_range), comm, PETSC_ERR_USER_INPUT, "give either -linearized_sweep or -linearized_sweep_range, not both");
+  PetscCheck(!o->has_values || o->nvalues <= 1024, comm, PETSC_ERR_USER_INPUT, "-linearized_sweep: at most 1024 values (use -linearized_sweep_range)");
+  if (!o->has_values) o->nvalues = 0;
+  if (o->has_range) {
+    PetscInt n;
+    PetscCheck(nrange == 3, comm, PETSC_ERR_USER_INPUT, "-linearized_sweep_range needs start,stop,step (3 numbers), got %" PetscInt_FMT, nrange);
+    char a[32], b[32], c[32];
+    PhlexFormatReal(o->range[0], a, sizeof(a));
+    PhlexFormatReal(o->range[1], b, sizeof(b));
+    PhlexFormatReal(o->range[2], c, sizeof(c));
+    PetscCheck(o->range[2] != 0 && (o->range[1] - o->range[0]) / o->range[2] >= 0, comm, PETSC_ERR_USER_INPUT, "-linearized_sweep_range %s,%s,%s: the step must be non-zero and go from start towards stop", a, b, c);
+    n = (PetscInt)PetscFloorReal((o->range[1] - o->range[0]) / o->range[2] + 1e-9) + 1;
+    PetscCheck(n <= 1024, comm, PETSC_ERR_USER_INPUT, "-linearized_sweep_range %s,%s,%s gives %" PetscInt_FMT " configurations; at most 1024", a, b, c, n);
+    for (PetscInt k = 0; k < n; k++) o->values[k] = o->range[0] + k * o->range[2];
+    o->nvalues = n;
+  }
+  if (!o->has_exp) o->nexp = 0;
+  PetscCheck(o->nexp <= 64, comm, PETSC_ERR_USER_INPUT, "-expect_frequencies: at most 64 values");
+  PetscFunctionReturn(0);
+}
+
+/* the eigensolver with phlex's defaults (Krylov-Schur, shift-and-invert, an indefinite LDL^T by MUMPS: the pencil
+   is a saddle point), options prefix linearized_ */
+static PetscErrorCode LinearizedEPSCreate(MPI_Comm comm, EPS *eps)
+{
+  ST  st;
+  KSP ksp;
+  PC  pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSCreate(comm, eps));
+  PetscCall(EPSSetOptionsPrefix(*eps, "linearized_"));
+  PetscCall(EPSSetProblemType(*eps, EPS_GHEP)); /* B = diag(M, 0): positive semi-definite; purification (default) removes its null-space components */
+  PetscCall(EPSSetType(*eps, EPSKRYLOVSCHUR));
+  PetscCall(EPSSetWhichEigenpairs(*eps, EPS_TARGET_MAGNITUDE));
+  PetscCall(EPSSetTolerances(*eps, 1e-12, PETSC_DEFAULT));
+  PetscCall(EPSGetST(*eps, &st));
+  PetscCall(STSetType(st, STSINVERT));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode LinearizedRereadOptions(void *ctx)
+{
+  MPI_Comm          comm = *(MPI_Comm *)ctx;
+  LinearizedOptions o;
+  EPS               eps;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSceneReadOptions(comm));
+  PetscCall(LinearizedSetFromOptions(comm, &o));
+  PetscCall(LinearizedEPSCreate(comm, &eps));
+  PetscCall(EPSSetFromOptions(eps));
+  PetscCall(EPSDestroy(&eps));
+  PetscFunctionReturn(0);
+}
+
+/* The pencil's pieces that do not change with the configuration, the index maps of the discrete unknowns, and the
+   per-configuration matrices. Q numbers the kept discrete unknowns: the velocities first, then the impulses. */
+typedef struct {
+  PhlexSystem sys;
+  Vec         X, Xdot;
+  PetscInt    nqv, nqi, nQ; /* discrete velocities, impulses, both */
+  PetscInt   *qmap;         /* discrete unknown -> Q index (-1: a configuration unknown, dropped) */
+  PetscInt   *Qq;           /* Q index -> discrete unknown */
+  Mat         K, Mvv;       /* field stiffness (stress eliminated) and mass: built once */
+  Mat         A, B;         /* the saddle-point pencil (the same nonzero pattern in every configuration) */
+  IS          isV, isQ;     /* the velocity field and Q in the pencil's numbering */
+  PetscReal   scale;        /* |M| (the at-rest checks are relative to it) */
+} Pencil;
+
+/* the n values of a vector that lives on rank 0, on every rank */
+static PetscErrorCode RootValues(MPI_Comm comm, Vec x, PetscInt n, PetscReal *out)
+{
+  const PetscScalar *a;
+  PetscInt           nl;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(x, &nl));
+  PetscCall(VecGetArrayRead(x, &a));
+  for (PetscInt k = 0; k < nl && k < n; k++) out[k] = PetscRealPart(a[k]);
+  PetscCall(VecRestoreArrayRead(x, &a));
+  PetscCallMPI(MPI_Bcast(out, (PetscMPIInt)n, MPIU_REAL, 0, comm));
+  PetscFunctionReturn(0);
+}
+
+/* Jacobian at the non-dimensional shift s, at rest (X' = 0): the system's own IJacobian */
+static PetscErrorCode EvaluateJacobian(Pencil *p, PetscReal s)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemIJacobian(NULL, 0.0, p->X, p->Xdot, s / p->sys->units->time, p->sys->J, p->sys->J, p->sys));
+  PetscFunctionReturn(0);
+}
+
+/* an AIJ copy (a nest's blocks converted one by one: MatConvert of a nest needs MatGetRow of every block) */
+static PetscErrorCode ToAIJ(Mat A, Mat *B)
+{
+  PetscBool nest;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompare((PetscObject)A, MATNEST, &nest));
+  if (nest) {
+    PetscInt nr, nc;
+    Mat    **sub, *blocks, N;
+    IS      *isr, *isc;
+    PetscCall(MatNestGetSubMats(A, &nr, &nc, &sub));
+    PetscCall(PetscCalloc3(nr * nc, &blocks, nr, &isr, nc, &isc));
+    PetscCall(MatNestGetISs(A, isr, isc));
+    for (PetscInt i = 0; i < nr; i++)
+      for (PetscInt j = 0; j < nc; j++)
+        if (sub[i][j]) PetscCall(ToAIJ(sub[i][j], &blocks[i * nc + j]));
+    PetscCall(MatCreateNest(PetscObjectComm((PetscObject)A), nr, isr, nc, isc, blocks, &N));
+    PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, B));
+    PetscCall(MatDestroy(&N));
+    for (PetscInt k = 0; k < nr * nc; k++) PetscCall(MatDestroy(&blocks[k]));
+    PetscCall(PetscFree3(blocks, isr, isc));
+  } else PetscCall(MatConvert(A, MATAIJ, MAT_INITIAL_MATRIX, B));
+  PetscFunctionReturn(0);
+}
+
+/* E and A parts of a matrix taken at shifts 1 and 2: E = J2 - J1, A = 2 J1 - J2 (in place: J1 <- A, J2 <- E) */
+static PetscErrorCode SplitShift(Mat J1, Mat J2)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatAXPY(J2, -1.0, J1, DIFFERENT_NONZERO_PATTERN));
+  PetscCall(MatAXPY(J1, -1.0, J2, DIFFERENT_NONZERO_PATTERN));
+  PetscFunctionReturn(0);
+}
+
+/* The field operators, once: M = E_vv, K = -A_vs E_ss^{-1} A_sv; checks that the state is at rest (A_vv = 0: no
+   gyroscopic term) and that the displacement does not act on the velocity rows (A_vu = 0: no preload) */
+static PetscErrorCode BuildFieldOperators(Pencil *p)
+{
+  PhlexSystem     sys = p->sys;
+  Mat             Jss1, Jss2, Jvv1, Jvv2, Jvu = NULL, Minv, Avs, Asv;
+  PetscReal       na, nm;
+  PetscInt        nb, rstart;
+  const PetscInt *bsz;
+  PetscScalar    *diag;
+
+  PetscFunctionBeginUser;
+  PetscCall(EvaluateJacobian(p, 1.0));
+  PetscCall(ToAIJ(sys->Jss, &Jss1));
+  PetscCall(ToAIJ(sys->Jvv, &Jvv1));
+  PetscCall(EvaluateJacobian(p, 2.0));
+  PetscCall(ToAIJ(sys->Jss, &Jss2));
+  PetscCall(ToAIJ(sys->Jvv, &Jvv2));
+  PetscCall(SplitShift(Jss1, Jss2));
+  PetscCall(SplitShift(Jvv1, Jvv2));
+  p->Mvv = Jvv2;
+  PetscCall(MatNorm(p->Mvv, NORM_FROBENIUS, &nm));
+  PetscCall(MatNorm(Jvv1, NORM_FROBENIUS, &na));
+  p->scale = nm;
+  PetscCheck(na <= 1e-10 * nm, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the velocity equations have terms in v at the linearisation point (|A_vv| = %g |M|): the bodies are not at rest (a spinning frame); the linearisation about a steady motion is not this analysis", (double)(na / nm));
+  if (sys->Jvu) {
+    PetscCall(ToAIJ(sys->Jvu, &Jvu));
+    PetscCall(MatNorm(Jvu, NORM_FROBENIUS, &na));
+    PetscCall(MatDestroy(&Jvu));
+    PetscCheck(na <= 1e-10 * nm, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the displacement acts on the velocity equations at the linearisation point (|A_vu| = %g |M|): a loaded or moving state; linearise about an unloaded configuration at rest", (double)(na / nm));
+  }
+  /* E_ss is block diagonal per cell (the compliance mass): its inverse exactly, block by block */
+  PetscCall(MatGetVariableBlockSizes(sys->Ms, &nb, &bsz));
+  {
+    PetscInt n = 0;
+    for (PetscInt b = 0; b < nb; b++) n += bsz[b] * bsz[b];
+    PetscCall(PetscMalloc1(PetscMax(n, 1), &diag));
+  }
+  PetscCall(MatInvertVariableBlockDiagonal(Jss2, nb, bsz, diag));
+  PetscCall(MatDuplicate(Jss2, MAT_DO_NOT_COPY_VALUES, &Minv));
+  PetscCall(MatGetOwnershipRange(Minv, &rstart, NULL));
+  for (PetscInt b = 0, r = rstart, off = 0; b < nb; b++) {
+    PetscInt idx[64];
+    PetscCheck(bsz[b] <= 64, sys->comm, PETSC_ERR_SUP, "stress block of %" PetscInt_FMT " unknowns", bsz[b]);
+    for (PetscInt k = 0; k < bsz[b]; k++) idx[k] = r + k;
+    PetscCall(MatSetValues(Minv, bsz[b], idx, bsz[b], idx, diag + off, INSERT_VALUES)); /* symmetric blocks: either order */
+    r += bsz[b];
+    off += bsz[b] * bsz[b];
+  }
+  PetscCall(MatAssemblyBegin(Minv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Minv, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscFree(diag));
+  PetscCall(ToAIJ(sys->Jvs, &Avs));
+  PetscCall(ToAIJ(sys->Jsv, &Asv));
+  PetscCall(MatMatMatMult(Avs, Minv, Asv, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &p->K));
+  PetscCall(MatScale(p->K, -1.0));
+  PetscCall(MatSetOption(p->K, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(MatDestroy(&Minv));
+  PetscCall(MatDestroy(&Avs));
+  PetscCall(MatDestroy(&Asv));
+  PetscCall(MatDestroy(&Jss1));
+  PetscCall(MatDestroy(&Jss2));
+  PetscCall(MatDestroy(&Jvv1));
+  PetscFunctionReturn(0);
+}
+
+/* the discrete unknowns kept (velocities, impulses) and dropped (configuration) */
+static PetscErrorCode BuildDiscreteMap(Pencil *p)
+{
+  PhlexSystem sys = p->sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc2(PetscMax(sys->nq, 1), &p->qmap, PetscMax(sys->nq, 1), &p->Qq));
+  for (PetscInt k = 0; k < sys->nq; k++) p->qmap[k] = -1;
+  for (PetscInt k = 0; k < sys->nq; k++)
+    if (sys->qkind[k] == PHLEX_DOF_VELOCITY) p->Qq[p->nqv] = k, p->qmap[k] = p->nqv++;
+  p->nQ = p->nqv;
+  for (PetscInt k = 0; k < sys->nq; k++)
+    if (sys->qkind[k] == PHLEX_DOF_IMPULSE) p->Qq[p->nQ] = k, p->qmap[k] = p->nQ++;
+  p->nqi = p->nQ - p->nqv;
+  PetscFunctionReturn(0);
+}
+
+/* The state at rest: velocities and impulses zero (the configuration and the stress as they are) */
+static PetscErrorCode SetRest(Pencil *p)
+{
+  PhlexSystem sys = p->sys;
+
+  PetscFunctionBeginUser;
+  if (sys->nfparts) {
+    Vec v;
+    PetscCall(VecGetSubVector(p->X, sys->is[PHLEX_FIELD_VELOCITY], &v));
+    PetscCall(VecSet(v, 0.0));
+    PetscCall(VecRestoreSubVector(p->X, sys->is[PHLEX_FIELD_VELOCITY], &v));
+  }
+  PetscCall(PhlexSystemGather(sys, p->X, sys->q));
+  for (PetscInt k = 0; k < sys->nq; k++)
+    if (sys->qkind[k] != PHLEX_DOF_CONFIGURATION) sys->q[k] = 0.0;
+  PetscCall(PhlexSystemScatter(sys, sys->q, p->X));
+  PetscFunctionReturn(0);
+}
+
+/* The border between the velocity field and the discrete unknowns at the current configuration, E and A parts
+   (n_v x nq dense, from nq products with the Jacobian's border), and the dense discrete block's */
+static PetscErrorCode Borders(Pencil *p, Mat *BE, Mat *BA, PetscReal *DE, PetscReal *DA)
+{
+  PhlexSystem     sys = p->sys;
+  const PetscInt  nq2 = sys->nq * sys->nq;
+
+  PetscFunctionBeginUser;
+  *BE = *BA = NULL;
+  PetscCall(EvaluateJacobian(p, 1.0));
+  if (sys->Bvq) PetscCall(MatComputeOperator(sys->Bvq, MATDENSE, BA));
+  PetscCall(PetscArraycpy(DA, sys->D, nq2));
+  PetscCall(EvaluateJacobian(p, 2.0));
+  if (sys->Bvq) {
+    PetscCall(MatComputeOperator(sys->Bvq, MATDENSE, BE));
+    PetscCall(SplitShift(*BA, *BE));
+  }
+  for (PetscInt k = 0; k < nq2; k++) {
+    const PetscReal j1 = DA[k], j2 = sys->D[k];
+    DE[k] = j2 - j1;
+    DA[k] = 2.0 * j1 - j2;
+  }
+  PetscFunctionReturn(0);
+}
+
+/* The pencil at the current configuration:
+     A = [[K, Cv^T], [Cv, [[0, Cq^T], [Cq, 0]]]],   B = [[M, Mvq], [Mqv, [[Mqq, 0], [0, 0]]]]
+   on (v | discrete velocities, impulses); Cv = -E_{v,imp}^T (the force distribution of the impulses, transposed),
+   Mvq = E_{v,vel}, Cq = A_{imp,vel}, Mqq = E_{vel,vel}. Checks: at rest (no A part among velocities), the discrete
+   rows of the system against these (the power-preserving structure), the configuration unknowns inert. */
+static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
+{
+  PhlexSystem        sys = p->sys;
+  const PetscInt     nq = sys->nq, nQ = p->nQ, nqv = p->nqv;
+  PetscMPIInt        rank;
+  PetscInt           nvl = 0, Ql;
+  PetscReal         *DE, *DA, dmax = 0, worst = 0;
+  Mat                BE = NULL, BA = NULL, AvQ = NULL, BvQ = NULL, AQv = NULL, BQv = NULL, AQQ, BQQ, N, blocks[4];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(sys->comm, &rank));
+  Ql = rank == 0 ? nQ : 0;
+  PetscCall(PetscMalloc2(PetscMax(nq * nq, 1), &DE, PetscMax(nq * nq, 1), &DA));
+  PetscCall(Borders(p, &BE, &BA, DE, DA));
+  for (PetscInt k = 0; k < nq * nq; k++) dmax = PetscMax(dmax, PetscAbsReal(DE[k]));
+  dmax = PetscMax(dmax, p->scale);
+  /* at rest: no A part among the velocities, no coupling of the configuration into the kept rows */
+  for (PetscInt i = 0; i < nq; i++)
+    for (PetscInt j = 0; j < nq; j++) {
+      const PetscInt ii = p->qmap[i], jj = p->qmap[j];
+      if (ii < 0) continue;
+      if (jj < 0) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]) + PetscAbsReal(DE[i * nq + j]));
+      else if (ii < nqv && jj < nqv) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]));
+    }
+  PetscCheck(worst <= 1e-10 * dmax, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration is not at rest or is loaded (a term of relative size %g couples the frames' positions or velocities into their equations: gravity, a preload, a spinning body); linearise about an unloaded configuration at rest", (double)(worst / dmax));
+  /* the power-preserving structure: the impulse columns of the velocity rows are minus the transposed constraint
+     rows; the frame couplings symmetric */
+  for (PetscInt ii = 0; ii < nQ; ii++)
+    for (PetscInt jj = 0; jj < nqv; jj++) {
+      const PetscInt i = p->Qq[ii], j = p->Qq[jj];
+      if (ii < nqv) worst = PetscMax(worst, PetscAbsReal(DE[i * nq + j] - DE[j * nq + i]));
+      else worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j] + DE[j * nq + i]));
+    }
+  PetscCheck(worst <= 1e-9 * dmax, sys->comm, PETSC_ERR_PLIB, "linearized analysis: the discrete block is not of the symmetric saddle-point form (deviation %g): a part or joint breaks the power-preserving structure", (double)(worst / dmax));
+
+  /* field couplings: columns of the border, in Q order, and their transposes (AIJ) */
+  if (BE) {
+    PetscInt           rs, re, ld;
+    const PetscScalar *be, *ba;
+    PetscReal          amax = 0, emax = 0;
+    PetscCall(MatGetOwnershipRange(BE, &rs, &re));
+    nvl = re - rs;
+    PetscCall(MatCreateAIJ(sys->comm, nvl, Ql, PETSC_DETERMINE, nQ, nQ, NULL, nQ, NULL, &AvQ));
+    PetscCall(MatCreateAIJ(sys->comm, nvl, Ql, PETSC_DETERMINE, nQ, nQ, NULL, nQ, NULL, &BvQ));
+    PetscCall(MatSetOption(AvQ, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+    PetscCall(MatSetOption(BvQ, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+    PetscCall(MatDenseGetLDA(BE, &ld));
+    PetscCall(MatDenseGetArrayRead(BE, &be));
+    PetscCall(MatDenseGetArrayRead(BA, &ba));
+    for (PetscInt r = 0; r < nvl; r++) {
+      for (PetscInt j = 0; j < nq; j++) {
+        const PetscInt  jj = p->qmap[j];
+        const PetscReal e = PetscRealPart(be[j * ld + r]), a = PetscRealPart(ba[j * ld + r]);
+        PetscInt        row = rs + r;
+        emax = PetscMax(emax, PetscAbsReal(e));
+        if (jj < 0 || jj < nqv) amax = PetscMax(amax, PetscAbsReal(a) + (jj < 0 ? PetscAbsReal(e) : 0.0));
+        if (jj < 0) continue;
+        /* every entry, zeros included: the same pattern in every configuration (the factorisation's analysis is reused) */
+        if (jj < nqv) {
+          PetscCall(MatSetValue(BvQ, row, jj, e, INSERT_VALUES));
+          PetscCall(MatSetValue(AvQ, row, jj, 0.0, INSERT_VALUES));
+        } else {
+          PetscCall(MatSetValue(AvQ, row, jj, -e, INSERT_VALUES));
+          PetscCall(MatSetValue(BvQ, row, jj, 0.0, INSERT_VALUES));
+        }
+      }
+    }
+    PetscCall(MatDenseRestoreArrayRead(BE, &be));
+    PetscCall(MatDenseRestoreArrayRead(BA, &ba));
+    PetscCall(MatAssemblyBegin(AvQ, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyBegin(BvQ, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(AvQ, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(BvQ, MAT_FINAL_ASSEMBLY));
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &amax, 1, MPIU_REAL, MPIU_MAX, sys->comm));
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &emax, 1, MPIU_REAL, MPIU_MAX, sys->comm));
+    PetscCheck(amax <= 1e-10 * PetscMax(emax, dmax), sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration is not at rest or is loaded (the frames' velocities or positions act on the field's equations with relative size %g); linearise about an unloaded configuration at rest", (double)(amax / PetscMax(emax, dmax)));
+    PetscCall(MatTranspose(AvQ, MAT_INITIAL_MATRIX, &AQv));
+    PetscCall(MatTranspose(BvQ, MAT_INITIAL_MATRIX, &BQv));
+    {
+      /* the system's own discrete rows applied to a field vector against the transposed columns */
+      Vec       xv, yq, yQ;
+      PetscReal *yfull, diff = 0, ref = 0;
+      PetscCall(MatCreateVecs(sys->Cqv, &xv, &yq));
+      PetscCall(VecSetRandom(xv, NULL));
+      PetscCall(MatMult(sys->Cqv, xv, yq)); /* at shift 2: 2 E + A */
+      PetscCall(PetscMalloc1(PetscMax(nq, 1), &yfull));
+      PetscCall(RootValues(sys->comm, yq, nq, yfull));
+      PetscCall(MatCreateVecs(AQv, NULL, &yQ));
+      PetscCall(MatMult(AQv, xv, yQ));
+      PetscCall(VecScale(yQ, 0.5));
+      PetscCall(MatMultAdd(BQv, xv, yQ, yQ));
+      {
+        PetscReal *yQa;
+        PetscCall(PetscMalloc1(PetscMax(nQ, 1), &yQa));
+        PetscCall(RootValues(sys->comm, yQ, nQ, yQa));
+        for (PetscInt ii = 0; ii < nQ; ii++) {
+          diff = PetscMax(diff, PetscAbsReal(2.0 * yQa[ii] - yfull[p->Qq[ii]]));
+          ref  = PetscMax(ref, PetscAbsReal(yfull[p->Qq[ii]]));
+        }
+        PetscCall(PetscFree(yQa));
+      }
+      PetscCheck(diff <= 1e-9 * PetscMax(ref, 1e-300), sys->comm, PETSC_ERR_PLIB, "linearized analysis: the discrete rows of the system differ from the transposed force distribution by %g (relative): a part or joint breaks the power-preserving structure", (double)(diff / PetscMax(ref, 1e-300)));
+      PetscCall(PetscFree(yfull));
+      PetscCall(VecDestroy(&xv));
+      PetscCall(VecDestroy(&yq));
+      PetscCall(VecDestroy(&yQ));
+    }
+  }
+  PetscCall(MatDestroy(&BE));
+  PetscCall(MatDestroy(&BA));
+
+  /* the discrete block (on rank 0), all entries of the kept pattern */
+  PetscCall(MatCreateAIJ(sys->comm, Ql, Ql, nQ, nQ, nQ, NULL, 0, NULL, &AQQ));
+  PetscCall(MatCreateAIJ(sys->comm, Ql, Ql, nQ, nQ, nQ, NULL, 0, NULL, &BQQ));
+  if (rank == 0) {
+    for (PetscInt ii = 0; ii < nQ; ii++)
+      for (PetscInt jj = 0; jj < nQ; jj++) {
+        const PetscInt i = p->Qq[ii], j = p->Qq[jj];
+        PetscReal      a = 0, b = 0;
+        if (ii < nqv && jj < nqv) b = DE[i * nq + j];
+        else if (ii >= nqv && jj < nqv) a = DA[i * nq + j];
+        else if (ii < nqv && jj >= nqv) a = DA[j * nq + i];
+        PetscCall(MatSetValue(AQQ, ii, jj, a, INSERT_VALUES));
+        PetscCall(MatSetValue(BQQ, ii, jj, b, INSERT_VALUES));
+      }
+  }
+  PetscCall(MatAssemblyBegin(AQQ, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(BQQ, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(AQQ, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(BQQ, MAT_FINAL_ASSEMBLY));
+
+  /* mechanism modes: the discrete velocities the constraints leave free, nqv - rank(Cq) (their field is zero: a
+     frame patch clamps it, mean axes constrain its rigid content) */
+  {
+    PetscReal   *C, *s, work[1];
+    PetscBLASInt m = (PetscBLASInt)p->nqi, n = (PetscBLASInt)nqv, lwork = -1, info, one = 1;
+    PetscInt     rnk = 0;
+    *nmech = nqv;
+    if (m && n) {
+      PetscReal *w;
+      PetscCall(PetscMalloc2(m * n, &C, PetscMin(m, n), &s));
+      for (PetscInt ii = 0; ii < m; ii++)
+        for (PetscInt jj = 0; jj < n; jj++) C[jj * m + ii] = DA[p->Qq[nqv + ii] * nq + p->Qq[jj]]; /* column-major */
+      PetscCallBLAS("LAPACKgesvd", LAPACKgesvd_("N", "N", &m, &n, C, &m, s, NULL, &one, NULL, &one, work, &lwork, &info));
+      lwork = (PetscBLASInt)work[0];
+      PetscCall(PetscMalloc1(lwork, &w));
+      PetscCallBLAS("LAPACKgesvd", LAPACKgesvd_("N", "N", &m, &n, C, &m, s, NULL, &one, NULL, &one, w, &lwork, &info));
+      PetscCheck(!info, sys->comm, PETSC_ERR_LIB, "LAPACK gesvd failed (%d)", (int)info);
+      for (PetscInt k = 0; k < PetscMin(m, n); k++)
+        if (s[k] > 1e-10 * s[0]) rnk++;
+      *nmech = nqv - rnk;
+      PetscCall(PetscFree(w));
+      PetscCall(PetscFree2(C, s));
+    }
+  }
+  PetscCall(PetscFree2(DE, DA));
+
+  /* the pencil: [[K, AvQ], [AQv, AQQ]] and [[M, BvQ], [BQv, BQQ]] */
+  {
+    Mat A, B;
+    blocks[0] = p->K, blocks[1] = AvQ, blocks[2] = AQv, blocks[3] = AQQ;
+    PetscCall(MatCreateNest(sys->comm, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? blocks : &blocks[3], &N));
+    if (!p->isV && sys->nfparts) {
+      IS is[2];
+      PetscCall(MatNestGetISs(N, is, NULL));
+      PetscCall(ISDuplicate(is[0], &p->isV));
+      PetscCall(ISCopy(is[0], p->isV));
+      PetscCall(ISDuplicate(is[1], &p->isQ));
+      PetscCall(ISCopy(is[1], p->isQ));
+    } else if (!p->isQ) {
+      IS is[1];
+      PetscCall(MatNestGetISs(N, is, NULL));
+      PetscCall(ISDuplicate(is[0], &p->isQ));
+      PetscCall(ISCopy(is[0], p->isQ));
+    }
+    PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &A));
+    PetscCall(MatDestroy(&N));
+    blocks[0] = p->Mvv, blocks[1] = BvQ, blocks[2] = BQv, blocks[3] = BQQ;
+    PetscCall(MatCreateNest(sys->comm, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? blocks : &blocks[3], &N));
+    PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &B));
+    PetscCall(MatDestroy(&N));
+    if (!p->A) {
+      p->A = A, p->B = B;
+      PetscCall(MatSetOption(p->A, MAT_SYMMETRIC, PETSC_TRUE));
+      PetscCall(MatSetOption(p->B, MAT_SYMMETRIC, PETSC_TRUE));
+    } else {
+      /* the same pattern: the eigensolver's factorisation keeps its symbolic analysis */
+      PetscCall(MatCopy(A, p->A, SAME_NONZERO_PATTERN));
+      PetscCall(MatCopy(B, p->B, SAME_NONZERO_PATTERN));
+      PetscCall(MatDestroy(&A));
+      PetscCall(MatDestroy(&B));
+    }
+  }
+  PetscCall(MatDestroy(&AvQ));
+  PetscCall(MatDestroy(&BvQ));
+  PetscCall(MatDestroy(&AQv));
+  PetscCall(MatDestroy(&BQv));
+  PetscCall(MatDestroy(&AQQ));
+  PetscCall(MatDestroy(&BQQ));
+  PetscFunctionReturn(0);
+}
+
+/* the driven joint of the sweep: named, or the scene's only driven joint */
+static PetscErrorCode SweepJoint(PhlexSystem sys, const char name[], PhlexJoint *joint)
+{
+  PetscInt ndriven = 0;
+
+  PetscFunctionBeginUser;
+  *joint = NULL;
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PhlexJoint j = sys->joints[k];
+    PetscBool  same;
+    if (name[0]) {
+      PetscCall(PetscStrcmp(name, j->name, &same));
+      if (!same) continue;
+      PetscCheck(j->drive_row >= 0, sys->comm, PETSC_ERR_USER_INPUT, "-linearized_sweep_joint %s: the joint has no drive (-%sdrive_velocity): only a driven joint's position is swept", name, j->prefix);
+      *joint = j;
+      PetscFunctionReturn(0);
+    }
+    if (j->drive_row >= 0) {
+      ndriven++;
+      *joint = j;
+    }
+  }
+  PetscCheck(!name[0], sys->comm, PETSC_ERR_USER_INPUT, "-linearized_sweep_joint %s: no joint of that name", name);
+  PetscCheck(ndriven == 1, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: a sweep moves a driven joint; the scene has %" PetscInt_FMT " driven joints: name one with -linearized_sweep_joint", ndriven);
+  PetscFunctionReturn(0);
+}
+
+/* the mechanism moved to the drive position 'to' (rad or m) from 'from': the loops closed by the assembly's Newton
+   in steps of at most 5 degrees (or 5 % of the reference length), so that it follows the assembly branch */
+static PetscErrorCode MoveTo(Pencil *p, PhlexJoint j, PetscReal from, PetscReal to)
+{
+  PhlexSystem     sys  = p->sys;
+  const PetscBool turn = j->drive_row == PHLEX_ROW_R3 ? PETSC_TRUE : PETSC_FALSE;
+  const PetscReal step = turn ? 5.0 * PETSC_PI / 180.0 : 0.05 * sys->units->length;
+  const PetscInt  n    = PetscMax(1, (PetscInt)PetscCeilReal(PetscAbsReal(to - from) / step - 1e-9));
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 1; k <= n; k++) {
+    j->drive_initial = from + (to - from) * (PetscReal)k / (PetscReal)n;
+    PetscCall(PhlexAssemblyClose(sys, 0.0, p->X, PETSC_FALSE, NULL));
+  }
+  PetscCall(PhlexAssemblyPlaceAttached(sys, p->X));
+  PetscCall(PhlexSystemUpdateJoints(sys, p->X, 0.0));
+  PetscFunctionReturn(0);
+}
+
+typedef struct {
+  PetscInt   n, nmech;
+  PetscReal *theta, *resid; /* non-dimensional omega^2, ascending; relative residuals */
+  Vec       *x;             /* eigenvectors (pencil numbering), when asked */
+} Spectrum;
+
+static PetscErrorCode SpectrumDestroy(Spectrum *s)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; s->x && i < s->n; i++) PetscCall(VecDestroy(&s->x[i]));
+  PetscCall(PetscFree(s->x));
+  PetscCall(PetscFree2(s->theta, s->resid));
+  PetscCall(PetscMemzero(s, sizeof(*s)));
+  PetscFunctionReturn(0);
+}
+
+/* the lowest nev non-zero eigenvalues and the nmech zero ones of the current pencil */
+static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nmech, PetscBool vectors, Spectrum *s)
+{
+  PetscInt  want, nconv, nzero = 0;
+  Vec       x;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscCall(EPSSetOperators(eps, p->A, p->B));
+  want = nev + nmech;
+  PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
+  /* a target just below zero: the saddle point is singular at 0 when the mechanism moves */
+  PetscCall(EPSSetTarget(eps, nmech ? -1e-6 : 0.0));
+  PetscCall(EPSSolve(eps));
+  PetscCall(EPSGetConverged(eps, &nconv));
+  PetscCheck(nconv >= want, p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: the eigensolver converged %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs wanted (%" PetscInt_FMT " mechanism modes + -linearized_nev %" PetscInt_FMT "); see -linearized_eps_monitor, -linearized_eps_ncv", nconv, want, nmech, nev);
+  s->n = want;
+  PetscCall(PetscMalloc2(want, &s->theta, want, &s->resid));
+  if (vectors) PetscCall(PetscCalloc1(want, &s->x));
+  PetscCall(MatCreateVecs(p->A, &x, NULL));
+  for (PetscInt i = 0; i < want; i++) {
+    PetscScalar kr, ki;
+    PetscCall(EPSGetEigenpair(eps, i, &kr, &ki, x, NULL));
+    s->theta[i] = PetscRealPart(kr);
+    /* a zero eigenvalue: the relative residual divides by it; the backward error instead */
+    if (PetscAbsReal(s->theta[i]) < 1e-8) {
+      nzero++;
+      PetscCall(EPSComputeError(eps, i, EPS_ERROR_BACKWARD, &s->resid[i]));
+    } else PetscCall(EPSComputeError(eps, i, EPS_ERROR_RELATIVE, &s->resid[i]));
+    if (vectors) {
+      PetscCall(VecDuplicate(x, &s->x[i]));
+      PetscCall(VecCopy(x, s->x[i]));
+    }
+  }
+  PetscCall(VecDestroy(&x));
+  s->nmech = PetscMax(nmech, nzero);
+  PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* mode shapes of every flexible body at one configuration: <body>_modes.h5/.xmf (the whole velocity, frame motion
+   included, normalised to 1) */
+static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
+{
+  PhlexSystem sys = p->sys;
+  PetscReal  *qv, *rigid, *lambda;
+  Vec        *vecs;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc4(PetscMax(p->nQ, 1), &qv, 6 * s->n, &rigid, s->n, &lambda, s->n, &vecs));
+  for (PetscInt i = 0; i < s->n; i++) lambda[i] = s->theta[i];
+  for (PetscInt f = 0; f < sys->nfparts; f++) {
+    PhlexPart part = sys->fparts[f];
+    if (!part->ops.modesoutput) continue;
+    for (PetscInt i = 0; i < s->n; i++) {
+      Vec xV, xQ, xi;
+      PetscCall(VecGetSubVector(s->x[i], p->isV, &xV));
+      PetscCall(VecGetSubVector(xV, sys->fis[PHLEX_FIELD_VELOCITY][f], &xi));
+      PetscCall(VecDuplicate(xi, &vecs[i]));
+      PetscCall(VecCopy(xi, vecs[i]));
+      PetscCall(VecRestoreSubVector(xV, sys->fis[PHLEX_FIELD_VELOCITY][f], &xi));
+      PetscCall(VecRestoreSubVector(s->x[i], p->isV, &xV));
+      PetscCall(VecGetSubVector(s->x[i], p->isQ, &xQ));
+      PetscCall(RootValues(sys->comm, xQ, p->nQ, qv));
+      PetscCall(VecRestoreSubVector(s->x[i], p->isQ, &xQ));
+      for (PetscInt c = 0; c < 6; c++) rigid[6 * i + c] = 0.0;
+      for (PetscInt c = 0; c < 3; c++) {
+        if (part->frame.v >= 0) rigid[6 * i + c] = qv[p->qmap[part->qoff + part->frame.v + c]];
+        if (part->frame.w >= 0) rigid[6 * i + 3 + c] = qv[p->qmap[part->qoff + part->frame.w + c]];
+      }
+    }
+    PetscCall((*part->ops.modesoutput)(part, out, s->n, s->nmech, lambda, vecs, rigid));
+    for (PetscInt i = 0; i < s->n; i++) PetscCall(VecDestroy(&vecs[i]));
+  }
+  PetscCall(PetscFree4(qv, rigid, lambda, vecs));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSceneSolveLinearized - linearised analysis of the assembly: the lowest frequencies and mode shapes of the
+  whole mechanism linearised about configurations at rest, swept over a driven joint's position in one run
+
+  Collective
+
+  Options Database Keys:
++ -linearized_nev <n>                     - elastic frequencies wanted per configuration (default 6)
+. -linearized_sweep_joint <name>          - the driven joint whose position is swept (default: the only driven joint)
+. -linearized_sweep a,b,...               - its positions [deg or m, as -drive_initial]
+. -linearized_sweep_range start,stop,step - the same as a range (stop included)
+. -linearized_fields_configuration <k>    - the configuration whose mode shapes are written (default 0; -1 none)
+. -expect_frequencies f1,f2,...           - self-check: elastic frequencies [Hz] of the first configuration
+. -expect_frequencies_rtol <r>            - its relative tolerance (default 1e-6)
+. -expect_residual_max <r>                - bound on the relative eigenpair residuals
+- -linearized_eps_*, -linearized_st_*     - SLEPc options (defaults: Krylov-Schur, shift-and-invert, LDL^T by MUMPS)
+
+  Notes:
+  A driven joint is held at its position (its drive row is a constraint: a clamped crank). Writes
+  linearized_modes.csv (every mode of every configuration), linearized_sweep.csv (one row per configuration) and the
+  mode shapes of one configuration.
+@*/
+PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
+{
+  LinearizedOptions o;
+  Pencil            p;
+  PhlexJoint        joint = NULL;
+  EPS               eps;
+  PetscViewer       csv, sweep;
+  PetscReal         here = 0, worst = 0, *fexp = NULL, unit = 1;
+  PetscInt          nconfig, nfexp = 0, Nd;
+  const char       *uname = "";
+  PetscLogDouble    t0, t1, tbuild = 0, tsolve = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(LinearizedSetFromOptions(scene->comm, &o));
+  PetscCall(LinearizedEPSCreate(scene->comm, &eps));
+  if (PhlexHelpGetMode() != PHLEX_HELP_OPTIONS) PetscCall(EPSSetFromOptions(eps));
+  if (PhlexHelpGetMode() != PHLEX_HELP_NONE) {
+    PetscCall(EPSDestroy(&eps));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PhlexOptionsCheckUnused(scene->comm, LinearizedRereadOptions, &scene->comm));
+  if (scene->gravity[0] != 0 || scene->gravity[1] != 0 || scene->gravity[2] != 0) {
+    char g[3][32];
+    for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(scene->gravity[k], g[k], sizeof(g[k]));
+    SETERRQ(scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has gravity (-gravity %s,%s,%s): the analysis linearises about an unloaded configuration at rest", g[0], g[1], g[2]);
+  }
+  PetscCall(PetscMemzero(&p, sizeof(p)));
+  PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
+  PetscCall(PetscTime(&t0));
+  PetscCall(PhlexSystemCreateForScene(scene, &p.sys, &p.X));
+  PetscCall(VecDuplicate(p.X, &p.Xdot));
+  PetscCall(VecSet(p.Xdot, 0.0));
+  PetscCall(BuildDiscreteMap(&p));
+  if (p.sys->njoints) PetscCall(PhlexAssemblyClose(p.sys, 0.0, p.X, PETSC_TRUE, NULL));
+  if (p.sys->njoints) PetscCall(PhlexSystemUpdateJoints(p.sys, p.X, 0.0));
+  PetscCall(SetRest(&p));
+  if (p.sys->nfparts) PetscCall(BuildFieldOperators(&p));
+  else p.scale = 1.0;
+  PetscCall(PetscTime(&t1));
+  tbuild += t1 - t0;
+
+  /* the configurations */
+  nconfig = PetscMax(o.nvalues, 1);
+  if (o.nvalues || o.joint[0]) {
+    PetscCall(SweepJoint(p.sys, o.joint, &joint));
+    unit  = joint->drive_row == PHLEX_ROW_R3 ? PETSC_PI / 180.0 : 1.0;
+    uname = joint->drive_row == PHLEX_ROW_R3 ? "deg" : "m";
+    here  = joint->drive_initial;
+  }
+  PetscCheck(o.fields_configuration < nconfig, scene->comm, PETSC_ERR_USER_INPUT, "-linearized_fields_configuration %" PetscInt_FMT ": the run has %" PetscInt_FMT " configurations (0-based)", o.fields_configuration, nconfig);
+  Nd = 0;
+  if (p.sys->nfparts) PetscCall(MatGetSize(p.Mvv, &Nd, NULL));
+  PetscCall(PetscPrintf(scene->comm, "Linearised analysis of the assembly about rest: %" PetscInt_FMT " configuration%s", nconfig, nconfig == 1 ? "" : "s"));
+  if (joint) {
+    char a[32], b[32];
+    PhlexFormatReal(o.nvalues ? o.values[0] : here / unit, a, sizeof(a));
+    PhlexFormatReal(o.nvalues ? o.values[o.nvalues - 1] : here / unit, b, sizeof(b));
+    PetscCall(PetscPrintf(scene->comm, " of joint %s (drive position %s to %s %s)", joint->name, a, b, uname));
+  }
+  PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " elastic frequencies each\n", o.nev));
+  PetscCall(PetscPrintf(scene->comm, "  pencil: %" PetscInt_FMT " field velocities, %" PetscInt_FMT " discrete velocities, %" PetscInt_FMT " constraint rows (stress eliminated, positions at rest dropped)\n", Nd, p.nqv, p.nqi));
+
+  PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_modes.csv", "configuration,position,mode,kind,frequency_hz,omega_rad_s,relative_residual", &csv));
+  PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_sweep.csv", NULL, &sweep));
+  PetscCall(PetscViewerASCIIPrintf(sweep, "configuration,position,mechanism_modes"));
+  for (PetscInt m = 0; m < o.nev; m++) PetscCall(PetscViewerASCIIPrintf(sweep, ",omega%" PetscInt_FMT "_rad_s", m + 1));
+  PetscCall(PetscViewerASCIIPrintf(sweep, "\n"));
+  if (nconfig > 1) {
+    PetscCall(PetscPrintf(scene->comm, "  %6s %12s  %4s", "config", joint ? (joint->drive_row == PHLEX_ROW_R3 ? "angle [deg]" : "slide [m]") : "", "mech"));
+    for (PetscInt m = 0; m < o.nev; m++) PetscCall(PetscPrintf(scene->comm, "   f%-2" PetscInt_FMT " [Hz]    ", m + 1));
+    PetscCall(PetscPrintf(scene->comm, "\n"));
+  }
+  for (PetscInt c = 0; c < nconfig; c++) {
+    const PetscReal pos = o.nvalues ? o.values[c] : here / unit;
+    const PetscBool shapes = (PetscBool)(c == o.fields_configuration && scene->output->fields);
+    PetscInt        nmech;
+    Spectrum        s;
+    PetscCall(PetscTime(&t0));
+    if (joint && o.nvalues) {
+      PetscCall(MoveTo(&p, joint, here, pos * unit));
+      here = pos * unit;
+      PetscCall(SetRest(&p));
+    }
+    PetscCall(BuildPencil(&p, &nmech));
+    PetscCall(PetscTime(&t1));
+    tbuild += t1 - t0;
+    t0 = t1;
+    PetscCall(PetscMemzero(&s, sizeof(s)));
+    PetscCall(SolvePencil(&p, eps, o.nev, nmech, shapes, &s));
+    PetscCall(PetscTime(&t1));
+    tsolve += t1 - t0;
+    if (nconfig == 1) {
+      PetscCall(PetscPrintf(scene->comm, "  %" PetscInt_FMT " mechanism mode%s (zero frequency)\n  mode  frequency [Hz]       omega [rad/s]        kind       rel. residual\n", s.nmech, s.nmech == 1 ? "" : "s"));
+    } else PetscCall(PetscPrintf(scene->comm, "  %6" PetscInt_FMT " %12.6g  %4" PetscInt_FMT, c, (double)pos, s.nmech));
+    PetscCall(PetscViewerASCIIPrintf(sweep, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT, c, (double)pos, s.nmech));
+    for (PetscInt i = 0; i < s.n; i++) {
+      const PetscBool mech  = (PetscBool)(i < s.nmech);
+      const PetscReal omega = mech ? 0.0 : PetscSqrtReal(PetscAbsReal(s.theta[i])) / scene->units.time;
+      const PetscReal f     = omega / (2.0 * PETSC_PI);
+      if (nconfig == 1) PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-18.10g   %-9s  %.1e\n", i + 1, (double)f, (double)omega, mech ? "mechanism" : "elastic", (double)s.resid[i]));
+      else if (!mech && i - s.nmech < o.nev) PetscCall(PetscPrintf(scene->comm, "  %-14.8g", (double)f));
+      PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT ",%s,%.12e,%.12e,%.3e\n", c, (double)pos, i + 1, mech ? "mechanism" : "elastic", (double)f, (double)omega, (double)s.resid[i]));
+      if (!mech && i - s.nmech < o.nev) PetscCall(PetscViewerASCIIPrintf(sweep, ",%.12e", (double)omega));
+      if (!mech) worst = PetscMax(worst, s.resid[i]);
+      if (c == 0 && o.nexp && !mech) {
+        if (!fexp) PetscCall(PetscMalloc1(s.n, &fexp));
+        fexp[nfexp++] = f;
+      }
+    }
+    if (nconfig > 1) PetscCall(PetscPrintf(scene->comm, "\n"));
+    PetscCall(PetscViewerASCIIPrintf(sweep, "\n"));
+    if (shapes) PetscCall(WriteShapes(&p, scene->output, &s));
+    PetscCall(SpectrumDestroy(&s));
+    PetscCall(PhlexInterruptCheck(scene->comm, "linearized analysis"));
+  }
+  PetscCall(PetscPrintf(scene->comm, "  time: %.3g s building the pencils (K and M once, the constraint rows per configuration), %.3g s in the eigensolver (%.3g s per configuration)\n", tbuild, tsolve, tsolve / nconfig));
+  PetscCall(PetscLogStagePop());
+  PetscCall(PetscViewerDestroy(&csv));
+  PetscCall(PetscViewerDestroy(&sweep));
+  PetscCall(PhlexOutputCommit(scene->output));
+  if (o.rmax > 0) PetscCall(PhlexExpectMax(scene->comm, "eigenpair residuals (max relative)", "-expect_residual_max", worst, o.rmax, PETSC_TRUE));
+  if (o.nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nfexp, fexp, o.nexp, o.expected, o.rtol));
+  PetscCall(PetscFree(fexp));
+  PetscCall(EPSDestroy(&eps));
+  PetscCall(MatDestroy(&p.A));
+  PetscCall(MatDestroy(&p.B));
+  PetscCall(MatDestroy(&p.K));
+  PetscCall(MatDestroy(&p.Mvv));
+  PetscCall(ISDestroy(&p.isV));
+  PetscCall(ISDestroy(&p.isQ));
+  PetscCall(PetscFree2(p.qmap, p.Qq));
+  PetscCall(VecDestroy(&p.X));
+  PetscCall(VecDestroy(&p.Xdot));
+  PetscCall(PhlexSystemDestroy(&p.sys));
+  PetscFunctionReturn(0);
+}
