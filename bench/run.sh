@@ -94,7 +94,7 @@ case_args() {
     common="-ts_max_steps $steps -output_fields 0 -output_dir ${OUTROOT}_fl/$1$TAG -log_view"
     case $variant in
     full) ARGS="-options_file options/floating_tumbling.yaml $mesh $common" ;;
-    frozen) ARGS="-options_file options/floating_tumbling.yaml -body0_inertia frozen $mesh $common" ;;
+    frozen) ARGS="-options_file options/floating_tumbling.yaml -body0_inertia constant_without_gyroscopic $mesh $common" ;;
     full_iterative|frozen_iterative)
       inertia=${variant%_iterative}
       ARGS="-options_file options/floating_tumbling.yaml -body0_inertia $inertia -solver_options_file options/solver/bordered_iterative.opts $mesh $common" ;;

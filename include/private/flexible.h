@@ -43,7 +43,9 @@ typedef struct {
    body (no field). */
 typedef struct {
   MPI_Comm         comm;
-  PetscBool        frozen;  /* inertia terms at u_f = 0 */
+  PetscBool        frozen;     /* inertia terms at u_f = 0 (constant mass operator) */
+  PetscBool        gyroscopic; /* with frozen: the gyroscopic loads kept, at the undeformed geometry (the constant
+                                  model, frame.c); without: none on the elastic field */
   PhlexInertia     inertia;
   Vec              tnode, wnode; /* per node: int rho phi, int rho x phi (NULL: no field) */
   Mat              Mv;           /* velocity mass of the field (NULL: no field) */
@@ -56,6 +58,7 @@ typedef struct {
   PetscReal m, s[3], sd[3], sgrav[3], Vf[3], Vfd[3], E[9], Ed[9], J[9], Jd[9], L[3], Ld[3];
   PetscReal pt[3], pr[3], ptd[3], prd[3], gbody[3], Fext[3], Mext[3];
   PetscReal Lx[3]; /* int rho (x - P) x v (the mean-axes rotation constraint) */
+  PetscReal Wv[9]; /* int rho (x - P)_b v_c, row-major */
   Vec       Mu, Mvv, Mud, Mvd;      /* Mv u, Mv v, Mv u', Mv v' (field only) */
   Vec       bext, barm;             /* elastic load; its part whose moment arm about P moves with u (forces, not the
                                        moment distributions of ports: a port turns by its mean rotation) */
@@ -149,7 +152,9 @@ struct _p_PhlexFlexible {
   /* floating frame */
   PetscBool           floating;         /* rigid motion of the frame is an unknown */
   PhlexFrameCondition frame_condition;  /* patch or mean axes */
-  PetscBool           frozen_inertia;   /* inertia terms at u_f = 0 */
+  PetscBool           frozen_inertia;   /* mass operator at u_f = 0 (models constant, constant_without_gyroscopic) */
+  PetscBool           gyroscopic;       /* with it: the gyroscopic loads kept (constant) */
+  const char         *inertia_model;    /* full, constant, constant_without_gyroscopic */
   PetscReal           origin[3];        /* frame origin P (SI mesh coordinates) */
   PetscBool           origin_given;
   PhlexPose           pose;             /* initial r_P, R, v_P, w */

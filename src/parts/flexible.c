@@ -5,7 +5,7 @@
 const char *const PhlexICTypes[]         = {"zero", "uniform", "rigid", "beam", "mode", "PhlexICType", "PHLEX_IC_", NULL};
 const char *const PhlexFrameConditions[] = {"patch", "mean_axes", "PhlexFrameCondition", "PHLEX_FRAME_", NULL};
 static const char *const PhlexMotionTypes[]  = {"fixed", "floating", "PhlexMotion", "PHLEX_MOTION_", NULL};
-static const char *const PhlexInertiaTypes[] = {"full", "frozen", "PhlexInertia", "PHLEX_INERTIA_", NULL};
+static const char *const PhlexInertiaTypes[] = {"full", "constant", "constant_without_gyroscopic"};
 
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart);
 
@@ -42,7 +42,7 @@ static PetscErrorCode MaterialSetFromOptions(PhlexFlexible b, PhlexMaterial *m, 
    -frame patch|mean_axes    how the frame of a floating body is fixed to it
    -frame_patch <group>      physical surface where u_f = v_f = 0 (fixed: the clamp; floating: the frame)
    -frame_origin x,y,z       mean axes: the frame origin P (default: the centre of mass)
-   -inertia full|frozen      floating: inertia of x + u_f, or at u_f = 0
+   -inertia full|constant|constant_without_gyroscopic   floating: the inertia model (frame.c)
    -youngs_modulus, -poissons_ratio, -density, -regions, -ports, -body_force, -ic_*: see README */
 static PetscErrorCode FlexSetFromOptions(PhlexPart part)
 {
@@ -67,7 +67,17 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCall(PetscOptionsString("-frame_patch", "Physical surface where u_f = v_f = 0: the clamp of a fixed body, the frame patch of a floating one", "PhlexFlexibleSetFromOptions", b->frame_patch, b->frame_patch, sizeof(b->frame_patch), NULL));
   PetscCall(PetscOptionsEList("-frame", "Floating body: frame fixed by a patch (-frame_patch, a rigid inclusion) or by mean axes (Tisserand: int rho u_f = 0, int rho (x - P) x u_f = 0)", "PhlexFlexibleSetFromOptions", PhlexFrameConditions, 2, PhlexFrameConditions[cond], &cond, &fcond));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_origin", "Floating body with mean axes: frame origin P (default: the centre of mass) [m]", "PhlexFlexibleSetFromOptions", 3, b->origin, &b->origin_given));
-  PetscCall(PetscOptionsEList("-inertia", "Floating body: inertia with x + u_f (full) or at u_f = 0 (frozen, quadratic Hamiltonian)", "PhlexFlexibleSetFromOptions", PhlexInertiaTypes, 2, PhlexInertiaTypes[inertia], &inertia, NULL));
+  {
+    char      name[64] = "full";
+    PetscBool set, known = PETSC_FALSE;
+    PetscCall(PetscOptionsString("-inertia", "Floating body: inertia model: full (mass operator of x + u_f, every inertia load), constant (the paper's: mass operator at u_f = 0, the gyroscopic loads at the undeformed geometry; quadratic Hamiltonian) or constant_without_gyroscopic (mass operator at u_f = 0, no centrifugal, Coriolis or transport load on the elastic field)", "PhlexFlexibleSetFromOptions", name, name, sizeof(name), &set));
+    for (PetscInt k = 0; k < 3 && !known; k++) {
+      PetscCall(PetscStrcmp(name, PhlexInertiaTypes[k], &known));
+      if (known) inertia = k;
+    }
+    PetscCheck(!set || known || strcmp(name, "frozen"), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sinertia frozen was renamed: constant_without_gyroscopic is that model (mass operator at u_f = 0, no velocity-dependent load on the elastic field); constant is the paper's constant-inertia model (the same mass operator with the gyroscopic loads kept)", b->name, b->prefix);
+    PetscCheck(!set || known, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sinertia %s: unknown; use full, constant or constant_without_gyroscopic", b->name, b->prefix, name);
+  }
   PetscCall(PetscOptionsStringArray("-regions", "Physical volumes with their own material (-region_<name>_youngs_modulus ...)", "PhlexFlexibleSetFromOptions", rptr, &nregions, &flg));
   if (!flg) nregions = 0;
   PetscCall(PetscOptionsStringArray("-ports", "Physical surfaces: ports carrying wrench inputs or joints (-port_<name>_force ...)", "PhlexFlexibleSetFromOptions", pptr, &nports, &flg));
@@ -79,6 +89,8 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscOptionsEnd();
   b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
   b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
+  b->gyroscopic     = inertia == 1 ? PETSC_TRUE : PETSC_FALSE;
+  b->inertia_model  = PhlexInertiaTypes[inertia];
   b->frame_loaded   = (ff || fm) ? PETSC_TRUE : PETSC_FALSE;
   /* a fixed body has no rigid state: its rigid options would be silently ignored */
   if (!b->floating) {
@@ -258,6 +270,7 @@ static PetscErrorCode FlexSetUp(PhlexPart part)
   PetscCall(SetUpLayout(part));
   b->frame.comm    = b->comm;
   b->frame.frozen  = b->frozen_inertia;
+  b->frame.gyroscopic = b->gyroscopic;
   b->frame.inertia = (PhlexInertia){0};
   if (b->floating) {
     b->frame.inertia = b->inertia;
@@ -299,8 +312,8 @@ static PetscErrorCode FlexView(PhlexPart part, PetscViewer viewer)
   PetscCall(PetscViewerASCIIPrintf(viewer, "volume %.6g m^3, mass %.6g kg, centre of mass (%.6g, %.6g, %.6g) m\n", (double)b->volume, (double)b->mass, (double)b->center_of_mass[0], (double)b->center_of_mass[1], (double)b->center_of_mass[2]));
   if (b->floating) {
     PetscReal q[4];
-    if (b->frame_condition == PHLEX_FRAME_PATCH) PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on patch %s (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", b->frame_patch, (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
-    else PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on mean axes (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->frozen_inertia ? "frozen (u_f = 0)" : "full"));
+    if (b->frame_condition == PHLEX_FRAME_PATCH) PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on patch %s (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", b->frame_patch, (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->inertia_model));
+    else PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on mean axes (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->inertia_model));
     PhlexRotationToQuaternion(b->pose.rotation, q);
     {
       PetscReal       v0[3], w0[3];

@@ -15,9 +15,27 @@
      p_r' + w x p_r + v_P x p_t = M_ext + s x R^T g
      p_f' - dT/du + G^T Sigma   = b_ext + t R^T g          (dT/du = int rho phi (V x w))
      u' = v,  Ms Sigma' = G v,  r' = R v_P,  R' = R [w]x
-   With -body0_inertia frozen every inertia term is evaluated at u = 0 (s = s0, E = E0, z = w, dT/du = 0): the
-   Hamiltonian of T0 = 1/2 int rho |v_P + w x x + v|^2 is quadratic and its Hamel J skew, so the implicit midpoint
-   rule conserves it to solver tolerance (the elastic field then feels no centrifugal or Coriolis load). */
+   Two models keep the mass operator at u = 0 (s = s0, E = E0, z = w): the Hamiltonian
+   H0 = 1/2 int rho |v_P + w x x + v|^2 + strain is quadratic, the interconnection skew, and the implicit midpoint rule
+   conserves H0 to solver tolerance.
+   - constant_without_gyroscopic: the Hamel equations of T0 alone. T0 does not depend on u, so the elastic field
+     feels the frame's accelerations (t v_P', w' x x) but no velocity-dependent load: no centrifugal, Coriolis or
+     transport (w x v_P) term.
+   - constant (the paper's constant-inertia model, Section 4 and eq. EB_J): the gyroscopic terms of J(e) of eq.
+     ph_mfd_all kept at u = 0, with the modified momenta of eq. mod_momenta and the operator of eq. mod_momentafl.
+     About the coefficient 2 there: in the full model it compensates -delta_u H = -p_f x w, the u-dependence of the
+     kinetic energy (the paper's remark after eq. mod_momentafl). With the mass operator at u = 0, delta_u H_kin = 0 and
+     nothing is left to compensate: the 2 would double the centrifugal and transport loads on the field. With
+     coefficient 1, I_pf = int {p_f + rho v_f} (.), the field gets (p_f + rho v) x w = rho (v_P + w x x + 2 v) x w:
+     the exact transport, centrifugal and Coriolis loads at the undeformed geometry (the exact equations with y = x);
+     J stays skew, so H0 is still conserved. What the coefficient 1 costs is in the frame's moment equation: the full
+     model at u = 0 has 2 int p_f x v there, this one int p_f x v, i.e. it misses int rho (v_P + w x x) x v, a term
+     of the elastic velocity times the rigid one. In Hamel form (what is implemented) the constant model is the
+     model without gyroscopic terms plus, power-neutral in total:
+       translation:  + w x int rho v                       (p~_t = p_t + int rho v, eq. mod_momenta)
+       rotation:     - int rho x x (v x w)                 (p~_r and the I_pf column, after the Jacobi identity)
+       field (node l): - (t_l v_P + w x w_l + 2 (Mv v)_l) x w   (-(I_pf)^* w)
+   (The author's beam code uses p_t instead of p~_t and int p_f without rho v_f: one Coriolis term fewer.) */
 #include <phlex_impl.h>
 
 /* ---------------------------------------------------------------------------------------------------------- */
@@ -183,6 +201,7 @@ PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, 
     Eps(K, f->L);
     Eps(Kd, f->Ld);
     Eps(Wv, f->Lx);
+    for (PetscInt k = 0; k < 9; k++) f->Wv[k] = Wv[k];
   }
   /* momenta and their rates */
   {
@@ -278,6 +297,13 @@ PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec
   for (PetscInt k = 0; k < 3; k++) Fq[15 + k] = f->prd[k] + a[k] + c[k] - f->Mext[k];
   PhlexCross(f->sgrav, f->gbody, a);
   for (PetscInt k = 0; k < 3; k++) Fq[15 + k] -= a[k];
+  if (fr->frozen && fr->gyroscopic) {
+    /* constant model: + w x int rho v (translation), + w tr(Wv) - Wv^T w = - int rho x x (v x w) (rotation) */
+    const PetscReal tr = f->Wv[0] + f->Wv[4] + f->Wv[8];
+    PhlexCross(f->w, f->Vf, a);
+    for (PetscInt k = 0; k < 3; k++) Fq[12 + k] += a[k];
+    for (PetscInt k = 0; k < 3; k++) Fq[15 + k] += f->w[k] * tr - (f->Wv[k] * f->w[0] + f->Wv[3 + k] * f->w[1] + f->Wv[6 + k] * f->w[2]);
+  }
 
   /* elastic rows: p_f' - Mv v' = t vP' + int rho phi (w' x y) + Mv (w x ud), minus dT/du, minus t R^T g */
   PhlexCross(f->vP, f->w, vxw);
@@ -321,6 +347,13 @@ PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec
       for (PetscInt k = 0; k < 3; k++) acc[k] += tmp[k] - tl * vxw[k] - tmp2[k];
       PhlexCross(Mv_l, f->w, tmp);
       for (PetscInt k = 0; k < 3; k++) acc[k] -= tmp[k];
+    } else if (fr->gyroscopic) {
+      /* constant model: - (t v_P + w x w_l + 2 Mv v) x w  (z = w_l: u = 0) */
+      PetscReal Mv_l[3];
+      for (PetscInt k = 0; k < 3; k++) Mv_l[k] = PetscRealPart(Mvva[3 * l + k]);
+      PhlexMatVec3(C, z, tmp2);
+      PhlexCross(Mv_l, f->w, tmp);
+      for (PetscInt k = 0; k < 3; k++) acc[k] -= tl * vxw[k] + tmp2[k] + 2.0 * tmp[k];
     }
     for (PetscInt k = 0; k < 3; k++) fa[3 * l + k] += acc[k];
   }
@@ -380,8 +413,9 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
   {
     PetscReal Sd[9];
     PhlexSkew(wd, Sd);
+    const PetscBool gyro = (PetscBool)(!full && fr->gyroscopic);
     for (PetscInt i = 0; i < 9; i++) {
-      Bvv[i] = full ? S[i] : 0.0;
+      Bvv[i] = full ? S[i] : (gyro ? 2.0 * S[i] : 0.0); /* constant model: -2 Mv v x w */
       Bvu[i] = full ? shift * S[i] + Sd[i] - C[i] : 0.0;
     }
   }
@@ -450,6 +484,17 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
         for (PetscInt a = 0; a < 3; a++) A(15 + a, 3 + 3 * i + j) += -g[i] * a3[a];
       }
   }
+  if (!full && fr->gyroscopic) {
+    /* constant model: d(w x Vf)/dw = -[Vf]x; d(w tr(Wv) - Wv^T w)/dw = tr(Wv) I - Wv^T */
+    PetscReal SVf[9];
+    const PetscReal tr = f->Wv[0] + f->Wv[4] + f->Wv[8];
+    PhlexSkew(f->Vf, SVf);
+    for (PetscInt a = 0; a < 3; a++)
+      for (PetscInt c = 0; c < 3; c++) {
+        A(12 + a, 15 + c) -= SVf[3 * a + c];
+        A(15 + a, 15 + c) += (a == c ? tr : 0.0) - f->Wv[3 * c + a];
+      }
+  }
 #undef A
 
   /* field borders, node by node */
@@ -485,7 +530,7 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
       ej[j] = 1.0;
       /* vP_j: shift t e_j - t (e_j x w) */
       PhlexCross(ej, w, a3);
-      for (PetscInt c = 0; c < 3; c++) col[c] = shift * tl * ej[c] - (full ? tl * a3[c] : 0.0);
+      for (PetscInt c = 0; c < 3; c++) col[c] = shift * tl * ej[c] - (full || fr->gyroscopic ? tl * a3[c] : 0.0);
       for (PetscInt c = 0; c < 3; c++) Bc[(12 + j) * ld + 3 * l + c] = col[c];
       /* w_a (a = j): shift e_a x z + [e_a x Mud - t vP x e_a - dC/dw_a z - Mv v x e_a] */
       PhlexCross(ej, z, col);
@@ -498,6 +543,15 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
         for (PetscInt c = 0; c < 3; c++) {
           const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
           col[c] += t1[c] - tl * t2[c] - dCz - t3[c];
+        }
+      } else if (fr->gyroscopic) {
+        /* constant model: - (t vP x e_a + dC/dw_a z + 2 Mv v x e_a) */
+        PetscReal t2[3], t3[3];
+        PhlexCross(vP, ej, t2);
+        PhlexCross(Mvl, ej, t3);
+        for (PetscInt c = 0; c < 3; c++) {
+          const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
+          col[c] += -tl * t2[c] - dCz - 2.0 * t3[c];
         }
       }
       for (PetscInt c = 0; c < 3; c++) Bc[(15 + j) * ld + 3 * l + c] = col[c];
@@ -521,6 +575,13 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
           PetscReal mdx[3];
           PhlexCross(zd, ee, mdx);
           for (PetscInt k = 0; k < 3; k++) Cv[(15 + k) * ld + colidx] += mdx[k];
+        } else if (fr->gyroscopic) {
+          /* constant model: translation + t (w x e_e); rotation + w z_e - e_e (z . w) (z = w_l) */
+          const PetscReal zw = PhlexDot3(z, w);
+          for (PetscInt k = 0; k < 3; k++) {
+            Cv[(12 + k) * ld + colidx] += tl * a3[k];
+            Cv[(15 + k) * ld + colidx] += w[k] * z[e] - ee[k] * zw;
+          }
         }
       }
       /* u: sgrav depends on u in both models: p_r row -t (e_e x R^T g) */
