@@ -43,7 +43,8 @@ struct _p_PhlexOutput {
 /* What to do with redundant constraint components found at set-up. */
 typedef enum {
   PHLEX_REDUNDANT_ERROR,
-  PHLEX_REDUNDANT_DROP
+  PHLEX_REDUNDANT_DROP,
+  PHLEX_REDUNDANT_KEEP
 } PhlexRedundantPolicy;
 PETSC_EXTERN const char *const PhlexRedundantPolicies[];
 

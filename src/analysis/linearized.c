@@ -100,7 +100,14 @@ static PetscErrorCode LinearizedEPSCreate(MPI_Comm comm, EPS *eps)
   PetscCall(KSPSetType(ksp, KSPPREONLY));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCCHOLESKY));
-  if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  if (PetscDefined(HAVE_MUMPS)) {
+    PetscBool set;
+    PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+    /* the saddle point's delayed pivots outgrow MUMPS's default workspace (INFOG(1) = -9 on the four-bar with 16
+       cells per link): 200 % more, unless given */
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-linearized_st_mat_mumps_icntl_14", &set));
+    if (!set) PetscCall(PetscOptionsSetValue(NULL, "-linearized_st_mat_mumps_icntl_14", "200"));
+  }
   PetscFunctionReturn(0);
 }
 

@@ -2,7 +2,7 @@
 #include <phlex_impl.h>
 
 const char *const PhlexAnalysisTypes[]     = {"transient", "modes", "linearized", "PhlexAnalysisType", "PHLEX_ANALYSIS_", NULL};
-const char *const PhlexRedundantPolicies[] = {"error", "drop", "PhlexRedundantPolicy", "PHLEX_REDUNDANT_", NULL};
+const char *const PhlexRedundantPolicies[] = {"error", "drop", "keep", "PhlexRedundantPolicy", "PHLEX_REDUNDANT_", NULL};
 
 /*@C
   PhlexSceneCreate - creates an empty scene
@@ -57,7 +57,7 @@ PetscErrorCode PhlexSceneFindPart(PhlexScene s, const char name[], PhlexPart *pa
 . -scale_density <kg/m^3>           - reference density (default: the largest density of the flexible bodies)
 . -scale_modulus <Pa>               - reference modulus (default: the largest Young's modulus)
 . -gravity gx,gy,gz                 - gravitational acceleration (inertial frame) [m/s^2]
-. -joints_redundant <error,drop>    - redundant constraint components found at set-up: an error, or dropped
+. -joints_redundant <error,drop,keep> - redundant constraint components found at set-up: an error, dropped, or kept
 . -assembly_tol <r>                 - tolerance of the position-level closure of the loops (relative to the reference length)
 - -joints_project_interval <n>      - project the positions back onto the joints every n steps (0: never)
 @*/
@@ -75,7 +75,7 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
   PetscCall(PetscOptionsReal("-scale_density", "Reference density [kg/m^3] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_density, &s->scale_density, NULL));
   PetscCall(PetscOptionsReal("-scale_modulus", "Reference modulus [Pa] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_modulus, &s->scale_modulus, NULL));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, s->comm, "scene", "", "-gravity", "Gravitational acceleration (inertial frame) acting on every body [m/s^2]", "PhlexSceneSetFromOptions", 3, s->gravity, NULL));
-  PetscCall(PetscOptionsEList("-joints_redundant", "Redundant constraint components found at set-up: error, or drop them", "PhlexSceneSetFromOptions", PhlexRedundantPolicies, 2, PhlexRedundantPolicies[policy], &policy, NULL));
+  PetscCall(PetscOptionsEList("-joints_redundant", "Redundant constraint components (for the rigid motion) found at set-up: error, drop them, or keep them (a flexible body on each such joint takes up the over-constraint)", "PhlexSceneSetFromOptions", PhlexRedundantPolicies, 3, PhlexRedundantPolicies[policy], &policy, NULL));
   PetscCall(PetscOptionsReal("-assembly_tol", "Position-level closure of the joints before the first step, relative to the reference length", "PhlexSceneSetFromOptions", s->assembly_tol, &s->assembly_tol, NULL));
   PetscCall(PetscOptionsInt("-assembly_max_it", "Newton iterations of the position-level closure", "PhlexSceneSetFromOptions", s->assembly_max_it, &s->assembly_max_it, NULL));
   PetscCall(PetscOptionsInt("-joints_project_interval", "Project the positions back onto the joints every n steps (0: never); the energy change is reported", "PhlexSceneSetFromOptions", s->project_interval, &s->project_interval, NULL));

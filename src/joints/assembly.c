@@ -61,7 +61,8 @@ static PetscErrorCode RigidGradient(PhlexSystem sys, PetscInt *nrows, PetscReal 
 /*@C
   PhlexAssemblyRedundancy - finds constraint components that depend on others (at the drawn configuration, for the
   rigid motion of the bodies' frames; a component that no frame motion can change is carried by elasticity and not
-  checked), reports them by joint and component, and drops them when -joints_redundant drop (the others stay)
+  checked), reports them by joint and component, and drops them when -joints_redundant drop (the others stay), or keeps
+  them when -joints_redundant keep (a flexible body on each such joint takes up the over-constraint)
 
   Collective
 
@@ -130,8 +131,18 @@ PetscErrorCode PhlexAssemblyRedundancy(PhlexSystem sys, Vec X, PetscInt *ndroppe
     PetscCall(PetscStrlcat(report, item, sizeof(report)));
     (*ndropped)++;
   }
+  if (*ndropped && sys->scene->redundant == PHLEX_REDUNDANT_KEEP) {
+    /* kept: the over-constraint goes into the elasticity of a flexible body on each such joint */
+    for (PetscInt i = 0; i < n; i++) {
+      PhlexJoint j = sys->joints[jidx[i]];
+      if (!redundant[i]) continue;
+      PetscCheck(j->side[0].part->nv || j->side[1].part->nv, sys->comm, PETSC_ERR_USER_INPUT, "joint %s: its component %s is redundant for the rigid motion and neither of its bodies is flexible: -joints_redundant keep needs a flexible body to take up the over-constraint (use drop)", j->name, j->rowname[ridx[i]]);
+    }
+    PetscCall(PetscPrintf(sys->comm, "Redundant constraints for the rigid motion kept (-joints_redundant keep; the flexible bodies take them up): %s\n", report));
+    *ndropped = 0;
+  }
   if (*ndropped) {
-    PetscCheck(sys->scene->redundant != PHLEX_REDUNDANT_ERROR, sys->comm, PETSC_ERR_USER_INPUT, "redundant constraints: %s depend on the other joints' constraints (for the bodies' rigid motion); remove them, use joints that constrain less (e.g. cylindrical or spherical instead of revolute), or drop them with -joints_redundant drop", report);
+    PetscCheck(sys->scene->redundant != PHLEX_REDUNDANT_ERROR, sys->comm, PETSC_ERR_USER_INPUT, "redundant constraints: %s depend on the other joints' constraints (for the bodies' rigid motion); remove them, use joints that constrain less (e.g. cylindrical or spherical instead of revolute), drop them with -joints_redundant drop, or keep them with -joints_redundant keep when a flexible body on each such joint takes them up", report);
     PetscCall(PetscPrintf(sys->comm, "Redundant constraints dropped (-joints_redundant drop): %s\n", report));
     /* drop from the last row of each joint backwards, so that the row indices stay valid */
     for (PetscInt i = n - 1; i >= 0; i--) {
