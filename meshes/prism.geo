@@ -1,22 +1,25 @@
-// phlex: a link of the four-bar mechanism (Kitis & Lindenberg 1990; the pH paper's case 1, cases.md section 1) as
-// a 3D solid: a straight prism along +x with a rectangular section h (in-plane, y) x b (out of plane, z) whose
-// area and in-plane second moment are the beam's: b h = A, b h^3 / 12 = I = (EI)/E, i.e. h = sqrt(12 I / A):
+// phlex: a straight prism along +x with a rectangular section h (y) x b (z), structured: the beams of the paper's
+// validation cases as 3D solids.
+// The four-bar's links (Kitis & Lindenberg 1990; the pH paper's case 1, cases.md section 1): the section has the
+// beam's area and in-plane second moment, b h = A, b h^3 / 12 = I = (EI)/E, i.e. h = sqrt(12 I / A):
 //   crank      L = 0.108,  A = 1.0774e-4 m^2, EI = 11.472 N m^2: h = 4.24221e-3 m, b = 2.53971e-2 m
 //   coupler    L = 0.2794, A = 4.0645e-5 m^2, EI = 0.616 N m^2:  h = 1.60047e-3 m, b = 2.53956e-2 m
 //   follower   L = 0.2705, the coupler's section
 // (E = 7.1e10 Pa). b comes out as the original 1 inch. With nu = 0 the width does not act on the in-plane bending
 // (no anticlastic coupling), so one element across b and across h suffices (quadratic velocity: the bending strain,
 // linear through the depth, is exact); the elements along the length set the accuracy.
+// The hinged spatial beam (case 3, cases.md section 3): L = 0.14142 m, h = b = 3 mm.
 //   x in [0, L], y in [-h/2, h/2], z in [-b/2, b/2]   (metres)
 //
 // Parameters: L, h, b and nx, the cells along the length (structured: nx x 1 x 1 boxes, each cut into 6 tetrahedra
-// by gmsh 4.8: 6 nx tetrahedra, 4 (nx + 1) vertices).
+// by gmsh 4.8: 6 nx tetrahedra, 4 (nx + 1) vertices). One cell across each side: with velocity P2 the bending
+// strain, linear through the section, is exact; the cells along the length set the accuracy.
 // Regenerate (see Makefile), e.g.
-//   gmsh fourbar_link.geo -3 -setnumber L 0.2794 -setnumber h 1.60047e-3 -setnumber b 2.53956e-2 -setnumber nx 8
+//   gmsh prism.geo -3 -setnumber L 0.2794 -setnumber h 1.60047e-3 -setnumber b 2.53956e-2 -setnumber nx 8
 //        -format msh41 -o fourbar_coupler_nx8.msh
 //
 // Physical groups:
-//   volume  "link" tag 1
+//   volume  "link" tag 1 (the name is kept for the four-bar meshes)
 //   surface "P"    tag 1   x = 0 (the start: the link's frame patch)
 //   surface "C"    tag 2   x = L (the end)
 SetFactory("OpenCASCADE");
@@ -31,7 +34,7 @@ Box(1) = {0, -h/2, -b/2, L, h, b};
 
 edges() = Curve In BoundingBox{-eps, -h/2-eps, -b/2-eps, L+eps, h/2+eps, b/2+eps};
 If (#edges() != 12)
-  Error("fourbar_link.geo: expected 12 edges, got %g", #edges());
+  Error("prism.geo: expected 12 edges, got %g", #edges());
   Abort;
 EndIf
 For i In {0:#edges()-1}
@@ -48,7 +51,7 @@ Transfinite Volume{1};
 start() = Surface In BoundingBox{-eps, -h/2-eps, -b/2-eps, eps, h/2+eps, b/2+eps};
 end()   = Surface In BoundingBox{L-eps, -h/2-eps, -b/2-eps, L+eps, h/2+eps, b/2+eps};
 If (#start() != 1 || #end() != 1)
-  Error("fourbar_link.geo: expected one face at each end, got %g, %g", #start(), #end());
+  Error("prism.geo: expected one face at each end, got %g, %g", #start(), #end());
   Abort;
 EndIf
 
