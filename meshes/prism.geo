@@ -9,6 +9,9 @@
 // (no anticlastic coupling), so one element across b and across h suffices (quadratic velocity: the bending strain,
 // linear through the depth, is exact); the elements along the length set the accuracy.
 // The hinged spatial beam (case 3, cases.md section 3): L = 0.14142 m, h = b = 3 mm.
+// The crank-slider's coupler (case 2, cases.md section 2): L = 0.3 m, the round rod's A = pi d^2/4 = 2.82743e-5 m^2
+// and I = pi d^4/64 = 6.36173e-11 m^4 (d = 6 mm): h = 5.19615e-3 m, b = 5.44140e-3 m, with mid = 1 (the midpoint
+// whose deflection the paper plots is the mean of the mid-section M).
 //   x in [0, L], y in [-h/2, h/2], z in [-b/2, b/2]   (metres)
 //
 // Parameters: L, h, b and nx, the cells along the length (structured: nx x 1 x 1 boxes, each cut into 6 tetrahedra
@@ -22,31 +25,43 @@
 //   volume  "link" tag 1 (the name is kept for the four-bar meshes)
 //   surface "P"    tag 1   x = 0 (the start: the link's frame patch)
 //   surface "C"    tag 2   x = L (the end)
+//   surface "M"    tag 3   x = L/2 (with mid = 1; interior, between the two halves)
 SetFactory("OpenCASCADE");
 
 DefineConstant[ L = {0.2794, Name "Parameters/L"} ];
 DefineConstant[ h = {1.60047e-3, Name "Parameters/h"} ];
 DefineConstant[ b = {2.53956e-2, Name "Parameters/b"} ];
 DefineConstant[ nx = {8, Name "Parameters/nx"} ];
+DefineConstant[ mid = {0, Name "Parameters/mid"} ];  // 1: cut at x = L/2, the mid-section a surface "M" (nx even)
 eps = 1e-3 * h;
 
-Box(1) = {0, -h/2, -b/2, L, h, b};
+If (mid)
+  If (nx % 2)
+    Error("prism.geo: mid = 1 needs an even nx, got %g", nx);
+    Abort;
+  EndIf
+  Box(1) = {0, -h/2, -b/2, L/2, h, b};
+  Box(2) = {L/2, -h/2, -b/2, L/2, h, b};
+  BooleanFragments{ Volume{1}; Delete; }{ Volume{2}; Delete; }
+  ncells = nx / 2;
+  lcut = L / 4;
+Else
+  Box(1) = {0, -h/2, -b/2, L, h, b};
+  ncells = nx;
+  lcut = L / 2;
+EndIf
 
 edges() = Curve In BoundingBox{-eps, -h/2-eps, -b/2-eps, L+eps, h/2+eps, b/2+eps};
-If (#edges() != 12)
-  Error("prism.geo: expected 12 edges, got %g", #edges());
-  Abort;
-EndIf
 For i In {0:#edges()-1}
   bb() = BoundingBox Curve{ edges(i) };
-  If (bb(3) - bb(0) > L/2)
-    Transfinite Curve{ edges(i) } = nx + 1;
+  If (bb(3) - bb(0) > lcut)
+    Transfinite Curve{ edges(i) } = ncells + 1;
   Else
     Transfinite Curve{ edges(i) } = 2;
   EndIf
 EndFor
 Transfinite Surface{:};
-Transfinite Volume{1};
+Transfinite Volume{:};
 
 start() = Surface In BoundingBox{-eps, -h/2-eps, -b/2-eps, eps, h/2+eps, b/2+eps};
 end()   = Surface In BoundingBox{L-eps, -h/2-eps, -b/2-eps, L+eps, h/2+eps, b/2+eps};
@@ -54,8 +69,16 @@ If (#start() != 1 || #end() != 1)
   Error("prism.geo: expected one face at each end, got %g, %g", #start(), #end());
   Abort;
 EndIf
+If (mid)
+  middle() = Surface In BoundingBox{L/2-eps, -h/2-eps, -b/2-eps, L/2+eps, h/2+eps, b/2+eps};
+  If (#middle() != 1)
+    Error("prism.geo: expected one face at mid-length, got %g", #middle());
+    Abort;
+  EndIf
+  Physical Surface("M", 3) = {middle()};
+EndIf
 
-Physical Volume("link", 1) = {1};
+Physical Volume("link", 1) = {Volume{:}};
 Physical Surface("P", 1) = {start()};
 Physical Surface("C", 2) = {end()};
 
