@@ -27,7 +27,7 @@ BIN       := bin/phlex
 # The dependency probe: PETSc, SLEPc and gmsh present means nothing has to be installed.
 HAVE_DEPS = $(shell pkg-config --exists $(PKGS) 2>/dev/null && command -v gmsh >/dev/null 2>&1 && command -v $(MPIEXEC) >/dev/null 2>&1 && echo yes)
 
-.PHONY: all run check check-update deps deps-if-missing meshes format clean print bench memcheck
+.PHONY: all run check check-update deps deps-if-missing meshes format clean print bench memcheck validate
 
 all: $(BIN)
 
@@ -63,6 +63,10 @@ meshes:
 
 memcheck: $(BIN)
 	tests/memcheck.sh
+
+validate: deps-if-missing
+	@$(MAKE) --no-print-directory $(BIN)
+	python3 tools/validate.py $(VALIDATE_ARGS)
 
 bench: $(BIN)
 	@$(MAKE) --no-print-directory -C bench

@@ -1,0 +1,260 @@
+#!/usr/bin/env python3
+"""make validate: the pH paper's three cases at full size against their reference curves (cases.md).
+
+Runs bin/phlex on options/fourbar.yaml, options/crankslider.yaml and options/hinged_beam.yaml (several meshes,
+both inertia models where the issue asks for them), checks each metric with the tools that the regression tests use
+(tools/compare_fourbar.py, tools/crankslider_midpoint.py, tools/check_hinged_beam.py), and writes under validation/:
+  <case>_*.csv                   the computed curves beside the references
+  <case>.png                     plots of them (matplotlib; skipped with a note when it is missing)
+  summary.csv, summary.md        case, metric, tolerance, value, pass/fail, and the wall time of each run
+  runs/<run>/                    each run's own output directory (energy.csv, ports, joints, ...)
+Exit status 1 if a checked metric fails. Usage: python3 tools/validate.py [--out validation] [--quick]
+(--quick: the coarse meshes only, about a minute).
+"""
+import argparse
+import csv
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+REF = os.path.join(ROOT, "validation", "reference")
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+
+
+def run(name, args, out):
+    """one phlex run into out/runs/name; returns (output dir, wall seconds)"""
+    d = os.path.join(out, "runs", name)
+    if os.path.isdir(d):
+        shutil.rmtree(d)
+    cmd = [os.path.join(ROOT, "bin", "phlex")] + args + ["-output_dir", d, "-output_fields", "0", "-progress", "0"]
+    t0 = time.time()
+    p = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True)
+    wall = time.time() - t0
+    with open(os.path.join(out, "runs", name + ".log"), "w") as f:
+        f.write("$ " + " ".join(cmd) + "\n" + p.stdout + p.stderr)
+    if p.returncode:
+        sys.exit("validate: run %s failed (exit %d); see %s.log:\n%s" % (name, p.returncode, os.path.join(out, "runs", name), p.stderr[-2000:]))
+    print("  %-28s %7.1f s" % (name, wall), flush=True)
+    return d, wall
+
+
+def check(tool, args):
+    """a checker's lines (metric: ... PASS/FAIL) and its exit status"""
+    p = subprocess.run([sys.executable, os.path.join(ROOT, "tools", tool)] + args, cwd=ROOT, capture_output=True, text=True)
+    return [l for l in p.stdout.splitlines() if l.strip()], p.returncode
+
+
+class Summary:
+    def __init__(self):
+        self.rows, self.failed = [], False
+
+    def add(self, case, run_name, line, checked=True):
+        m = re.search(r"(PASS|FAIL)\s*$", line)
+        status = m.group(1) if (m and checked) else "info"
+        if status == "FAIL":
+            self.failed = True
+        text = re.sub(r":\s*(PASS|FAIL)\s*$", "", line)
+        tol = re.search(r"tolerance ([^),]+)", text)
+        self.rows.append([case, run_name, text, tol.group(1) if tol else "", status])
+
+    def write(self, out, walls):
+        with open(os.path.join(out, "summary.csv"), "w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["case", "run", "metric and value", "tolerance", "status"])
+            w.writerows(self.rows)
+        with open(os.path.join(out, "summary.md"), "w") as f:
+            f.write("# Validation summary (make validate)\n\n| case | run | metric and value | tolerance | status |\n|---|---|---|---|---|\n")
+            for r in self.rows:
+                f.write("| " + " | ".join(x.replace("|", "/") for x in r) + " |\n")
+            f.write("\n| run | wall time [s] |\n|---|---|\n")
+            for k, v in walls:
+                f.write("| %s | %.1f |\n" % (k, v))
+
+
+def have_matplotlib(python):
+    return subprocess.run([python, "-c", "import matplotlib"], capture_output=True).returncode == 0
+
+
+def read_csv(path):
+    with open(path, newline="") as f:
+        return list(csv.DictReader(f))
+
+
+def fourbar(out, S, walls, quick):
+    print("four-bar (linearised sweep, 0-360 deg every 5 deg)")
+    meshes = [8] if quick else [8, 16, 32]
+    sweeps = {}
+    for nx in meshes:
+        args = ["-options_file", "options/fourbar.yaml", "-linearized_sweep_range", "0,360,5"]
+        for k, l in enumerate(["crank", "coupler", "follower"]):
+            args += ["-body%d_dm_plex_filename" % k, "meshes/fourbar_%s_nx%d.msh" % (l, nx)]
+        d, w = run("fourbar_nx%d" % nx, args, out)
+        walls.append(("fourbar_nx%d (73 configurations)" % nx, w))
+        shutil.copy(os.path.join(d, "linearized_sweep.csv"), os.path.join(out, "fourbar_sweep_nx%d.csv" % nx))
+        sweeps[nx] = read_csv(os.path.join(d, "linearized_sweep.csv"))
+        lines, _ = check("compare_fourbar.py", [os.path.join(d, "linearized_sweep.csv"), os.path.join(REF, "fourbar_frequencies_fe_check.csv"), "--rtol", "0.01", "--label", "vs converged beam FE, nu = 0,"])
+        for l in lines:
+            S.add("four-bar", "%d cells per link" % nx, l)
+    best = max(meshes)
+    d = os.path.join(out, "runs", "fourbar_nx%d" % best)
+    for ref, label in [("fourbar_frequencies.csv", "vs TITOP (figure data),"), ("fourbar_frequencies_phpaper.csv", "vs the pH paper's curve (3 elements per link),")]:
+        lines, _ = check("compare_fourbar.py", [os.path.join(d, "linearized_sweep.csv"), os.path.join(REF, ref), "--rtol", "0.01", "--label", label])
+        for l in lines:
+            S.add("four-bar", "%d cells per link" % best, l, checked=False)
+    if not quick:
+        args = ["-options_file", "options/fourbar.yaml", "-linearized_sweep_range", "0,360,5"]
+        for k, l in enumerate(["crank", "coupler", "follower"]):
+            args += ["-body%d_dm_plex_filename" % k, "meshes/fourbar_%s_nx16.msh" % l, "-body%d_poissons_ratio" % k, "0.33"]
+        d, w = run("fourbar_nx16_nu0.33", args, out)
+        walls.append(("fourbar_nx16_nu0.33", w))
+        shutil.copy(os.path.join(d, "linearized_sweep.csv"), os.path.join(out, "fourbar_sweep_nx16_nu0.33.csv"))
+        sweeps["nu"] = read_csv(os.path.join(d, "linearized_sweep.csv"))
+        lines, _ = check("compare_fourbar.py", [os.path.join(d, "linearized_sweep.csv"), os.path.join(REF, "fourbar_frequencies_fe_check.csv"), "--rtol", "0.01", "--label", "nu = 0.33 vs the beam (no Poisson effect),"])
+        for l in lines:
+            S.add("four-bar", "16 cells, nu = 0.33", l, checked=False)
+
+
+def crankslider(out, S, walls, quick):
+    print("crank-slider (transient, 8 rad of crank angle)")
+    runs = [("full", 16, "2e-5"), ("constant", 16, "2e-5")]
+    if not quick:
+        runs += [("full", 8, "2e-5"), ("full", 32, "2e-5"), ("full", 16, "4e-5"), ("full", 16, "1e-5")]
+    curves = {}
+    for model, nx, dt in runs:
+        name = "crankslider_%s_nx%d_dt%s" % (model, nx, dt)
+        d, w = run(name, ["-options_file", "options/crankslider.yaml", "-body1_inertia", model, "-body1_dm_plex_filename", "meshes/crankslider_coupler_nx%d.msh" % nx, "-ts_dt", dt], out)
+        walls.append((name + " (0.0533 s simulated)", w))
+        csvout = os.path.join(out, name + ".csv")
+        lines, _ = check("crankslider_midpoint.py", [d, "--out", csvout])
+        main = (model, nx, dt) in [("full", 16, "2e-5"), ("constant", 16, "2e-5")]
+        for l in lines:
+            S.add("crank-slider", "%s inertia, %d cells, dt %s" % (model, nx, dt), l, checked=main and "u_x" not in l)
+        curves[(model, nx, dt)] = read_csv(csvout)
+
+
+def hinged(out, S, walls, quick):
+    print("hinged spatial beam (transient, 50 s)")
+    runs = [("full", 8), ("constant", 8)] + ([] if quick else [("full", 16)])
+    series = {}
+    for model, nx in runs:
+        name = "hinged_beam_%s_nx%d" % (model, nx)
+        d, w = run(name, ["-options_file", "options/hinged_beam.yaml", "-body0_inertia", model, "-body0_dm_plex_filename", "meshes/hinged_beam_nx%d.msh" % nx], out)
+        walls.append((name + " (50 s simulated)", w))
+        csvout = os.path.join(out, name + ".csv")
+        lines, _ = check("check_hinged_beam.py", [d, "--out", csvout])
+        for l in lines:
+            checked = model == "full" and nx == 8 and "information" not in l
+            S.add("hinged beam", "%s inertia, %d cells" % (model, nx), l, checked=checked)
+        series[(model, nx)] = read_csv(csvout)
+
+
+def plots(out):
+    """the PNGs, from the CSV files of a validation run (needs matplotlib)"""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    if os.path.exists(os.path.join(out, "fourbar_sweep_nx32.csv")) or os.path.exists(os.path.join(out, "fourbar_sweep_nx8.csv")):
+        best = 32 if os.path.exists(os.path.join(out, "fourbar_sweep_nx32.csv")) else 8
+        sweeps = {best: read_csv(os.path.join(out, "fourbar_sweep_nx%d.csv" % best))}
+        if os.path.exists(os.path.join(out, "fourbar_sweep_nx16_nu0.33.csv")):
+            sweeps["nu"] = read_csv(os.path.join(out, "fourbar_sweep_nx16_nu0.33.csv"))
+        ref = read_csv(os.path.join(REF, "fourbar_frequencies_fe_check.csv"))
+        titop = read_csv(os.path.join(REF, "fourbar_frequencies.csv"))
+
+        fig, ax = plt.subplots(figsize=(8, 5))
+        for k, c in zip(range(1, 4), ["C0", "C1", "C2"]):
+            ax.plot([float(r["theta1_deg"]) for r in ref], [float(r["f%d" % k]) for r in ref], "-", color=c, lw=3, alpha=0.35, label="beam FE (converged)" if k == 1 else None)
+            ax.plot([float(r["theta1_deg"]) for r in titop], [float(r["f%d" % k]) for r in titop], "x", color=c, ms=4, label="TITOP (paper figure)" if k == 1 else None)
+            s = sweeps[best]
+            ax.plot([float(r["position"]) for r in s], [float(r["omega%d_rad_s" % k]) for r in s], ".", color=c, label="phlex, %d cells per link" % best if k == 1 else None)
+            if "nu" in sweeps:
+                s = sweeps["nu"]
+                ax.plot([float(r["position"]) for r in s], [float(r["omega%d_rad_s" % k]) for r in s], ":", color=c, label="phlex, nu = 0.33" if k == 1 else None)
+        ax.set_xlabel("crank angle theta1 [deg]")
+        ax.set_ylabel("pulsation [rad/s]")
+        ax.set_title("Four-bar, crank clamped: the three lowest pulsations")
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "fourbar.png"), dpi=120)
+        plt.close(fig)
+
+    if os.path.exists(os.path.join(out, "crankslider_full_nx16_dt2e-5.csv")):
+        curves = {k: read_csv(os.path.join(out, "crankslider_%s_nx16_dt2e-5.csv" % k[0])) for k in [("full", 16, "2e-5"), ("constant", 16, "2e-5")]}
+        ffrf = read_csv(os.path.join(REF, "crankslider_midpoint_ffrf_check.csv"))
+        paper = read_csv(os.path.join(REF, "crankslider_midpoint_uy_phpaper.csv"))
+
+        fig, ax = plt.subplots(figsize=(9, 4.5))
+        ax.plot([float(r["crank_angle_rad"]) for r in ffrf], [float(r["uy_over_L"]) for r in ffrf], "-", color="0.6", lw=3, label="FFRF check (converged, full inertia)")
+        ax.plot([float(r["crank_angle_rad"]) for r in paper], [float(r["uy_over_L"]) for r in paper], "--", color="k", lw=1, label="pH paper")
+        for key, c in [(("full", 16, "2e-5"), "C0"), (("constant", 16, "2e-5"), "C3")]:
+            s = curves[key]
+            ax.plot([float(r["crank_angle_rad"]) for r in s], [float(r["uy_over_L"]) for r in s], "-", color=c, lw=1, label="phlex, %s inertia" % key[0])
+        ax.set_xlabel("crank angle [rad]")
+        ax.set_ylabel("u_y / L at the coupler's midpoint")
+        ax.set_title("Rotating crank-slider: midpoint deflection relative to the chord")
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "crankslider.png"), dpi=120)
+        plt.close(fig)
+
+    if os.path.exists(os.path.join(out, "hinged_beam_full_nx8.csv")):
+        series = {k: read_csv(os.path.join(out, "hinged_beam_%s_nx8.csv" % k[0])) for k in [("full", 8), ("constant", 8)]}
+        Hp = read_csv(os.path.join(REF, "hinged_beam_energy_phpaper.csv"))
+        Wp = read_csv(os.path.join(REF, "hinged_beam_omega_z_phpaper.csv"))
+
+        fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
+        a1.plot([float(r["time_s"]) for r in Hp], [float(r["H_code_units"]) for r in Hp], "-", color="0.6", lw=3, label="pH paper")
+        a2.plot([float(r["time_s"]) for r in Wp], [float(r["omega_z_rad_s"]) for r in Wp], "-", color="0.6", lw=2, label="pH paper (sampled every 0.1 s)")
+        for key, c in [(("full", 8), "C0"), (("constant", 8), "C3")]:
+            s = series[key]
+            t = [float(r["time_s"]) for r in s]
+            a1.plot(t, [float(r["H_code_units"]) for r in s], "-", color=c, lw=1, label="phlex, %s inertia" % key[0])
+            a2.plot(t, [float(r["omega_z_rad_s"]) for r in s], "-", color=c, lw=0.6, label="phlex, %s inertia" % key[0])
+        a1.set_ylabel("H [code units = 1e-9 J]")
+        a2.set_ylabel("inertial omega_z [rad/s]")
+        a2.set_xlabel("time [s]")
+        a2.set_ylim(-0.15, 0.2)
+        a1.set_title("Hinged spatial beam: energy and vertical angular velocity")
+        for a in (a1, a2):
+            a.grid(alpha=0.3)
+            a.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "hinged_beam.png"), dpi=120)
+        plt.close(fig)
+
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--out", default=os.path.join(ROOT, "validation"))
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--cases", default="fourbar,crankslider,hinged")
+    ap.add_argument("--plots-only", action="store_true", help="only redraw the PNGs from the CSV files in --out")
+    a = ap.parse_args()
+    if a.plots_only:
+        plots(a.out)
+        return
+    os.makedirs(os.path.join(a.out, "runs"), exist_ok=True)
+    S, walls = Summary(), []
+    t0 = time.time()
+    for c in a.cases.split(","):
+        {"fourbar": fourbar, "crankslider": crankslider, "hinged": hinged}[c](a.out, S, walls, a.quick)
+    S.write(a.out, walls)
+    # the plots: this interpreter's matplotlib, else the system Python's (a pyenv shim may hide python3-matplotlib)
+    python = next((p for p in [sys.executable, "/usr/bin/python3"] if os.path.exists(p) and have_matplotlib(p)), None)
+    if python:
+        subprocess.run([python, os.path.abspath(__file__), "--plots-only", "--out", a.out], check=True)
+    else:
+        print("validate: matplotlib is missing (python3-matplotlib): no PNG written")
+    print("validation: %d checked metrics, %d failed, %.0f s; %s" % (sum(1 for r in S.rows if r[4] != "info"), sum(1 for r in S.rows if r[4] == "FAIL"), time.time() - t0, os.path.join(os.path.relpath(a.out, ROOT), "summary.md")))
+    sys.exit(1 if S.failed else 0)
+
+
+if __name__ == "__main__":
+    main()
