@@ -104,6 +104,7 @@ PETSC_INTERN PetscErrorCode PhlexFieldWriterBeginStep(PhlexFieldWriter, PetscRea
 PETSC_INTERN PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter, const char[], Vec, PetscReal, const PetscReal *, const PetscReal *, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterVertexMax(PhlexFieldWriter, Vec, PetscReal, const PetscReal *, const PetscReal *, PetscBool, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterStress(PhlexFieldWriter, Vec, PetscReal);
+PETSC_INTERN PetscErrorCode PhlexFieldWriterSetOutputRotation(PhlexFieldWriter, const PetscReal[9]);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterSetGeometryField(PhlexFieldWriter, const char[]);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *);
 

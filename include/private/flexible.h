@@ -244,7 +244,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleInitialState(PhlexPart, PhlexPartVec *)
 
 /* flexible_modes.c */
 PETSC_INTERN PetscErrorCode PhlexFlexibleComputeModes(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
-PETSC_INTERN PetscErrorCode PhlexFlexibleModesOutput(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleModesOutput(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *, const PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleRefine(PhlexPart, PetscInt, PhlexPart *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleModesOrder(PhlexPart, char[], size_t);
 PETSC_INTERN PetscErrorCode PhlexFlexibleModesKind(PhlexPart, char[], size_t, PetscInt *);

@@ -107,7 +107,7 @@ typedef struct {
   PetscErrorCode (*outputstep)(PhlexPart, PetscInt, PetscReal, const PhlexPartVec *, PetscBool); /* series rows (step >= 0), fields if asked */
   PetscErrorCode (*outputclose)(PhlexPart);
   PetscErrorCode (*modes)(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
-  PetscErrorCode (*modesoutput)(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *);
+  PetscErrorCode (*modesoutput)(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *, const PetscReal *); /* ..., placement: r_P (non-dimensional) and R of a floating body in an assembly, or NULL (body frame) */
   PetscErrorCode (*refine)(PhlexPart, PetscInt, PhlexPart *); /* the same part on a finer discretisation */
   PetscErrorCode (*modesorder)(PhlexPart, char[], size_t);      /* its discretisation and the order of its eigenvalues under refinement */
   PetscErrorCode (*modeskind)(PhlexPart, char[], size_t, PetscInt *); /* "free", "clamped", ...; how many rigid-body modes it has (-1: none counted) */

@@ -635,16 +635,32 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
 }
 
 /* mode shapes of every flexible body at one configuration: <body>_modes.h5/.xmf (the whole velocity, frame motion
-   included, normalised to 1) */
+   included, normalised to 1), each body placed where it sits and its shapes in inertial components */
 static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
 {
   PhlexSystem sys = p->sys;
-  PetscReal  *qv, *rigid, *lambda;
+  PetscReal  *qv, *rigid, *lambda, *scale;
   Vec        *vecs;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc4(PetscMax(p->nQ, 1), &qv, 6 * s->n, &rigid, s->n, &lambda, s->n, &vecs));
+  PetscCall(PhlexSystemGather(sys, p->X, sys->q)); /* the configuration (placements) */
   for (PetscInt i = 0; i < s->n; i++) lambda[i] = s->theta[i];
+  /* one scale per mode for the whole assembly: its largest nodal field or frame velocity is 1 (so the bodies' shapes
+     meet at the joints) */
+  PetscCall(PetscMalloc1(s->n, &scale));
+  for (PetscInt i = 0; i < s->n; i++) {
+    Vec       xV, xQ;
+    PetscReal m = 0;
+    PetscCall(VecGetSubVector(s->x[i], p->isV, &xV));
+    PetscCall(VecNorm(xV, NORM_INFINITY, &m));
+    PetscCall(VecRestoreSubVector(s->x[i], p->isV, &xV));
+    PetscCall(VecGetSubVector(s->x[i], p->isQ, &xQ));
+    PetscCall(RootValues(sys->comm, xQ, p->nQ, qv));
+    PetscCall(VecRestoreSubVector(s->x[i], p->isQ, &xQ));
+    for (PetscInt k = 0; k < p->nqv; k++) m = PetscMax(m, PetscAbsReal(qv[k]));
+    scale[i] = m > 0 ? 1.0 / m : 1.0;
+  }
   for (PetscInt f = 0; f < sys->nfparts; f++) {
     PhlexPart part = sys->fparts[f];
     if (!part->ops.modesoutput) continue;
@@ -654,6 +670,7 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
       PetscCall(VecGetSubVector(xV, sys->fis[PHLEX_FIELD_VELOCITY][f], &xi));
       PetscCall(VecDuplicate(xi, &vecs[i]));
       PetscCall(VecCopy(xi, vecs[i]));
+      PetscCall(VecScale(vecs[i], scale[i]));
       PetscCall(VecRestoreSubVector(xV, sys->fis[PHLEX_FIELD_VELOCITY][f], &xi));
       PetscCall(VecRestoreSubVector(s->x[i], p->isV, &xV));
       PetscCall(VecGetSubVector(s->x[i], p->isQ, &xQ));
@@ -661,14 +678,24 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
       PetscCall(VecRestoreSubVector(s->x[i], p->isQ, &xQ));
       for (PetscInt c = 0; c < 6; c++) rigid[6 * i + c] = 0.0;
       for (PetscInt c = 0; c < 3; c++) {
-        if (part->frame.v >= 0) rigid[6 * i + c] = qv[p->qmap[part->qoff + part->frame.v + c]];
-        if (part->frame.w >= 0) rigid[6 * i + 3 + c] = qv[p->qmap[part->qoff + part->frame.w + c]];
+        if (part->frame.v >= 0) rigid[6 * i + c] = scale[i] * qv[p->qmap[part->qoff + part->frame.v + c]];
+        if (part->frame.w >= 0) rigid[6 * i + 3 + c] = scale[i] * qv[p->qmap[part->qoff + part->frame.w + c]];
       }
     }
-    PetscCall((*part->ops.modesoutput)(part, out, s->n, s->nmech, lambda, vecs, rigid));
+    {
+      /* where the body sits in this configuration: its frame's r_P and R */
+      PetscReal place[12], *pl = NULL;
+      if (part->frame.r >= 0 && part->frame.R >= 0) {
+        for (PetscInt k = 0; k < 3; k++) place[k] = sys->q[part->qoff + part->frame.r + k];
+        for (PetscInt k = 0; k < 9; k++) place[3 + k] = sys->q[part->qoff + part->frame.R + k];
+        pl = place;
+      }
+      PetscCall((*part->ops.modesoutput)(part, out, s->n, s->nmech, lambda, vecs, rigid, pl));
+    }
     for (PetscInt i = 0; i < s->n; i++) PetscCall(VecDestroy(&vecs[i]));
   }
   PetscCall(PetscFree4(qv, rigid, lambda, vecs));
+  PetscCall(PetscFree(scale));
   PetscFunctionReturn(0);
 }
 

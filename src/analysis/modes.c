@@ -184,7 +184,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
       const PetscReal lam = lambda[i] / PetscSqr(scene->units.time);
       PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d,%s\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0, part->name));
     }
-    if (scene->output->fields && part->ops.modesoutput) PetscCall((*part->ops.modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid));
+    if (scene->output->fields && part->ops.modesoutput) PetscCall((*part->ops.modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid, NULL));
     if (o.nrefine > 0) PetscCall(ConvergenceStudy(scene, part, o.nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid, o.order_expect, o.order_tol));
     if (nexp) {
       nfexp = nconv - nrigid;

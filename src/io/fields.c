@@ -17,6 +17,8 @@ struct _p_PhlexFieldWriter {
   char        vfields[8][PHLEX_NAME_LEN], cfields[8][PHLEX_NAME_LEN];
   PetscInt    cfield_nc[8];
   char        geometry_field[PHLEX_NAME_LEN];   /* vertex field holding time-dependent coordinates, or "" */
+  PetscBool   rotate_out;                       /* vertex fields are turned by Rout after composing (inertial components) */
+  PetscReal   Rout[9];
 };
 
 static PetscErrorCode CreateOutputDM(DM dm, PetscInt degree, PetscInt nc, const char name[], DM *odm)
@@ -170,6 +172,11 @@ static PetscErrorCode VertexValues(PhlexFieldWriter w, Vec v, PetscReal scale, c
       }
       for (PetscInt c = 0; c < 3; c++) lo[oo + c] = r[c] + A[3 * c] * x[0] + A[3 * c + 1] * x[1] + A[3 * c + 2] * x[2] + (rotate ? 0.0 : f[c]);
     }
+    if (w->rotate_out) {
+      PetscReal f[3];
+      for (PetscInt c = 0; c < 3; c++) f[c] = PetscRealPart(lo[oo + c]);
+      for (PetscInt c = 0; c < 3; c++) lo[oo + c] = w->Rout[3 * c] * f[0] + w->Rout[3 * c + 1] * f[1] + w->Rout[3 * c + 2] * f[2];
+    }
   }
   PetscCall(VecRestoreArrayRead(coords, &xc));
   PetscCall(VecRestoreArrayRead(w->lv, &lv));
@@ -305,6 +312,20 @@ PetscErrorCode PhlexFieldWriterStress(PhlexFieldWriter w, Vec stress, PetscReal 
   PetscCall(RegisterField(w, PETSC_FALSE, "stress", 6));
   PetscCall(RegisterField(w, PETSC_FALSE, "von_mises", 1));
   PetscCall(PetscLogEventEnd(PHLEX_Output, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterSetOutputRotation - turns every vertex field written from now on by R (row-major; body to inertial
+  components), or stops doing so (R NULL)
+
+  Not collective
+@*/
+PetscErrorCode PhlexFieldWriterSetOutputRotation(PhlexFieldWriter w, const PetscReal R[9])
+{
+  PetscFunctionBeginUser;
+  w->rotate_out = R ? PETSC_TRUE : PETSC_FALSE;
+  for (PetscInt k = 0; k < 9 && R; k++) w->Rout[k] = R[k];
   PetscFunctionReturn(0);
 }
 

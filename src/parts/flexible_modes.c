@@ -292,19 +292,32 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   floating body's include the rigid part v_P + w x (x - P), so that the frame patch moves rigidly)
 
   Collective
+
+  Notes:
+  With a placement (r_P non-dimensional, R row-wise: a floating body of an assembly, linearised analysis), the mesh is
+  written where the body sits, r_P + R (x - P) (the field inertial_position, the XDMF geometry), and the mode shapes
+  in inertial components, scaled as given (the caller normalises the whole assembly alike): the bodies of a mechanism
+  then appear assembled in ParaView and warp consistently.
 @*/
-PetscErrorCode PhlexFlexibleModesOutput(PhlexPart part, PhlexOutput out, PetscInt nconv, PetscInt nrigid, const PetscReal *lambda, Vec *vecs, const PetscReal *rigid)
+PetscErrorCode PhlexFlexibleModesOutput(PhlexPart part, PhlexOutput out, PetscInt nconv, PetscInt nrigid, const PetscReal *lambda, Vec *vecs, const PetscReal *rigid, const PetscReal *placement)
 {
   PhlexFlexible     b = (PhlexFlexible)part->data;
   const PhlexUnits *un = part->units;
   PhlexFieldWriter  fw;
   char              name[PHLEX_NAME_LEN + 8];
+  PetscReal         rp[3];
 
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_modes", b->name));
   PetscCall(PhlexFieldWriterCreate(out, b, name, &fw));
+  if (placement) {
+    PetscReal RP[3];
+    PhlexMatVec3(&placement[3], b->origin, RP);
+    for (PetscInt k = 0; k < 3; k++) rp[k] = placement[k] * un->length - RP[k];
+    PetscCall(PhlexFieldWriterSetGeometryField(fw, "inertial_position"));
+  }
   for (PetscInt i = 0; i < nconv; i++) {
-    PetscReal vmax, A[9] = {0}, r[3] = {0}, *Ap = NULL, *rp = NULL;
+    PetscReal vmax, A[9] = {0}, r[3] = {0}, *Ap = NULL, *rp0 = NULL;
     if (b->floating) {
       /* the whole velocity field v_P + w x (x - P) + v */
       const PetscReal *q = &rigid[6 * i];
@@ -313,15 +326,22 @@ PetscErrorCode PhlexFlexibleModesOutput(PhlexPart part, PhlexOutput out, PetscIn
       for (PetscInt k = 0; k < 9; k++) A[k] /= un->length;
       PhlexMatVec3(A, b->origin, wP);
       for (PetscInt k = 0; k < 3; k++) r[k] = q[k] - wP[k];
-      Ap = A, rp = r;
+      Ap = A, rp0 = r;
     }
-    PetscCall(PhlexFieldWriterVertexMax(fw, vecs[i], 1.0, Ap, rp, PETSC_FALSE, &vmax));
+    /* one body: largest vertex value 1; in an assembly the caller scales all bodies alike (continuous at the joints) */
+    if (placement) vmax = 1.0;
+    else PetscCall(PhlexFieldWriterVertexMax(fw, vecs[i], 1.0, Ap, rp0, PETSC_FALSE, &vmax));
     if (vmax > 0) {
       for (PetscInt k = 0; k < 9; k++) A[k] /= vmax;
       for (PetscInt k = 0; k < 3; k++) r[k] /= vmax;
     }
     PetscCall(PhlexFieldWriterBeginStep(fw, (PetscReal)(i + 1)));
-    PetscCall(PhlexFieldWriterVertexField(fw, "mode_shape", vecs[i], vmax > 0 ? 1.0 / vmax : 1.0, Ap, rp, PETSC_FALSE));
+    if (placement) PetscCall(PhlexFieldWriterSetOutputRotation(fw, &placement[3]));
+    PetscCall(PhlexFieldWriterVertexField(fw, "mode_shape", vecs[i], vmax > 0 ? 1.0 / vmax : 1.0, Ap, rp0, PETSC_FALSE));
+    if (placement) {
+      PetscCall(PhlexFieldWriterSetOutputRotation(fw, NULL));
+      PetscCall(PhlexFieldWriterVertexField(fw, "inertial_position", NULL, un->length, &placement[3], rp, PETSC_TRUE));
+    }
   }
   PetscCall(PhlexFieldWriterDestroy(&fw));
   PetscFunctionReturn(0);
