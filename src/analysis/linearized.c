@@ -605,31 +605,51 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
   PetscCall(EPSSetOperators(eps, p->A, p->B));
   want = nev + nmech;
   PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
-  /* a target just below zero: the saddle point is singular at 0 when the mechanism moves */
-  PetscCall(EPSSetTarget(eps, nmech ? -1e-6 : 0.0));
+  /* a target just below zero: the saddle point is singular at 0 when the mechanism moves (unless one is given) */
+  {
+    PetscBool given;
+    PetscCall(PetscOptionsHasName(NULL, "linearized_", "-eps_target", &given));
+    if (!given) PetscCall(EPSSetTarget(eps, nmech ? -1e-6 : 0.0));
+  }
   PetscCall(EPSSolve(eps));
   PetscCall(EPSGetConverged(eps, &nconv));
   PetscCheck(nconv >= want, p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: the eigensolver converged %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs wanted (%" PetscInt_FMT " mechanism modes + -linearized_nev %" PetscInt_FMT "); see -linearized_eps_monitor, -linearized_eps_ncv", nconv, want, nmech, nev);
   s->n = want;
   PetscCall(PetscMalloc2(want, &s->theta, want, &s->resid));
   if (vectors) PetscCall(PetscCalloc1(want, &s->x));
-  PetscCall(MatCreateVecs(p->A, &x, NULL));
-  for (PetscInt i = 0; i < want; i++) {
-    PetscScalar kr, ki;
-    PetscCall(EPSGetEigenpair(eps, i, &kr, &ki, x, NULL));
-    s->theta[i] = PetscRealPart(kr);
-    /* a zero eigenvalue: the relative residual divides by it; the backward error instead */
-    if (PetscAbsReal(s->theta[i]) < 1e-8) {
-      nzero++;
-      PetscCall(EPSComputeError(eps, i, EPS_ERROR_BACKWARD, &s->resid[i]));
-    } else PetscCall(EPSComputeError(eps, i, EPS_ERROR_RELATIVE, &s->resid[i]));
-    if (vectors) {
-      PetscCall(VecDuplicate(x, &s->x[i]));
-      PetscCall(VecCopy(x, s->x[i]));
+  {
+    /* ascending eigenvalues (a target given with -linearized_eps_target changes the solver's order); a zero one
+       (|omega^2| below 1e-8 in the time scale) is a mechanism mode */
+    PetscReal *th;
+    PetscInt  *perm;
+    PetscCall(PetscMalloc2(nconv, &th, nconv, &perm));
+    for (PetscInt i = 0; i < nconv; i++) {
+      PetscScalar kr, ki;
+      PetscCall(EPSGetEigenvalue(eps, i, &kr, &ki));
+      th[i]   = PetscRealPart(kr);
+      perm[i] = i;
     }
+    PetscCall(PetscSortRealWithPermutation(nconv, th, perm));
+    PetscCall(MatCreateVecs(p->A, &x, NULL));
+    for (PetscInt i = 0; i < want; i++) {
+      const PetscInt e = perm[i];
+      PetscScalar    kr, ki;
+      PetscCall(EPSGetEigenpair(eps, e, &kr, &ki, x, NULL));
+      s->theta[i] = PetscRealPart(kr);
+      if (PetscAbsReal(s->theta[i]) < 1e-8) {
+        nzero++;
+        /* the relative residual divides by the eigenvalue: the backward error instead */
+        PetscCall(EPSComputeError(eps, e, EPS_ERROR_BACKWARD, &s->resid[i]));
+      } else PetscCall(EPSComputeError(eps, e, EPS_ERROR_RELATIVE, &s->resid[i]));
+      if (vectors) {
+        PetscCall(VecDuplicate(x, &s->x[i]));
+        PetscCall(VecCopy(x, s->x[i]));
+      }
+    }
+    PetscCall(PetscFree2(th, perm));
   }
   PetscCall(VecDestroy(&x));
-  s->nmech = PetscMax(nmech, nzero);
+  s->nmech = nzero;
   PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -746,6 +766,12 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     char g[3][32];
     for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(scene->gravity[k], g[k], sizeof(g[k]));
     SETERRQ(scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has gravity (-gravity %s,%s,%s): the analysis linearises about an unloaded configuration at rest", g[0], g[1], g[2]);
+  }
+  {
+    PetscBool flexible = PETSC_FALSE;
+    for (PetscInt k = 0; k < scene->nparts; k++)
+      if (scene->parts[k]->ops.modes) flexible = PETSC_TRUE;
+    PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body; rigid bodies and point masses on joints have no elastic modes about rest");
   }
   PetscCall(PetscMemzero(&p, sizeof(p)));
   PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
