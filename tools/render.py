@@ -12,6 +12,8 @@ Reads every <name>.xmf in <output_dir> (with the legacy XDMF reader, which keeps
                                  <body>_<field>.gif         those frames as an animated GIF (made with Pillow)
     two or more transients    -> all_bodies_<field>.png     the bodies together (and their frames and GIF)
     <body>_modes.xmf          -> <body>_modes_<k>.png       mode k, warped by its shape; its frequency from modes.csv
+    two or more placed modes  -> assembly_modes_<k>.png     a linearised assembly's mode k, all bodies where they sit,
+                                                            warped alike (-analysis linearized)
 
 Colour: --field NAME, a point or cell field of the files, vectors by their magnitude; NAME:X, :Y, :Z or
 :Magnitude for a vector, NAME:XX ... :XZ for the stress (components XX YY ZZ XY YZ XZ). Default: von_mises
@@ -480,6 +482,54 @@ def render_modes(pv, body, args, out, run, table):
         print(f"render: wrote {png}")
 
 
+def assembly_frequencies(dirpath):
+    """mode -> (frequency [Hz], kind) from linearized_modes.csv when it holds one configuration (else {})."""
+    path = os.path.join(dirpath, "linearized_modes.csv")
+    table, configs = {}, set()
+    if os.path.isfile(path):
+        with open(path, newline="") as fp:
+            for row in csv.DictReader(fp):
+                try:
+                    configs.add(row["configuration"])
+                    table[int(row["mode"])] = (float(row["frequency_hz"]), row["kind"])
+                except (KeyError, ValueError):
+                    raise RenderError(f"{path}: unexpected row {row}") from None
+    return table if len(configs) == 1 else {}
+
+
+def render_assembly_modes(pv, bodies, args, out, run):
+    """The modes of a linearised assembly: every body placed where it sits, all warped by one factor."""
+    field, comp, _ = field_of(bodies, args, default=("mode_shape",))
+    size = size_of(union([b.bounds_at(b.times[0]) for b in bodies]))
+    warps = []
+    for body in bodies:
+        warp = pv.WarpByVector(Input=body.reader, Vectors=["POINTS", "mode_shape"])
+        body.ghost, body.shape = body.reader, warp
+        warps.append(warp)
+    scene = Scene(pv, args)
+    for body in bodies:
+        scene.show(body, field, comp)
+    table = assembly_frequencies(args.output_dir)
+    for t in sorted({t for b in bodies for t in b.times}):
+        k = int(round(t))
+        largest = 0.0
+        for body in bodies:
+            body.reader.UpdatePipeline(t)
+            largest = max(largest, body.reader.PointData["mode_shape"].GetRange(-1)[1])
+        for warp in warps:
+            warp.ScaleFactor = MAGNIFY_TO * size / largest if largest > 0 else 0
+        lo = min(b.range_at(t, field, comp)[0] for b in bodies)
+        hi = max(b.range_at(t, field, comp)[1] for b in bodies)
+        scene.set_range(field, *(args.crange or (lo, hi)))
+        scene.aim(union([b.bounds_at(t) for b in bodies] + [b.reader.GetDataInformation().GetBounds() for b in bodies]))
+        freq, kind = table.get(k, (None, ""))
+        what = f"mode {k}" + (", mechanism" if kind == "mechanism" else f": {freq:.6g} Hz" if freq is not None else "")
+        png = os.path.join(out, f"assembly_modes_{k:02d}.png")
+        scene.save(t, png, f"run '{run}': the assembly ({', '.join(b.name[:-len('_modes')] for b in bodies)})",
+                   f"{what}; largest displacement drawn at {MAGNIFY_TO:.0%} of the assembly's size")
+        print(f"render: wrote {png}")
+
+
 def write_gif(frames, path, fps):
     """An animated GIF of the PNG frames (at most 800 pixels wide), with Pillow."""
     try:
@@ -545,6 +595,11 @@ def render_all(pv, args, names, out):
         table = mode_table(args.output_dir) if modes else {}
         for body in modes:
             render_modes(pv, body, args, out, run, table)
+        placed = [b for b in modes if b.floating]
+        if len(placed) > 1:
+            for body in placed:
+                body.shape = body.reader
+            render_assembly_modes(pv, [Body(pv, b.path) for b in placed], args, out, run)
         if transients:
             render_transients(pv, transients, args, out, run)
     except (RenderError, OSError) as err:
