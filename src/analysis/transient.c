@@ -262,6 +262,8 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
     char e[32];
     SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "at step %" PetscInt_FMT " (t = %g s) the energy is %s: the state holds NaN or Inf; reduce -ts_dt, or check the inputs' magnitudes; no result was written", step, (double)t, PhlexFormatReal(H * u->energy, e, sizeof(e)));
   }
+  /* the energy holds no multiplier: a NaN there shows in the step's power balance */
+  PetscCheck(!PetscIsInfOrNanReal(residual), m->scene->comm, PETSC_ERR_NOT_CONVERGED, "at step %" PetscInt_FMT " (t = %g s) the power balance of the step is not a number: the state (a multiplier, an input) holds NaN or Inf; reduce -ts_dt, or check the inputs' magnitudes; no result was written", step, (double)t);
   if (step > 0 && m->lossless_scheme && m->watch_balance > 0) {
     const PetscReal scale = PetscMax(m->Emax, PetscAbsReal(m->H0));
     PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently; tighten -snes_rtol/-ksp_rtol or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
