@@ -8,8 +8,8 @@
    Sigma, the velocities V (field v and discrete ones: frame v_P, w, point velocities) and the joints' impulses is
        s E_ss Sigma + A_sv V = 0,      s (M V - B Lambda) + A_vs Sigma = 0,      C V = 0
    with M the kinetic-energy matrix, C the constraint rows and B = -C^T their force distribution (the power-preserving
-   interconnection of the ports, paper eq. (5.x): lambda . (C V) = w . y). The stress is eliminated exactly
-   (K = -A_vs E_ss^{-1} A_sv = G^T Ms^{-1} G, element by element), which also removes the self-equilibrated stresses
+   interconnection of the ports: lambda . (C V) = w . y). The stress is eliminated exactly (K = -A_vs E_ss^{-1} A_sv
+   = G^T Ms^{-1} G, cell by cell: the bodies' condensed operators), which also removes the self-equilibrated stresses
    (the Casimirs of the mixed form, each a zero eigenvalue), and with s = i omega, nu = s^2 Lambda:
        [K  C^T] [V ]          [M  0] [V ]
        [C   0 ] [nu] = w^2    [0  0] [nu]
@@ -198,69 +198,110 @@ static PetscErrorCode SplitShift(Mat J1, Mat J2)
   PetscFunctionReturn(0);
 }
 
-/* The field operators, once: M = E_vv, K = -A_vs E_ss^{-1} A_sv; checks that the state is at rest (A_vv = 0: no
-   gyroscopic term) and that the displacement does not act on the velocity rows (A_vu = 0: no preload) */
-static PetscErrorCode BuildFieldOperators(Pencil *p)
+/* the parts' condensed velocity operators S(s) = s Mv + K/s (part contract: the preconditioner's operator), block
+   diagonal over the flexible bodies, as one AIJ matrix at the shift last evaluated */
+static PetscErrorCode CondensedOperator(PhlexSystem sys, Mat *S)
 {
-  PhlexSystem     sys = p->sys;
-  Mat             Jss1, Jss2, Jvv1, Jvv2, Jvu = NULL, Minv, Avs, Asv;
-  PetscReal       na, nm;
-  PetscInt        nb, rstart;
-  const PetscInt *bsz;
-  PetscScalar    *diag;
+  Mat *m, N;
 
   PetscFunctionBeginUser;
-  PetscCall(EvaluateJacobian(p, 1.0));
-  PetscCall(ToAIJ(sys->Jss, &Jss1));
-  PetscCall(ToAIJ(sys->Jvv, &Jvv1));
-  PetscCall(EvaluateJacobian(p, 2.0));
-  PetscCall(ToAIJ(sys->Jss, &Jss2));
-  PetscCall(ToAIJ(sys->Jvv, &Jvv2));
-  PetscCall(SplitShift(Jss1, Jss2));
-  PetscCall(SplitShift(Jvv1, Jvv2));
-  p->Mvv = Jvv2;
-  PetscCall(MatNorm(p->Mvv, NORM_FROBENIUS, &nm));
-  PetscCall(MatNorm(Jvv1, NORM_FROBENIUS, &na));
-  p->scale = nm;
-  PetscCheck(na <= 1e-10 * nm, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the velocity equations have terms in v at the linearisation point (|A_vv| = %g |M|): the bodies are not at rest (a spinning frame); the linearisation about a steady motion is not this analysis", (double)(na / nm));
+  PetscCall(PetscMalloc1(sys->nfparts, &m));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    m[i] = ops.Sv;
+  }
+  PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &N));
+  PetscCall(ToAIJ(N, S));
+  PetscCall(MatDestroy(&N));
+  PetscCall(PetscFree(m));
+  PetscFunctionReturn(0);
+}
+
+/* |A x| / |E x| for a random x, with A = 2 J1 - J2 and E = J2 - J1 from the products y1 = J1 x, y2 = J2 x */
+static PetscErrorCode RelativeAPart(Vec y1, Vec y2, PetscReal *rel)
+{
+  Vec       a;
+  PetscReal na, ne;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecDuplicate(y1, &a));
+  PetscCall(VecAXPBYPCZ(a, 2.0, -1.0, 0.0, y1, y2)); /* 2 y1 - y2 */
+  PetscCall(VecNorm(a, NORM_2, &na));
+  PetscCall(VecAXPBYPCZ(a, -1.0, 1.0, 0.0, y1, y2)); /* y2 - y1 */
+  PetscCall(VecNorm(a, NORM_2, &ne));
+  PetscCall(VecDestroy(&a));
+  *rel = na / PetscMax(ne, PETSC_SMALL);
+  PetscFunctionReturn(0);
+}
+
+/* The field operators, once: from the bodies' condensed operators at shifts 1 and 2, S(s) = s M + K/s,
+   M = (2 S(2) - S(1))/3 and K = S(1) - M (K = G^T Ms^{-1} G: the stress eliminated cell by cell, so that the
+   self-equilibrated stresses of the mixed form, each a zero eigenvalue, are gone). Checks on a random vector that the
+   velocity rows have no term in v or u at the linearisation point (at rest: no gyroscopic load, no preload) and
+   that the velocity block of the system's Jacobian is s M there. */
+static PetscErrorCode BuildFieldOperators(Pencil *p)
+{
+  PhlexSystem sys = p->sys;
+  Mat         S1, S2;
+  Vec         x, y1, y2, yu1, yu2, xu = NULL;
+  PetscReal   rel, dev, nm;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateVecs(sys->Jvv, &x, &y1));
+  PetscCall(VecDuplicate(y1, &y2));
+  PetscCall(VecDuplicate(y1, &yu1));
+  PetscCall(VecDuplicate(y1, &yu2));
+  PetscCall(VecSetRandom(x, NULL));
   if (sys->Jvu) {
-    PetscCall(ToAIJ(sys->Jvu, &Jvu));
-    PetscCall(MatNorm(Jvu, NORM_FROBENIUS, &na));
-    PetscCall(MatDestroy(&Jvu));
-    PetscCheck(na <= 1e-10 * nm, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the displacement acts on the velocity equations at the linearisation point (|A_vu| = %g |M|): a loaded or moving state; linearise about an unloaded configuration at rest", (double)(na / nm));
+    PetscCall(MatCreateVecs(sys->Jvu, &xu, NULL));
+    PetscCall(VecSetRandom(xu, NULL));
   }
-  /* E_ss is block diagonal per cell (the compliance mass): its inverse exactly, block by block */
-  PetscCall(MatGetVariableBlockSizes(sys->Ms, &nb, &bsz));
-  {
-    PetscInt n = 0;
-    for (PetscInt b = 0; b < nb; b++) n += bsz[b] * bsz[b];
-    PetscCall(PetscMalloc1(PetscMax(n, 1), &diag));
-  }
-  PetscCall(MatInvertVariableBlockDiagonal(Jss2, nb, bsz, diag));
-  PetscCall(MatDuplicate(Jss2, MAT_DO_NOT_COPY_VALUES, &Minv));
-  PetscCall(MatGetOwnershipRange(Minv, &rstart, NULL));
-  for (PetscInt b = 0, r = rstart, off = 0; b < nb; b++) {
-    PetscInt idx[64];
-    PetscCheck(bsz[b] <= 64, sys->comm, PETSC_ERR_SUP, "stress block of %" PetscInt_FMT " unknowns", bsz[b]);
-    for (PetscInt k = 0; k < bsz[b]; k++) idx[k] = r + k;
-    PetscCall(MatSetValues(Minv, bsz[b], idx, bsz[b], idx, diag + off, INSERT_VALUES)); /* symmetric blocks: either order */
-    r += bsz[b];
-    off += bsz[b] * bsz[b];
-  }
-  PetscCall(MatAssemblyBegin(Minv, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(Minv, MAT_FINAL_ASSEMBLY));
-  PetscCall(PetscFree(diag));
-  PetscCall(ToAIJ(sys->Jvs, &Avs));
-  PetscCall(ToAIJ(sys->Jsv, &Asv));
-  PetscCall(MatMatMatMult(Avs, Minv, Asv, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &p->K));
-  PetscCall(MatScale(p->K, -1.0));
+  PetscCall(EvaluateJacobian(p, 1.0));
+  PetscCall(CondensedOperator(sys, &S1));
+  PetscCall(MatMult(sys->Jvv, x, y1));
+  if (xu) PetscCall(MatMult(sys->Jvu, xu, yu1));
+  PetscCall(EvaluateJacobian(p, 2.0));
+  PetscCall(CondensedOperator(sys, &S2));
+  PetscCall(MatMult(sys->Jvv, x, y2));
+  if (xu) PetscCall(MatMult(sys->Jvu, xu, yu2));
+  /* M = (2 S2 - S1)/3, K = S1 - M */
+  PetscCall(MatDuplicate(S2, MAT_COPY_VALUES, &p->Mvv));
+  PetscCall(MatScale(p->Mvv, 2.0 / 3.0));
+  PetscCall(MatAXPY(p->Mvv, -1.0 / 3.0, S1, SAME_NONZERO_PATTERN));
+  PetscCall(MatDuplicate(S1, MAT_COPY_VALUES, &p->K));
+  PetscCall(MatAXPY(p->K, -1.0, p->Mvv, SAME_NONZERO_PATTERN));
   PetscCall(MatSetOption(p->K, MAT_SYMMETRIC, PETSC_TRUE));
-  PetscCall(MatDestroy(&Minv));
-  PetscCall(MatDestroy(&Avs));
-  PetscCall(MatDestroy(&Asv));
-  PetscCall(MatDestroy(&Jss1));
-  PetscCall(MatDestroy(&Jss2));
-  PetscCall(MatDestroy(&Jvv1));
+  PetscCall(MatNorm(p->Mvv, NORM_FROBENIUS, &nm));
+  p->scale = nm;
+  /* at rest: the velocity block of the Jacobian is s M, nothing else */
+  PetscCall(RelativeAPart(y1, y2, &rel));
+  PetscCheck(rel <= 1e-10, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the velocity equations have terms in v at the linearisation point (relative size %g): the bodies are not at rest (a spinning frame); the linearisation about a steady motion is not this analysis", (double)rel);
+  {
+    Vec mx;
+    PetscCall(VecDuplicate(y1, &mx));
+    PetscCall(MatMult(p->Mvv, x, mx));
+    PetscCall(VecAXPBYPCZ(mx, -1.0, 1.0, 1.0, y2, y1)); /* M x - (y2 - y1) */
+    PetscCall(VecNorm(mx, NORM_2, &dev));
+    PetscCall(VecAXPBYPCZ(mx, -1.0, 1.0, 0.0, y1, y2));
+    PetscCall(VecNorm(mx, NORM_2, &rel));
+    PetscCall(VecDestroy(&mx));
+    PetscCheck(dev <= 1e-10 * rel, sys->comm, PETSC_ERR_PLIB, "linearized analysis: a body's condensed operator does not match its Jacobian's velocity block (relative deviation %g)", (double)(dev / rel));
+  }
+  if (xu) {
+    PetscReal n1, n2;
+    PetscCall(VecNorm(yu1, NORM_2, &n1));
+    PetscCall(VecNorm(yu2, NORM_2, &n2));
+    PetscCheck(PetscMax(n1, n2) <= 1e-10 * rel, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the displacement acts on the velocity equations at the linearisation point (relative size %g): a loaded or moving state; linearise about an unloaded configuration at rest", (double)(PetscMax(n1, n2) / rel));
+  }
+  PetscCall(MatDestroy(&S1));
+  PetscCall(MatDestroy(&S2));
+  PetscCall(VecDestroy(&x));
+  PetscCall(VecDestroy(&xu));
+  PetscCall(VecDestroy(&y1));
+  PetscCall(VecDestroy(&y2));
+  PetscCall(VecDestroy(&yu1));
+  PetscCall(VecDestroy(&yu2));
   PetscFunctionReturn(0);
 }
 
@@ -496,14 +537,11 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       IS is[2];
       PetscCall(MatNestGetISs(N, is, NULL));
       PetscCall(ISDuplicate(is[0], &p->isV));
-      PetscCall(ISCopy(is[0], p->isV));
       PetscCall(ISDuplicate(is[1], &p->isQ));
-      PetscCall(ISCopy(is[1], p->isQ));
     } else if (!p->isQ) {
       IS is[1];
       PetscCall(MatNestGetISs(N, is, NULL));
       PetscCall(ISDuplicate(is[0], &p->isQ));
-      PetscCall(ISCopy(is[0], p->isQ));
     }
     PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &A));
     PetscCall(MatDestroy(&N));
