@@ -198,23 +198,15 @@ static PetscErrorCode SplitShift(Mat J1, Mat J2)
   PetscFunctionReturn(0);
 }
 
-/* the parts' condensed velocity operators S(s) = s Mv + K/s (part contract: the preconditioner's operator), block
-   diagonal over the flexible bodies, as one AIJ matrix at the shift last evaluated */
+/* the bodies' condensed velocity operators S(s) = s Mv + K/s at the shift last evaluated, as one AIJ matrix */
 static PetscErrorCode CondensedOperator(PhlexSystem sys, Mat *S)
 {
-  Mat *m, N;
+  Mat N;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(sys->nfparts, &m));
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexFieldOperators ops;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    m[i] = ops.Sv;
-  }
-  PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &N));
+  PetscCall(PhlexSystemCondensedOperator(sys, &N));
   PetscCall(ToAIJ(N, S));
   PetscCall(MatDestroy(&N));
-  PetscCall(PetscFree(m));
   PetscFunctionReturn(0);
 }
 

@@ -497,6 +497,28 @@ PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, 
 }
 
 /*@C
+  PhlexSystemCondensedOperator - the bodies' condensed velocity operators shift Mv + K/shift (each part's Sv, at the
+  shift last evaluated), block diagonal: the part's own matrix for one body, else a MATNEST of them
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, Mat *N)
+{
+  Mat *m;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(PetscMax(sys->nfparts, 1), &m));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    m[i] = ops.Sv;
+  }
+  PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, N));
+  PetscCall(PetscFree(m));
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexSystemIJacobian - dF/dX + shift dF/dX' (TS IJacobian). Constant field blocks are only rescaled when the shift
   changes; the state-dependent pieces (frames, borders, joints, the dense discrete block) are recomputed at every
   call of a nonlinear scene.
@@ -550,17 +572,10 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
   }
   /* the preconditioning matrices of the splits: the condensed velocity operators changed with the shift */
   if (new_shift && sys->Sv && sys->nfparts > 1) {
-    Mat *m, N;
-    PetscCall(PetscMalloc1(sys->nfparts, &m));
-    for (PetscInt i = 0; i < sys->nfparts; i++) {
-      PhlexFieldOperators ops;
-      PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-      m[i] = ops.Sv;
-    }
-    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &N));
+    Mat N;
+    PetscCall(PhlexSystemCondensedOperator(sys, &N));
     PetscCall(MatConvert(N, MATAIJ, MAT_REUSE_MATRIX, &sys->Sv));
     PetscCall(MatDestroy(&N));
-    PetscCall(PetscFree(m));
   }
   if (sys->Ssv && new_shift) {
     Mat blocks[4] = {sys->Jss, sys->Jsv, sys->Jvs, sys->Jvv}, N;
