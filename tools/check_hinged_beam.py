@@ -1,38 +1,69 @@
 #!/usr/bin/env python3
 """The hinged spatial beam (cases.md section 3) against the pH paper: energy plateaus and the mean of omega_z.
 
-Reads <dir>/energy.csv and <dir>/<body>_rigid.csv of a run of options/hinged_beam.yaml and checks
-  - H on 10.5-15 s (after the torque) = 30.3 code units (1e-9 J) within --rtol (default 2 %),
-  - H after 15.5 s (after the tip pulse) = 126 code units within --rtol, and its spread there (the run is lossless),
-  - the plateau of the inertial omega_z = (R w)_z after the torque: its time average over 10.2-15 s = 0.0302 rad/s
-    within --rtol (the rigid-body value: angular impulse 2e-6 N m s over rho A L^3/3),
-  - after the pulse, the angular momentum about the vertical L_z = the torque's impulse 2e-6 N m s (the tip force
-    along Z adds none) within --lrtol (default 1e-4: the midpoint rule conserves it to O(dt^2) with full inertia).
-After the pulse the beam swings out of the horizontal plane and spins slowly about its own axis (its polar inertia is
-1e-7 of the transverse one); omega_z then includes that spin's vertical component, so its windows are printed for
-information, not checked: the paper's own curve there is called sampling- and model-dependent (cases.md 3.3).
-Prints one line per metric with PASS/FAIL; exit status 1 on a FAIL. --out writes t, H [code units], omega_z.
+Reads <dir>/energy.csv and <dir>/<body>_rigid.csv of a run of options/hinged_beam.yaml (standard library only) and
+checks, each against a stated tolerance, the acceptance tests of cases.md 3.3 (energies in code units of 1e-9 J):
+  - H after the torque: its time average over 10.2-15 s = 30.3 within --rtol (default 2 %);
+  - H after the tip pulse: its time average over 15.4 s - end = 126 within --rtol, and constant there: its spread
+    (max - min) / mean <= --drift (default 1e-4; the run is lossless: the full inertia model keeps H to O(dt^2),
+    about 1e-6 at dt = 0.01 s, the constant models to solver tolerance);
+  - the inertial omega_z = (R w)_z (R row-wise, w body frame): its time average over 10.2-15 s (the plateau the test
+    of the torque phase sees) and over 10.2 s - end (cases.md's test) = 0.0302 rad/s within --rtol (the rigid-body
+    value: the torque's angular impulse 2e-6 N m s over rho A L^3 / 3);
+  - after the pulse, the angular momentum about the vertical L_z = the torque's impulse 2e-6 N m s (the vertical tip
+    force adds none) within --lrtol (default 1e-4: the midpoint rule conserves it to O(dt^2) with full inertia and
+    constant_without_gyroscopic; the constant model does not conserve it, README "inertia models").
+The windows of each check start where the input that precedes it ends (10.2 s, 15.4 s); a metric whose window the
+run does not reach is skipped. Also checked, as the cause a failing omega_z would have: the frame's mean spin about
+the beam's axis after the pulse, |time average of w_x| <= --spin_max (default rtol x 0.0302 rad/s: its vertical
+component adds to omega_z, so a larger steady spin could move the mean by more than the tolerance; a mesh without
+the section's symmetry makes it grow steadily, meshes/hinged_beam.geo; the bending makes w_x oscillate about zero,
+and its largest value is printed for information). Printed for information too: the power-balance residual and
+omega_z on the paper's windows after the pulse (mean, min, max; the paper's are aliased by its 0.1 s sampling).
+One line per metric ending in PASS or FAIL; exit status 1 if any FAILs, 2 on bad input. --out writes t, H [code
+units], omega_z [rad/s] and w_x [rad/s] for plots against validation/reference/hinged_beam_*_phpaper.csv.
 
-  tools/check_hinged_beam.py output/hinged_beam [--body beam] [--rtol 0.02] [--out series.csv]
+  tools/check_hinged_beam.py output/hinged_beam [--body beam] [--rtol 0.02] [--drift 1e-4] [--spin_max W]
+                              [--out series.csv]
 """
 import argparse
 import csv
+import math
 import os
 import sys
 
 UNIT = 1e-9  # J per code unit (cases.md 3.1, reading (a))
+T_TORQUE_END, T_PULSE_START, T_PULSE_END = 10.2, 15.0, 15.4
+H_TORQUE, H_PULSE, OMEGA_Z, L_Z = 30.3, 126.0, 0.0302, 2e-6
+PAPER_WINDOWS = [(16, 25, 0.0303, 0.0250, 0.0358), (25, 35, 0.0305, 0.0081, 0.0509), (35, 45, 0.0294, -0.0174, 0.0768), (45, 50, 0.0311, -0.0303, 0.0901)]
 
 
 def read(path):
-    with open(path, newline="") as f:
-        return list(csv.DictReader(f))
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        sys.stderr.write("check_hinged_beam: cannot read %s: %s\n" % (path, e.strerror))
+        sys.exit(2)
+    if not rows:
+        sys.stderr.write("check_hinged_beam: %s has no rows\n" % path)
+        sys.exit(2)
+    return rows
 
 
-def mean_between(t, y, a, b):
-    """time average of a piecewise-linear series on [a, b] (trapezoids over the samples inside)"""
-    pts = [(ti, yi) for ti, yi in zip(t, y) if a <= ti <= b]
+def column(rows, name, path):
+    try:
+        return [float(r[name]) for r in rows]
+    except (KeyError, TypeError, ValueError):
+        sys.stderr.write("check_hinged_beam: %s has no numeric column %s\n" % (path, name))
+        sys.exit(2)
+
+
+def window(t, y, a, b):
+    """time average (trapezoids over the samples in [a, b]), min and max of a sampled series"""
+    pts = [(ti, yi) for ti, yi in zip(t, y) if a - 1e-9 <= ti <= b + 1e-9]
     if len(pts) < 2:
-        sys.exit("no samples between %g and %g s" % (a, b))
+        return None
     area = sum(0.5 * (y0 + y1) * (t1 - t0) for (t0, y0), (t1, y1) in zip(pts[:-1], pts[1:]))
     return area / (pts[-1][0] - pts[0][0]), min(p[1] for p in pts), max(p[1] for p in pts)
 
@@ -41,54 +72,73 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("dir")
     ap.add_argument("--body", default="beam")
-    ap.add_argument("--rtol", type=float, default=0.02)
-    ap.add_argument("--lrtol", type=float, default=1e-4)
+    ap.add_argument("--rtol", type=float, default=0.02, help="relative tolerance of the plateaus and omega_z means")
+    ap.add_argument("--drift", type=float, default=1e-4, help="largest relative spread of H after the pulse")
+    ap.add_argument("--lrtol", type=float, default=1e-4, help="relative tolerance of L_z after the pulse")
+    ap.add_argument("--spin_max", type=float, help="largest |mean w_x| after the pulse [rad/s] (default rtol x 0.0302)")
     ap.add_argument("--out")
     a = ap.parse_args()
-    en = read(os.path.join(a.dir, "energy.csv"))
-    rg = read(os.path.join(a.dir, a.body + "_rigid.csv"))
-    t = [float(r["time"]) for r in en]
-    H = [float(r["total"]) / UNIT for r in en]
-    tr = [float(r["time"]) for r in rg]
-    wz = [float(r["R31"]) * float(r["wx"]) + float(r["R32"]) * float(r["wy"]) + float(r["R33"]) * float(r["wz"]) for r in rg]
-    tend = t[-1]
-    checks = []
-    if tend >= 15.0:
-        h1, lo1, hi1 = mean_between(t, H, 10.5, 15.0)
-        checks.append(("energy after the torque (10.5-15 s) [code units]", h1, 30.3, "spread %.3g" % (hi1 - lo1)))
-    else:
-        h1, lo1, hi1 = mean_between(t, H, 10.5, tend)
-        checks.append(("energy after the torque (10.5-%g s) [code units]" % tend, h1, 30.3, "spread %.3g" % (hi1 - lo1)))
-    w, _, _ = mean_between(tr, wz, 10.2, min(15.0, tend))
-    checks.append(("omega_z plateau (mean over 10.2-%g s) [rad/s]" % min(15.0, tend), w, 0.0302, ""))
-    if tend >= 20.0:
-        h2, lo2, hi2 = mean_between(t, H, 15.5, tend)
-        checks.append(("energy after the pulse (15.5-%g s) [code units]" % tend, h2, 126.0, "spread %.3g" % (hi2 - lo2)))
+    epath, rpath = os.path.join(a.dir, "energy.csv"), os.path.join(a.dir, a.body + "_rigid.csv")
+    en, rg = read(epath), read(rpath)
+    t, H = column(en, "time", epath), [h / UNIT for h in column(en, "total", epath)]
+    work, resid = column(en, "supplied_work", epath), column(en, "balance_residual", epath)
+    tr = column(rg, "time", rpath)
+    R3 = [column(rg, "R3%d" % j, rpath) for j in (1, 2, 3)]
+    w = [column(rg, k, rpath) for k in ("wx", "wy", "wz")]
+    wz = [sum(R3[j][i] * w[j][i] for j in range(3)) for i in range(len(tr))]
+    Lz = column(rg, "Lz", rpath)
+    tend = min(t[-1], tr[-1])
     ok = True
-    if tend >= 20.0:
-        Lz = [float(r["Lz"]) for r in rg if float(r["time"]) >= 15.4]
-        dev = max(abs(x - 2e-6) for x in Lz) / 2e-6
-        status = "PASS" if dev <= a.lrtol else "FAIL"
-        ok = status == "PASS"
-        print("hinged beam angular momentum about Z after the pulse: max |L_z - 2e-6 N m s| / 2e-6 = %.2g (tolerance %g): %s" % (dev, a.lrtol, status))
-        wins = []
-        for lo, hi in [(16, 25), (25, 35), (35, 45), (45, tend)]:
-            if hi <= tend and hi > lo:
-                m, mn, mx = mean_between(tr, wz, lo, hi)
-                wins.append("%g-%g s: %.4f [%.4f, %.4f]" % (lo, hi, m, mn, mx))
-        print("hinged beam omega_z after the pulse (information; paper: 0.0303, 0.0305, 0.0294, 0.0311 on these windows): " + "; ".join(wins))
-    for name, val, ref, extra in checks:
+
+    def verdict(name, val, ref, tol, extra=""):
+        nonlocal ok
         dev = (val - ref) / ref
-        status = "PASS" if abs(dev) <= a.rtol else "FAIL"
+        status = "PASS" if abs(dev) <= tol else "FAIL"
         ok = ok and status == "PASS"
-        print("hinged beam %s: %.5g (reference %g, deviation %+.2f %%, tolerance %g %%%s): %s" % (name, val, ref, 100 * dev, 100 * a.rtol, ", " + extra if extra else "", status))
+        print("hinged beam %s: %.5g (reference %g, deviation %+.2f %%, tolerance %g %%%s): %s" % (name, val, ref, 100 * dev, 100 * tol, extra, status))
+
+    scale = max(abs(x) for x in work) or 1.0
+    print("hinged beam power balance (information): max |H_{n+1} - H_n - dt P| / max |supplied work| = %.1e" % (max(abs(x) for x in resid) / scale))
+    end1 = min(T_PULSE_START, tend)
+    if end1 > T_TORQUE_END:
+        m, lo, hi = window(t, H, T_TORQUE_END, end1)
+        verdict("energy after the torque (mean over 10.2-%g s) [code units]" % end1, m, H_TORQUE, a.rtol, ", spread %.2g" % (hi - lo))
+        m, _, _ = window(tr, wz, T_TORQUE_END, end1)
+        verdict("omega_z plateau (mean over 10.2-%g s) [rad/s]" % end1, m, OMEGA_Z, a.rtol)
+    if tend > T_PULSE_END + 1.0:
+        m, lo, hi = window(t, H, T_PULSE_END, tend)
+        verdict("energy after the pulse (mean over 15.4-%g s) [code units]" % tend, m, H_PULSE, a.rtol)
+        spread = (hi - lo) / m
+        status = "PASS" if spread <= a.drift else "FAIL"
+        ok = ok and status == "PASS"
+        print("hinged beam energy constant after the pulse: (max - min) / mean over 15.4-%g s = %.2g (tolerance %g): %s" % (tend, spread, a.drift, status))
+        dev = max(abs(x - L_Z) for x, ti in zip(Lz, tr) if ti >= T_PULSE_END) / L_Z
+        status = "PASS" if dev <= a.lrtol else "FAIL"
+        ok = ok and status == "PASS"
+        print("hinged beam angular momentum about Z after the pulse: max |L_z - 2e-6 N m s| / 2e-6 = %.2g (tolerance %g): %s" % (dev, a.lrtol, status))
+        m, _, _ = window(tr, wz, T_TORQUE_END, tend)
+        verdict("omega_z mean over 10.2-%g s [rad/s]" % tend, m, OMEGA_Z, a.rtol)
+        wins = []
+        for lo, hi, pm, pmin, pmax in PAPER_WINDOWS:
+            if hi <= tend + 1e-9:
+                m, mn, mx = window(tr, wz, lo, hi)
+                wins.append("%g-%g s: %.4f [%.4f, %.4f] (paper %.4f [%.4f, %.4f])" % (lo, hi, m, mn, mx, pm, pmin, pmax))
+        if wins:
+            print("hinged beam omega_z after the pulse (information): " + "; ".join(wins))
+        spin, _, _ = window(tr, w[0], T_PULSE_END, tend)
+        amplitude = max(abs(x) for x, ti in zip(w[0], tr) if ti >= T_PULSE_END)
+        spin_max = a.spin_max if a.spin_max is not None else a.rtol * OMEGA_Z
+        status = "PASS" if abs(spin) <= spin_max else "FAIL"
+        ok = ok and status == "PASS"
+        print("hinged beam spin about the beam's axis after the pulse: |mean w_x| over 15.4-%g s = %.1e rad/s (largest |w_x| %.1e; tolerance %.1e): %s" % (tend, abs(spin), amplitude, spin_max, status))
     if a.out:
+        wzs = {ti: (x, s) for ti, x, s in zip(tr, wz, w[0])}
         with open(a.out, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(["time_s", "H_code_units", "omega_z_rad_s"])
-            wzs = dict(zip(tr, wz))
+            out = csv.writer(f)
+            out.writerow(["time_s", "H_code_units", "omega_z_rad_s", "omega_axis_rad_s"])
             for ti, hi in zip(t, H):
-                w.writerow(["%.6g" % ti, "%.8g" % hi, "%.8g" % wzs.get(ti, float("nan"))])
+                x, s = wzs.get(ti, (math.nan, math.nan))
+                out.writerow(["%.6g" % ti, "%.8g" % hi, "%.8g" % x, "%.8g" % s])
     sys.exit(0 if ok else 1)
 
 

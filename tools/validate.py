@@ -138,7 +138,7 @@ def crankslider(out, S, walls, quick):
 
 def hinged(out, S, walls, quick):
     print("hinged spatial beam (transient, 50 s)")
-    runs = [("full", 8), ("constant", 8)] + ([] if quick else [("full", 16)])
+    runs = [("full", 8), ("constant", 8), ("constant_without_gyroscopic", 8)] + ([] if quick else [("full", 16)])
     series = {}
     for model, nx in runs:
         name = "hinged_beam_%s_nx%d" % (model, nx)
@@ -147,7 +147,7 @@ def hinged(out, S, walls, quick):
         csvout = os.path.join(out, name + ".csv")
         lines, _ = check("check_hinged_beam.py", [d, "--out", csvout])
         for l in lines:
-            checked = model == "full" and nx == 8 and "information" not in l
+            checked = model == "full" and "information" not in l
             S.add("hinged beam", "%s inertia, %d cells" % (model, nx), l, checked=checked)
         series[(model, nx)] = read_csv(csvout)
 
@@ -204,14 +204,17 @@ def plots(out):
         plt.close(fig)
 
     if os.path.exists(os.path.join(out, "hinged_beam_full_nx8.csv")):
-        series = {k: read_csv(os.path.join(out, "hinged_beam_%s_nx8.csv" % k[0])) for k in [("full", 8), ("constant", 8)]}
+        models = [m for m in ("full", "constant", "constant_without_gyroscopic") if os.path.exists(os.path.join(out, "hinged_beam_%s_nx8.csv" % m))]
+        series = {(m, 8): read_csv(os.path.join(out, "hinged_beam_%s_nx8.csv" % m)) for m in models}
         Hp = read_csv(os.path.join(REF, "hinged_beam_energy_phpaper.csv"))
         Wp = read_csv(os.path.join(REF, "hinged_beam_omega_z_phpaper.csv"))
 
         fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 7), sharex=True)
         a1.plot([float(r["time_s"]) for r in Hp], [float(r["H_code_units"]) for r in Hp], "-", color="0.6", lw=3, label="pH paper")
         a2.plot([float(r["time_s"]) for r in Wp], [float(r["omega_z_rad_s"]) for r in Wp], "-", color="0.6", lw=2, label="pH paper (sampled every 0.1 s)")
-        for key, c in [(("full", 8), "C0"), (("constant", 8), "C3")]:
+        for key, c in [(("full", 8), "C0"), (("constant", 8), "C3"), (("constant_without_gyroscopic", 8), "C2")]:
+            if key not in series:
+                continue
             s = series[key]
             t = [float(r["time_s"]) for r in s]
             a1.plot(t, [float(r["H_code_units"]) for r in s], "-", color=c, lw=1, label="phlex, %s inertia" % key[0])
