@@ -54,7 +54,7 @@ def main():
         dev = [(w[k] - wr[k]) / wr[k] for k in range(3)]
         out.append([ang] + w + wr + dev)
         for k in range(3):
-            if abs(dev[k]) > abs(worst[k][0]):
+            if abs(dev[k]) > abs(worst[k][0]) * (1 + 1e-9):  # ties (0 and 360 deg): the first angle
                 worst[k] = (dev[k], ang)
     ok = True
     for k in range(3):

@@ -55,6 +55,7 @@ typedef struct {
   PetscInt stress_bs; /* stress unknowns per cell (block size of Ms) */
   Mat      Jvv, Jvu; /* velocity rows: d/dv (shift Mv [+ node-wise terms]) and d/du (node-wise terms, or NULL) */
   Mat      Sv;       /* preconditioner: condensed velocity operator shift Mv + K/shift (AIJ, rigid modes attached) */
+  Mat      M, K;     /* the velocity mass Mv and the condensed stiffness K = G^T Ms^{-1} G (AIJ; the linearised analysis) */
 } PhlexFieldOperators;
 
 /* Reference scales a part suggests before set-up (the scene takes the largest of each). */

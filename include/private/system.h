@@ -86,7 +86,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem, Vec, PetscReal)
 PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
-PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, Mat *);
+PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, PetscInt, Mat *);
 
 /* border.c: the shells of the border blocks and the callbacks of PC phlexbordered */
 PETSC_INTERN PetscErrorCode PhlexBorderCreateShells(PhlexSystem);

@@ -131,7 +131,7 @@ static PetscErrorCode AddJointLoads(PhlexPart part)
    V = v [+ v_P + w x (x - P + u)], rotation w + B_r^T v. A port turns with its mean rotation theta = B_r^T u, so its
    angular velocity has no w x u term (to first order in theta); its position r + R (c - P + ubar) has exactly the
    rate of the translation (full inertia), so a joint's position-level gap follows its velocity constraint (midpoint
-   rule: exactly for translations). With frozen inertia the kinematics are those at u = 0 (no w x ubar): a joint on
+   rule: exactly for translations). With a constant-inertia model the kinematics are those at u = 0 (no w x ubar): a joint on
    such a port drifts at |w x ubar|, the model's own approximation. The wrench distribution is the transpose: B w on the elastic rows; F and
    (c - P + ubar) x F + T on the frame. The ubar terms appear in the full-inertia model only (as the inertia terms). */
 
@@ -509,6 +509,8 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->Jvv       = b->Jvv;
   ops->Jvu       = b->Jvu;
   ops->Sv        = b->Sv;
+  ops->M         = b->Mvaij;
+  ops->K         = b->Kaij;
   PetscFunctionReturn(0);
 }
 
@@ -645,7 +647,7 @@ static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal 
   PetscFunctionReturn(0);
 }
 
-/* W: the state-independent span of the borders: the frame's 12 nodal fields t e_c and w_b e_c (floating; with frozen
+/* W: the state-independent span of the borders: the frame's 12 nodal fields t e_c and w_b e_c (floating; with constant_without_gyroscopic
    inertia every frame border lies in their span, gravity too) and the force distributions of the ports with joints */
 static PetscErrorCode FlexBorderBasis(PhlexPart part, Mat *W)
 {
@@ -750,7 +752,7 @@ static PetscErrorCode FlexBorderRows(PhlexPart part, Mat Y, PetscReal *out, Pets
   PetscFunctionReturn(0);
 }
 
-/* beta with the body's own border columns ~ W beta: (W^T W)^{-1} W^T Bc, k x nq column-major (exact for frozen
+/* beta with the body's own border columns ~ W beta: (W^T W)^{-1} W^T Bc, k x nq column-major (exact for constant_without_gyroscopic
    inertia; otherwise the projection used by the preconditioner) */
 static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, PetscInt ld)
 {

@@ -12,7 +12,7 @@
        S  = D - sum_i (C_i Y_i) beta_i                                         (m x m, LU)
        x0_i = A_i^{-1} f_i,  y = S^{-1} (g - sum_i C_i x0_i),  x_i = x0_i - Y_i (beta_i y)   (one solve per body)
 
-   This is the exact inverse when every border lies in its basis (frozen inertia: the joints' and the frames' forces);
+   This is the exact inverse when every border lies in its basis (-inertia constant_without_gyroscopic: the joints' and the frames' forces; not the other models, whose gyroscopic borders depend on the state);
    with full inertia (u-dependent borders, node-wise gyroscopic terms) it preconditions an outer Krylov method.
    The system composes what the PC needs on the preconditioning matrix ("phlex_border", system.h). Options of the
    solves with A_i: -<prefix>bordered_ksp_type, -<prefix>bordered_pc_type, ... (default preonly + Cholesky), and

@@ -497,12 +497,13 @@ PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, 
 }
 
 /*@C
-  PhlexSystemCondensedOperator - the bodies' condensed velocity operators shift Mv + K/shift (each part's Sv, at the
-  shift last evaluated), block diagonal: the part's own matrix for one body, else a MATNEST of them
+  PhlexSystemCondensedOperator - block diagonal over the bodies of one of their velocity-space operators: which = 0
+  the condensed operators shift Mv + K/shift (each part's Sv, at the shift last evaluated), 1 the masses Mv, 2 the
+  condensed stiffnesses K; the part's own matrix for one body, else a MATNEST of them
 
   Collective
 @*/
-PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, Mat *N)
+PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, PetscInt which, Mat *N)
 {
   Mat *m;
 
@@ -511,20 +512,13 @@ PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, Mat *N)
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    m[i] = ops.Sv;
+    m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : ops.K);
   }
   PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, N));
   PetscCall(PetscFree(m));
   PetscFunctionReturn(0);
 }
 
-/*@C
-  PhlexSystemIJacobian - dF/dX + shift dF/dX' (TS IJacobian). Constant field blocks are only rescaled when the shift
-  changes; the state-dependent pieces (frames, borders, joints, the dense discrete block) are recomputed at every
-  call of a nonlinear scene.
-
-  Collective
-@*/
 PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscReal shift, Mat A, Mat P, void *ctx)
 {
   PhlexSystem     sys = (PhlexSystem)ctx;
@@ -573,7 +567,7 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
   /* the preconditioning matrices of the splits: the condensed velocity operators changed with the shift */
   if (new_shift && sys->Sv && sys->nfparts > 1) {
     Mat N;
-    PetscCall(PhlexSystemCondensedOperator(sys, &N));
+    PetscCall(PhlexSystemCondensedOperator(sys, 0, &N));
     PetscCall(MatConvert(N, MATAIJ, MAT_REUSE_MATRIX, &sys->Sv));
     PetscCall(MatDestroy(&N));
   }
