@@ -18,6 +18,12 @@
 // Parameters: L, h, b and nx, the cells along the length (structured: nx x 1 x 1 boxes, each cut into 6 tetrahedra
 // by gmsh 4.8: 6 nx tetrahedra, 4 (nx + 1) vertices). One cell across each side: with velocity P2 the bending
 // strain, linear through the section, is exact; the cells along the length set the accuracy.
+// Or lx, the cell length along x (nx = round(L / lx), at least 1, even with mid = 1; lx > 0 wins over nx).
+// ny, nz: cells across h and across b (default 1; nx ny nz boxes, 6 nx ny nz tetrahedra). One cell across is
+// enough with nu = 0 only: with nu > 0 a wide, thin section (the four-bar's links, b/h = 16) needs cells across b,
+// or its Poisson (anticlastic) deformation locks and the bending stiffens towards the plate's E/(1 - nu^2)
+// (the coupler's first cantilever frequency with nu = 0.33: +6.0 % above Euler-Bernoulli with nz = 1, +0.85 % with
+// nx = 128, nz = 8; ../options/fourbar_link_modes.yaml).
 // Regenerate (see Makefile), e.g.
 //   gmsh prism.geo -3 -setnumber L 0.2794 -setnumber h 1.60047e-3 -setnumber b 2.53956e-2 -setnumber nx 8
 //        -format msh41 -o fourbar_coupler_nx8.msh
@@ -34,7 +40,23 @@ DefineConstant[ h = {1.60047e-3, Name "Parameters/h"} ];
 DefineConstant[ b = {2.53956e-2, Name "Parameters/b"} ];
 DefineConstant[ nx = {8, Name "Parameters/nx"} ];
 DefineConstant[ mid = {0, Name "Parameters/mid"} ];  // 1: cut at x = L/2, the mid-section a surface "M" (nx even)
+DefineConstant[ lx = {0, Name "Parameters/lx"} ];    // cell length along x (> 0: sets nx)
+DefineConstant[ ny = {1, Name "Parameters/ny"} ];    // cells across h
+DefineConstant[ nz = {1, Name "Parameters/nz"} ];    // cells across b
 eps = 1e-3 * h;
+If (lx > 0)
+  nx = Round(L / lx);
+  If (mid && nx % 2)
+    nx = nx + 1;
+  EndIf
+  If (nx < 1)
+    nx = 1;
+  EndIf
+EndIf
+If (ny < 1 || nz < 1)
+  Error("prism.geo: ny and nz must be at least 1, got %g, %g", ny, nz);
+  Abort;
+EndIf
 
 If (mid)
   If (nx % 2)
@@ -57,8 +79,10 @@ For i In {0:#edges()-1}
   bb() = BoundingBox Curve{ edges(i) };
   If (bb(3) - bb(0) > lcut)
     Transfinite Curve{ edges(i) } = ncells + 1;
+  ElseIf (bb(4) - bb(1) > h / 2)
+    Transfinite Curve{ edges(i) } = ny + 1;
   Else
-    Transfinite Curve{ edges(i) } = 2;
+    Transfinite Curve{ edges(i) } = nz + 1;
   EndIf
 EndFor
 Transfinite Surface{:};
