@@ -1,9 +1,11 @@
 #!/usr/bin/env python3
 """make validate: the pH paper's three cases at full size against their reference curves (cases.md).
 
-Runs bin/phlex on options/fourbar.yaml, options/crankslider.yaml and options/hinged_beam.yaml (several meshes,
-both inertia models where the issue asks for them), checks each metric with the tools that the regression tests use
-(tools/compare_fourbar.py, tools/crankslider_midpoint.py, tools/check_hinged_beam.py), and writes under validation/:
+Runs bin/phlex on options/fourbar.yaml, options/crankslider.yaml, options/hinged_beam.yaml and
+options/rotating_cantilever.yaml (several meshes, both inertia models where the issue asks for them, the rotating
+cantilever with and without geometric stiffening), checks each metric with the tools that the regression tests use
+(tools/compare_fourbar.py, tools/crankslider_midpoint.py, tools/check_hinged_beam.py, tools/rotating_cantilever.py),
+and writes under validation/:
   <case>_*.csv                   the computed curves beside the references
   <case>.png                     plots of them (matplotlib; skipped with a note when it is missing)
   summary.csv, summary.md        case, metric, tolerance, value, pass/fail, and the wall time of each run
@@ -158,6 +160,26 @@ def hinged(out, S, walls, quick):
         series[(model, nx)] = read_csv(csvout)
 
 
+def rotating(out, S, walls, quick):
+    print("rotating cantilever (linearised about the steady spin, Omega_bar = 0..12)")
+    # (name, mesh cells, extra options, checker options, checked)
+    runs = [("stiffened_nx16", 16, ["-linearized_coriolis", "false"], ["--rtol", "0.005", "--ratio-rtol", "0.005"], True)]
+    if not quick:
+        runs += [("stiffened_nx32", 32, ["-linearized_coriolis", "false"], ["--rtol", "0.002", "--ratio-rtol", "0.002"], True),
+                 ("stiffened_coriolis_nx32", 32, [], ["--rtol", "0.005", "--ratio-rtol", "0.005"], False),
+                 ("linear_nx32", 32, ["-linearized_coriolis", "false", "-body0_geometric_stiffening", "false"], ["--model", "linear", "--rtol", "0.002"], True)]
+    for name, nx, extra, copts, checked in runs:
+        d, w = run("rotating_cantilever_" + name, ["-options_file", "options/rotating_cantilever.yaml", "-body0_dm_plex_filename", "meshes/rotating_beam_nx%d.msh" % nx] + extra, out)
+        walls.append(("rotating_cantilever_%s (13 spin rates)" % name, w))
+        shutil.copy(os.path.join(d, "linearized_modes.csv"), os.path.join(out, "rotating_cantilever_%s_modes.csv" % name))
+        lines, _ = check("rotating_cantilever.py", [os.path.join(d, "linearized_modes.csv"), os.path.join(REF, "rotating_cantilever_frequencies.csv"), "--omega-ref", "29.95567", "--out", os.path.join(out, "rotating_cantilever_%s.csv" % name)] + copts)
+        what = {"stiffened_nx16": "stiffening, 16 cells, no Coriolis (as the reference)", "stiffened_nx32": "stiffening, 32 cells, no Coriolis (as the reference)",
+                "stiffened_coriolis_nx32": "stiffening, 32 cells, Coriolis kept (the reference has none)", "linear_nx32": "linear model (no stiffening), 32 cells: its known failure"}[name]
+        for l in lines:
+            if l.startswith("largest"):
+                S.add("rotating cantilever", what, l, checked=checked)
+
+
 def plots(out):
     """the PNGs, from the CSV files of a validation run (needs matplotlib)"""
     import matplotlib
@@ -237,13 +259,41 @@ def plots(out):
         fig.savefig(os.path.join(out, "hinged_beam.png"), dpi=120)
         plt.close(fig)
 
+    best = next((n for n in ("stiffened_nx32", "stiffened_nx16") if os.path.exists(os.path.join(out, "rotating_cantilever_%s.csv" % n))), None)
+    if best:
+        ref = read_csv(os.path.join(REF, "rotating_cantilever_frequencies.csv"))
+        fig, ax = plt.subplots(figsize=(8, 5.5))
+        ob = [float(r["Omega_bar"]) for r in ref]
+        for name, c in [("flap1", "C0"), ("lag1", "C1"), ("flap2", "C2"), ("lag2", "C3")]:
+            ax.plot(ob, [float(r[name]) for r in ref], "-", color=c, lw=3, alpha=0.35, label="beam reference, %s" % name)
+            runs = [(best, "o", "phlex, stiffening, no Coriolis"), ("stiffened_coriolis_nx32", "x", "phlex, stiffening, Coriolis kept"), ("linear_nx32", "s", "phlex, linear model")]
+            for run_name, mk, label in runs:
+                path = os.path.join(out, "rotating_cantilever_%s.csv" % run_name)
+                if not os.path.exists(path):
+                    continue
+                rows = [r for r in read_csv(path) if r["mode"] == name]
+                if run_name == "linear_nx32":  # lambda, or the growth rate of the divergence (drawn negative)
+                    pts = [(float(r["Omega_bar"]), float(r["lambda"]) * (-1 if name == "lag1" and float(r["Omega_bar"]) > 3.52 else 1)) for r in rows]
+                else:
+                    pts = [(float(r["Omega_bar"]), float(r["lambda"])) for r in rows]
+                ax.plot([p[0] for p in pts], [p[1] for p in pts], mk, color=c, ms=5 if mk != "s" else 3, mfc="none", label=label if name == "flap1" else None)
+        ax.axhline(0, color="k", lw=0.5)
+        ax.set_xlabel("spin rate Omega_bar = Omega / sqrt(EI / (rho A L^4))")
+        ax.set_ylabel("lambda = omega / sqrt(EI / (rho A L^4))\n(linear model diverging: minus its growth rate)")
+        ax.set_title("Rotating cantilever: flapwise and lagwise bending (3D solid, L/a = 50)")
+        ax.legend(fontsize=7, ncol=2)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "rotating_cantilever.png"), dpi=120)
+        plt.close(fig)
+
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default=os.path.join(ROOT, "validation"))
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--cases", default="fourbar,crankslider,hinged")
+    ap.add_argument("--cases", default="fourbar,crankslider,hinged,rotating")
     ap.add_argument("--plots-only", action="store_true", help="only redraw the PNGs from the CSV files in --out")
     a = ap.parse_args()
     if a.plots_only:
@@ -253,7 +303,7 @@ def main():
     S, walls = Summary(), []
     t0 = time.time()
     for c in a.cases.split(","):
-        {"fourbar": fourbar, "crankslider": crankslider, "hinged": hinged}[c](a.out, S, walls, a.quick)
+        {"fourbar": fourbar, "crankslider": crankslider, "hinged": hinged, "rotating": rotating}[c](a.out, S, walls, a.quick)
     S.write(a.out, walls)
     # the plots: this interpreter's matplotlib, else the system Python's (a pyenv shim may hide python3-matplotlib)
     python = next((p for p in [sys.executable, "/usr/bin/python3"] if os.path.exists(p) and have_matplotlib(p)), None)

@@ -127,6 +127,11 @@ PETSC_INTERN void     PhlexElementStiffness(const PhlexElementReferenceIntegrals
 PETSC_INTERN PetscInt PhlexElementCondense(PetscInt, PetscInt, PetscReal *, const PetscReal *, PetscReal *, PetscReal *);
 PETSC_INTERN PetscInt PhlexDenseCholesky(PetscInt, PetscReal *);
 PETSC_INTERN void     PhlexDenseCholeskySolve(PetscInt, const PetscReal *, PetscInt, PetscReal *);
+/* element_stiffening.c: the Green-Lagrange coupling and its derivatives (quadrature) */
+PETSC_INTERN void PhlexElementCouplingDeformed(const PhlexElementBasis *, const PhlexElementBasis *, PetscReal, const PetscReal[9], const PetscReal *, PetscReal *);
+PETSC_INTERN void PhlexElementGreenLagrange(const PhlexElementBasis *, const PhlexElementBasis *, PetscReal, const PetscReal[9], PetscBool, const PetscReal *, PetscReal *);
+PETSC_INTERN void PhlexElementGeometricStiffness(const PhlexElementBasis *, const PhlexElementBasis *, PetscReal, const PetscReal[9], const PetscReal *, PetscReal *);
+PETSC_INTERN void PhlexElementCouplingDerivative(const PhlexElementBasis *, const PhlexElementBasis *, PetscReal, const PetscReal[9], const PetscReal *, PetscReal *);
 
 struct _p_PhlexFlexible {
   MPI_Comm            comm;
@@ -205,6 +210,24 @@ struct _p_PhlexFlexible {
   PetscBLASInt *gram_piv;
   PetscInt   kW;              /* columns of W */
 
+  /* geometric stiffening (flexible_stiffening.c): the Green-Lagrange coupling G(u) */
+  PetscBool         stiffening;
+  Mat               Gu, Gut;   /* G(u) (G's pattern) and its transpose: the coupling of the residual and the Jacobian */
+  Mat               Ksig, Jsu; /* d(G(u)^T Sigma)/du (initial-stress stiffness, Kaij's pattern), d(G(u) v)/du (G's) */
+  Mat               Nsu;       /* G(u)^T Ms^{-1} d(G(u) v)/du (Kaij's pattern, not symmetric): its term in the exact Schur complement */
+  Vec               uloc, vloc; /* local (ghosted) displacement and velocity */
+  PetscInt         *cell_vloc;  /* per local cell: local-vector offsets of its velocity closure */
+  PhlexElementBasis basis_v, basis_s;
+  PetscBool         have_basis;
+
+  /* a uniformly rotating body frame (flexible_spin.c): a fixed body on a hub spinning at a constant rate */
+  PetscBool spinning;
+  PetscReal spin[3], spin_axis[3], spin_center[3]; /* rad/s, unit vector and m (mesh coordinates) */
+  Mat       Cor, Cen;   /* Mv x 2 hat(Omega) (Coriolis) and Mv x hat(Omega)^2 (centrifugal), non-dimensional AIJ */
+  Mat       Cor1, Cen1; /* the same at 1 rad/s about the axis (a sweep over the rate scales them) */
+  Vec       fcen, fcen1; /* Cen (x - c): the centrifugal load at the drawn geometry; at 1 rad/s */
+  KSP       steady_ksp; /* the steady spin's Newton (linearised analysis) */
+
   /* output */
   void *writer, *rigid_csv, *ports_csv;
 
@@ -241,6 +264,18 @@ PETSC_INTERN PetscErrorCode PhlexFlexPortDestroy(PhlexFlexPort *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleICSetFromOptions(PhlexFlexible, PhlexIC *, const char[], PetscInt);
 PETSC_INTERN PetscBool      PhlexFlexibleFrameVelocity(PhlexFlexible, PetscReal[3], PetscReal[3]);
 PETSC_INTERN PetscErrorCode PhlexFlexibleInitialState(PhlexPart, PhlexPartVec *);
+
+/* flexible_stiffening.c, flexible_spin.c */
+PETSC_INTERN PetscErrorCode PhlexFlexibleStiffeningSetUp(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexFlexibleCouplingUpdate(PhlexFlexible, Vec);
+PETSC_INTERN PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible, Vec, Vec, Vec);
+PETSC_INTERN PetscErrorCode PhlexFlexibleStressOfDisplacement(PhlexFlexible, Vec, Vec);
+PETSC_INTERN PetscErrorCode PhlexFlexibleStiffeningDestroy(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSpinSetUp(PhlexFlexible, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSpinEnergy(PhlexFlexible, Vec, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart, PhlexPartVec *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSpinRate(PhlexPart, PetscBool, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSpinDestroy(PhlexFlexible);
 
 /* flexible_modes.c */
 PETSC_INTERN PetscErrorCode PhlexFlexibleComputeModes(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);

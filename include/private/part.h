@@ -56,6 +56,10 @@ typedef struct {
   Mat      Jvv, Jvu; /* velocity rows: d/dv (shift Mv [+ node-wise terms]) and d/du (node-wise terms, or NULL) */
   Mat      Sv;       /* preconditioner: condensed velocity operator shift Mv + K/shift (AIJ, rigid modes attached) */
   Mat      M, K;     /* the velocity mass Mv and the condensed stiffness K = G^T Ms^{-1} G (AIJ; the linearised analysis) */
+  Mat      Jsu;      /* stress rows: d(G(u) v)/du (geometric stiffening), or NULL */
+  Mat      Kstate;   /* velocity rows' displacement columns of a stressed or spinning state, K_sigma + Cen (AIJ, symmetric), or NULL */
+  Mat      Gyro;     /* velocity rows' velocity terms besides shift Mv: the Coriolis matrix of a spin (AIJ, skew), or NULL */
+  PetscBool inexact_schur; /* Sv is not the exact Schur complement of u and Sigma (spin, stiffening): a Krylov method is needed */
 } PhlexFieldOperators;
 
 /* Reference scales a part suggests before set-up (the scene takes the largest of each). */
@@ -111,6 +115,8 @@ typedef struct {
   PetscErrorCode (*modesoutput)(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *, const PetscReal *); /* ..., placement: r_P (non-dimensional) and R of a floating body in an assembly, or NULL (body frame) */
   PetscErrorCode (*refine)(PhlexPart, PetscInt, PhlexPart *); /* the same part on a finer discretisation */
   PetscErrorCode (*modesorder)(PhlexPart, char[], size_t);      /* its discretisation and the order of its eigenvalues under refinement */
+  PetscErrorCode (*steadystate)(PhlexPart, PhlexPartVec *); /* its fields in the steady state of a prescribed uniform spin (NULL: at rest) */
+  PetscErrorCode (*spinrate)(PhlexPart, PetscBool, PetscReal *); /* get (PETSC_FALSE) or set (PETSC_TRUE) the rate of its prescribed spin [rad/s]; -1 on get: it has none */
   PetscErrorCode (*modeskind)(PhlexPart, char[], size_t, PetscInt *); /* "free", "clamped", ...; how many rigid-body modes it has (-1: none counted) */
   PetscErrorCode (*place)(PhlexPart, const PetscReal[3], PetscReal *); /* put its port at a point (an attached part given no position) */
 } PhlexPartOps;

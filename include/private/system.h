@@ -58,7 +58,9 @@ struct _p_PhlexSystem {
   PetscReal shift;
   Mat       J, Jaij;
   PetscBool use_aij;
-  Mat       Juu, Juv, Ms, Jss, Jsv, Jvs, Jvv, Jvu, Bvq, Cqu, Cqv, Dq;
+  Mat       Juu, Juv, Ms, Jss, Jsv, Jvs, Jvv, Jvu, Jsu, Bvq, Cqu, Cqv, Dq;
+  PetscBool state_dependent_fields, inexact_schur; /* a body with geometric stiffening: G(u) and its blocks change with the state */
+
   Mat       Sv, Pvq, Ssv, Abd, Cpre;
   IS       *fis[3]; /* per field part: its block in the numbering of the displacement, stress, velocity fields */
   PhlexBorderedData border;

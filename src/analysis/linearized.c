@@ -21,6 +21,7 @@
    eigensolver and the symbolic factorisation; per configuration only the constraint rows and the frame couplings are
    rebuilt (the joints turn), and the loop is closed by the assembly's Newton at the swept drive position. */
 #include <phlex_impl.h>
+#include <slepcpep.h>
 
 typedef struct {
   PetscInt  nev;
@@ -33,11 +34,16 @@ typedef struct {
   PetscReal expected[65], rtol, rmax;
   PetscInt  nexp;
   PetscBool has_exp;
+  PetscReal spins[1025];    /* spin rates of the configurations [rad/s] (a sweep over a body's -spin) */
+  PetscInt  nspins;
+  PetscBool coriolis;       /* keep the Coriolis (gyroscopic) terms of a spin: a quadratic eigenproblem */
 } LinearizedOptions;
 
 static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions *o)
 {
-  PetscInt nrange = 3;
+  PetscInt  nrange = 3, nsrange = 3;
+  PetscReal srange[3];
+  PetscBool has_spins = PETSC_FALSE, has_srange = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(o, sizeof(*o)));
@@ -47,11 +53,16 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
   o->rtol                 = 1e-6;
   o->rmax                 = -1;
   o->fields_configuration = 0;
+  o->nspins               = 1025;
+  o->coriolis             = PETSC_TRUE;
   PetscOptionsBegin(comm, NULL, "Linearised analysis of the assembly options", NULL);
   PetscCall(PetscOptionsInt("-linearized_nev", "Number of elastic (non-zero) frequencies wanted per configuration", "PhlexSceneSolveLinearized", o->nev, &o->nev, NULL));
   PetscCall(PetscOptionsString("-linearized_sweep_joint", "Driven joint whose position is swept (default: the scene's only driven joint)", "PhlexSceneSolveLinearized", o->joint, o->joint, sizeof(o->joint), NULL));
   PetscCall(PetscOptionsRealArray("-linearized_sweep", "Drive positions of the configurations, as -drive_initial: angles [deg] or slides [m] relative to the drawn configuration", "PhlexSceneSolveLinearized", o->values, &o->nvalues, &o->has_values));
   PetscCall(PetscOptionsRealArray("-linearized_sweep_range", "Drive positions start,stop,step (stop included) [deg or m]", "PhlexSceneSolveLinearized", o->range, &nrange, &o->has_range));
+  PetscCall(PetscOptionsRealArray("-linearized_spin_sweep", "Spin rates of the configurations, for the body with -spin (its axis kept) [rad/s]", "PhlexSceneSolveLinearized", o->spins, &o->nspins, &has_spins));
+  PetscCall(PetscOptionsRealArray("-linearized_spin_sweep_range", "Spin rates start,stop,step (stop included) [rad/s]", "PhlexSceneSolveLinearized", srange, &nsrange, &has_srange));
+  PetscCall(PetscOptionsBool("-linearized_coriolis", "About a spin: keep the Coriolis (gyroscopic) coupling, a quadratic eigenproblem (false: the symmetric problem of the stiffness and the spin softening alone, as beam tables do)", "PhlexSceneSolveLinearized", o->coriolis, &o->coriolis, NULL));
   PetscCall(PetscOptionsInt("-linearized_fields_configuration", "Write the mode shapes of this configuration (0-based index; -1: none)", "PhlexSceneSolveLinearized", o->fields_configuration, &o->fields_configuration, NULL));
   PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] of the first configuration (self-check)", "PhlexSceneSolveLinearized", o->expected, &o->nexp, &o->has_exp));
   PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveLinearized", o->rtol, &o->rtol, NULL));
@@ -74,6 +85,28 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
     PetscCheck(n <= 1024, comm, PETSC_ERR_USER_INPUT, "-linearized_sweep_range %s,%s,%s gives %" PetscInt_FMT " configurations; at most 1024", a, b, c, n);
     for (PetscInt k = 0; k < n; k++) o->values[k] = o->range[0] + k * o->range[2];
     o->nvalues = n;
+  }
+  PetscCheck(!((o->has_values || o->has_range) && (has_spins || has_srange)), comm, PETSC_ERR_USER_INPUT, "a sweep moves either a driven joint (-linearized_sweep*) or a spin rate (-linearized_spin_sweep*), not both");
+  PetscCheck(!(has_spins && has_srange), comm, PETSC_ERR_USER_INPUT, "give either -linearized_spin_sweep or -linearized_spin_sweep_range, not both");
+  PetscCheck(!has_spins || o->nspins <= 1024, comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep: at most 1024 values (use -linearized_spin_sweep_range)");
+  if (!has_spins) o->nspins = 0;
+  if (has_srange) {
+    char a[32], b[32], c[32];
+    PetscInt n;
+    PhlexFormatReal(srange[0], a, sizeof(a));
+    PhlexFormatReal(srange[1], b, sizeof(b));
+    PhlexFormatReal(srange[2], c, sizeof(c));
+    PetscCheck(nsrange == 3, comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep_range needs start,stop,step (3 numbers), got %" PetscInt_FMT, nsrange);
+    PetscCheck(srange[2] != 0 && (srange[1] - srange[0]) / srange[2] >= 0, comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep_range %s,%s,%s: the step must be non-zero and go from start towards stop", a, b, c);
+    PetscCheck((srange[1] - srange[0]) / srange[2] < 1024, comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep_range %s,%s,%s gives more than 1024 configurations", a, b, c);
+    n = (PetscInt)PetscFloorReal((srange[1] - srange[0]) / srange[2] + 1e-9) + 1;
+    for (PetscInt k = 0; k < n; k++) o->spins[k] = srange[0] + k * srange[2];
+    o->nspins = n;
+  }
+  for (PetscInt k = 0; k < o->nspins; k++) {
+    char a[32];
+    PhlexFormatReal(o->spins[k], a, sizeof(a));
+    PetscCheck(o->spins[k] >= 0 && !PetscIsInfOrNanReal(o->spins[k]), comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep: spin rate %s is not a finite rate >= 0 [rad/s] (the axis is the body's -spin: reverse it there)", a);
   }
   if (!o->has_exp) o->nexp = 0;
   PetscCheck(o->nexp <= 64, comm, PETSC_ERR_USER_INPUT, "-expect_frequencies: at most 64 values");
@@ -117,6 +150,32 @@ static PetscErrorCode LinearizedEPSCreate(MPI_Comm comm, EPS *eps)
   PetscFunctionReturn(0);
 }
 
+/* the quadratic eigensolver of a spinning state (Coriolis kept): TOAR, shift-and-invert about 0 (the same saddle
+   point factored), the same prefix linearized_ (-linearized_pep_*, -linearized_st_*) */
+static PetscErrorCode LinearizedPEPCreate(MPI_Comm comm, PEP *pep)
+{
+  ST  st;
+  KSP ksp;
+  PC  pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(PEPCreate(comm, pep));
+  PetscCall(PEPSetOptionsPrefix(*pep, "linearized_"));
+  PetscCall(PEPSetProblemType(*pep, PEP_GYROSCOPIC)); /* A0, A2 symmetric, A1 skew: eigenvalues in pairs +-lambda */
+  PetscCall(PEPSetType(*pep, PEPTOAR));
+  PetscCall(PEPSetWhichEigenpairs(*pep, PEP_TARGET_MAGNITUDE));
+  PetscCall(PEPSetTarget(*pep, 0.0));
+  PetscCall(PEPSetTolerances(*pep, 1e-12, PETSC_DEFAULT));
+  PetscCall(PEPGetST(*pep, &st));
+  PetscCall(STSetType(st, STSINVERT));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCLU)); /* A0 + sigma A1 + sigma^2 A2 is not symmetric for a sigma other than 0 */
+  if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode LinearizedRereadOptions(void *ctx)
 {
   MPI_Comm          comm = *(MPI_Comm *)ctx;
@@ -129,6 +188,12 @@ static PetscErrorCode LinearizedRereadOptions(void *ctx)
   PetscCall(LinearizedEPSCreate(comm, &eps));
   PetscCall(EPSSetFromOptions(eps));
   PetscCall(EPSDestroy(&eps));
+  if (o.coriolis) {
+    PEP pep;
+    PetscCall(LinearizedPEPCreate(comm, &pep));
+    PetscCall(PEPSetFromOptions(pep));
+    PetscCall(PEPDestroy(&pep));
+  }
   PetscFunctionReturn(0);
 }
 
@@ -140,10 +205,12 @@ typedef struct {
   PetscInt    nqv, nqi, nQ; /* discrete velocities, impulses, both */
   PetscInt   *qmap;         /* discrete unknown -> Q index (-1: a configuration unknown, dropped) */
   PetscInt   *Qq;           /* Q index -> discrete unknown */
-  Mat         K, Mvv;       /* field stiffness (stress eliminated) and mass: built once */
-  Mat         A, B;         /* the saddle-point pencil (the same nonzero pattern in every configuration) */
+  Mat         K, Mvv;       /* field stiffness (stress eliminated; with a stressed or spinning state's K_sigma + Cen) and mass */
+  Mat         Gyr;          /* the fields' gyroscopic (Coriolis) matrix about a spin, or NULL */
+  Mat         A, B, A1;     /* the saddle-point pencil (the same nonzero pattern in every configuration); A1 its Coriolis part */
   IS          isV, isQ;     /* the velocity field and Q in the pencil's numbering */
   PetscReal   scale;        /* |M| (the at-rest checks are relative to it) */
+  PetscBool   coriolis;     /* -linearized_coriolis: the Coriolis part kept (a quadratic eigenproblem) */
 } Pencil;
 
 /* the n values of a vector that lives on rank 0, on every rank */
@@ -216,33 +283,20 @@ static PetscErrorCode BodiesOperator(PhlexSystem sys, PetscInt which, Mat *S)
   PetscFunctionReturn(0);
 }
 
-/* |A x| / |E x| for a random x, with A = 2 J1 - J2 and E = J2 - J1 from the products y1 = J1 x, y2 = J2 x */
-static PetscErrorCode RelativeAPart(Vec y1, Vec y2, PetscReal *rel)
-{
-  Vec       a;
-  PetscReal na, ne;
-
-  PetscFunctionBeginUser;
-  PetscCall(VecDuplicate(y1, &a));
-  PetscCall(VecAXPBYPCZ(a, 2.0, -1.0, 0.0, y1, y2)); /* 2 y1 - y2 */
-  PetscCall(VecNorm(a, NORM_2, &na));
-  PetscCall(VecAXPBYPCZ(a, -1.0, 1.0, 0.0, y1, y2)); /* y2 - y1 */
-  PetscCall(VecNorm(a, NORM_2, &ne));
-  PetscCall(VecDestroy(&a));
-  *rel = na / PetscMax(ne, PETSC_SMALL);
-  PetscFunctionReturn(0);
-}
-
-/* The field operators, once: the bodies' velocity masses M and condensed stiffnesses K = G^T Ms^{-1} G (the stress
+/* The field operators: the bodies' velocity masses M and condensed stiffnesses K = G^T Ms^{-1} G (the stress
    eliminated cell by cell, so that the self-equilibrated stresses of the mixed form, each a zero eigenvalue, are
-   gone), from the part contract. Checks on a random vector that the
-   velocity rows have no term in v or u at the linearisation point (at rest: no gyroscopic load, no preload) and
-   that the velocity block of the system's Jacobian is s M there. */
+   gone), from the part contract; about a stressed or spinning steady state (a body with -spin, or with
+   -geometric_stiffening and a stress), K gains the state's stiffness K_sigma + Cen (initial stress, spin softening)
+   and G(u0) replaces G, and the Coriolis matrix is the pencil's gyroscopic part. Checks on a random vector that the
+   velocity rows have no other term in v or u at the linearisation point (at rest: no other gyroscopic load, no
+   preload) and that the velocity block of the system's Jacobian is s M + Coriolis there. Rebuilt per configuration
+   of a spin sweep (the state and its stress change); built once otherwise. */
 static PetscErrorCode BuildFieldOperators(Pencil *p)
 {
   PhlexSystem sys = p->sys;
-  Vec         x, y1, y2, yu1, yu2, xu = NULL;
+  Vec         x, y1, y2, yu1, yu2, xu = NULL, g = NULL;
   PetscReal   rel, dev, nm;
+  Mat         Kst = NULL, Gyr = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(sys->Jvv, &x, &y1));
@@ -260,15 +314,46 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
   PetscCall(EvaluateJacobian(p, 2.0));
   PetscCall(MatMult(sys->Jvv, x, y2));
   if (xu) PetscCall(MatMult(sys->Jvu, xu, yu2));
-  /* the bodies' own mass and condensed stiffness (taken apart they would lose digits to cancellation) */
+  /* the bodies' own mass and condensed stiffness (taken apart they would lose digits to cancellation), at the state */
+  PetscCall(MatDestroy(&p->Mvv));
+  PetscCall(MatDestroy(&p->K));
+  PetscCall(MatDestroy(&p->Gyr));
   PetscCall(BodiesOperator(sys, 1, &p->Mvv));
   PetscCall(BodiesOperator(sys, 2, &p->K));
+  PetscCall(PhlexSystemCondensedOperator(sys, 3, &Kst));
+  PetscCall(PhlexSystemCondensedOperator(sys, 4, &Gyr));
+  if (Kst) {
+    Mat Ka;
+    PetscCall(ToAIJ(Kst, &Ka));
+    PetscCall(MatAXPY(p->K, 1.0, Ka, DIFFERENT_NONZERO_PATTERN));
+    PetscCall(MatDestroy(&Ka));
+  }
+  if (Gyr) PetscCall(ToAIJ(Gyr, &p->Gyr));
   PetscCall(MatSetOption(p->K, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(MatNorm(p->Mvv, NORM_FROBENIUS, &nm));
   p->scale = nm;
-  /* at rest: the velocity block of the Jacobian is s M, nothing else */
-  PetscCall(RelativeAPart(y1, y2, &rel));
-  PetscCheck(rel <= 1e-10, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the velocity equations have terms in v at the linearisation point (relative size %g): the bodies are not at rest (a spinning frame); the linearisation about a steady motion is not this analysis", (double)rel);
+  /* at rest or in a steady spin: the velocity block of the Jacobian is s M + Coriolis, nothing else */
+  PetscCall(VecDuplicate(y1, &g));
+  PetscCall(VecAXPBYPCZ(g, 2.0, -1.0, 0.0, y1, y2)); /* its A part */
+  if (Gyr) {
+    Vec gx;
+    PetscCall(VecDuplicate(y1, &gx));
+    PetscCall(MatMult(Gyr, x, gx));
+    PetscCall(VecAXPY(g, -1.0, gx)); /* less the Coriolis term */
+    PetscCall(VecDestroy(&gx));
+  }
+  {
+    PetscReal na, ne;
+    Vec       e;
+    PetscCall(VecNorm(g, NORM_2, &na));
+    PetscCall(VecDuplicate(y1, &e));
+    PetscCall(VecAXPBYPCZ(e, -1.0, 1.0, 0.0, y1, y2));
+    PetscCall(VecNorm(e, NORM_2, &ne));
+    PetscCall(VecDestroy(&e));
+    rel = na / PetscMax(ne, PETSC_SMALL);
+  }
+  PetscCheck(rel <= 1e-10, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the velocity equations have terms in v at the linearisation point (relative size %g): the bodies are not at rest (a spinning frame); the analysis linearises about rest or about a body's prescribed steady spin (-<body>_spin)", (double)rel);
+  PetscCall(VecDestroy(&g));
   {
     Vec mx;
     PetscCall(VecDuplicate(y1, &mx));
@@ -281,11 +366,22 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
     PetscCheck(dev <= 1e-10 * rel, sys->comm, PETSC_ERR_PLIB, "linearized analysis: a body's condensed operator does not match its Jacobian's velocity block (relative deviation %g)", (double)(dev / rel));
   }
   if (xu) {
-    PetscReal n1, n2;
+    PetscReal n1, n2, ns = 0;
+    if (Kst) {
+      Vec k;
+      PetscCall(VecDuplicate(yu1, &k));
+      PetscCall(MatMult(Kst, xu, k));
+      PetscCall(VecNorm(k, NORM_2, &ns));
+      PetscCall(VecAXPY(yu1, -1.0, k));
+      PetscCall(VecAXPY(yu2, -1.0, k));
+      PetscCall(VecDestroy(&k));
+    }
     PetscCall(VecNorm(yu1, NORM_2, &n1));
     PetscCall(VecNorm(yu2, NORM_2, &n2));
-    PetscCheck(PetscMax(n1, n2) <= 1e-10 * rel, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the displacement acts on the velocity equations at the linearisation point (relative size %g): a loaded or moving state; linearise about an unloaded configuration at rest", (double)(PetscMax(n1, n2) / rel));
+    PetscCheck(PetscMax(n1, n2) <= 1e-10 * PetscMax(rel, ns), sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the displacement acts on the velocity equations at the linearisation point (relative size %g): a loaded or moving state; linearise about an unloaded configuration at rest or a prescribed steady spin", (double)(PetscMax(n1, n2) / rel));
   }
+  PetscCall(MatDestroy(&Kst));
+  PetscCall(MatDestroy(&Gyr));
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&xu));
   PetscCall(VecDestroy(&y1));
@@ -559,6 +655,19 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       PetscCall(MatDestroy(&A));
       PetscCall(MatDestroy(&B));
     }
+    if (p->Gyr && p->coriolis) {
+      /* the Coriolis part: [[Gyr, 0], [0, 0]] */
+      Mat G[4] = {p->Gyr, NULL, NULL, NULL}, A1;
+      IS  is[2] = {p->isV, p->isQ};
+      PetscCall(MatCreateNest(sys->comm, 2, is, 2, is, G, &N));
+      PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &A1));
+      PetscCall(MatDestroy(&N));
+      if (!p->A1) p->A1 = A1;
+      else {
+        PetscCall(MatCopy(A1, p->A1, SAME_NONZERO_PATTERN));
+        PetscCall(MatDestroy(&A1));
+      }
+    }
   }
   PetscCall(MatDestroy(&AvQ));
   PetscCall(MatDestroy(&BvQ));
@@ -644,7 +753,8 @@ static PetscErrorCode MoveTo(Pencil *p, PhlexJoint j, PetscReal from, PetscReal 
 
 typedef struct {
   PetscInt   n, nmech;
-  PetscReal *theta, *resid; /* non-dimensional omega^2, ascending; relative residuals */
+  PetscReal *theta, *resid; /* non-dimensional omega^2 (the oscillating part's), ascending; relative residuals */
+  PetscReal *growth;        /* non-dimensional growth rate of an unstable mode (0: stable) */
   Vec       *x;             /* eigenvectors (pencil numbering), when asked */
 } Spectrum;
 
@@ -653,7 +763,7 @@ static PetscErrorCode SpectrumDestroy(Spectrum *s)
   PetscFunctionBeginUser;
   for (PetscInt i = 0; s->x && i < s->n; i++) PetscCall(VecDestroy(&s->x[i]));
   PetscCall(PetscFree(s->x));
-  PetscCall(PetscFree2(s->theta, s->resid));
+  PetscCall(PetscFree3(s->theta, s->resid, s->growth));
   PetscCall(PetscMemzero(s, sizeof(*s)));
   PetscFunctionReturn(0);
 }
@@ -679,7 +789,7 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
   PetscCall(EPSGetConverged(eps, &nconv));
   PetscCheck(nconv >= want, p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: the eigensolver converged %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs wanted (%" PetscInt_FMT " mechanism modes + -linearized_nev %" PetscInt_FMT "); see -linearized_eps_monitor, -linearized_eps_ncv", nconv, want, nmech, nev);
   s->n = want;
-  PetscCall(PetscMalloc2(want, &s->theta, want, &s->resid));
+  PetscCall(PetscCalloc3(want, &s->theta, want, &s->resid, want, &s->growth));
   if (vectors) PetscCall(PetscCalloc1(want, &s->x));
   {
     /* ascending eigenvalues (a target given with -linearized_eps_target changes the solver's order); a zero one
@@ -701,7 +811,8 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
       PetscScalar    kr, ki;
       PetscCall(EPSGetEigenpair(eps, e, &kr, &ki, x, NULL));
       s->theta[i] = PetscRealPart(kr);
-      if (PetscAbsReal(s->theta[i]) <= 1e-8 * thmax) {
+      if (s->theta[i] < -1e-8 * thmax) s->growth[i] = PetscSqrtReal(-s->theta[i]), s->theta[i] = 0.0; /* divergence: K indefinite (a spin beyond a critical speed) */
+      if (PetscAbsReal(s->theta[i]) <= 1e-8 * thmax && !s->growth[i]) {
         nzero++;
         /* the relative residual divides by the eigenvalue: the backward error instead */
         PetscCall(EPSComputeError(eps, e, EPS_ERROR_BACKWARD, &s->resid[i]));
@@ -716,6 +827,72 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
   PetscCall(VecDestroy(&x));
   s->nmech = nzero;
   PetscCheck(nzero == nmech, p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: %" PetscInt_FMT " zero-frequency modes found where the constraints leave %" PetscInt_FMT " mechanism modes: a body's rigid motion is free without a frame (a fixed body without a clamp), or the spectrum is badly scaled (-scale_length)", nzero, nmech);
+  PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* About a spin with the Coriolis coupling kept: (A0 + lambda A1 + lambda^2 A2) x = 0 with A0 the saddle point of K,
+   A1 the Coriolis part, A2 = diag(M, 0) and lambda = s the Laplace variable. The gyroscopic structure gives the
+   eigenvalues in pairs +-lambda (and their conjugates): a stable mode is lambda = +-i omega, a divergence +-sigma
+   real, a flutter sigma +- i omega. The lowest nev modes (one of each pair), ascending in |lambda|. */
+static PetscErrorCode SolveGyroscopic(Pencil *p, PEP pep, PetscInt nev, PetscInt nmech, PetscBool vectors, Spectrum *s)
+{
+  Mat       A[3] = {p->A, p->A1, p->B};
+  PetscInt  nconv, n = 0;
+  Vec       xr, xi;
+  PetscReal *mag, *om, *gr, *res, lmax = 0;
+  PetscInt  *idx, *perm;
+
+  PetscFunctionBeginUser;
+  PetscCheck(!nmech, p->sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration has %" PetscInt_FMT " mechanism modes; with the Coriolis coupling of a spin (a quadratic eigenproblem) a zero eigenvalue is defective: give -linearized_coriolis false, or hold the mechanism", nmech);
+  PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscCall(PEPSetOperators(pep, 3, A));
+  PetscCall(PEPSetDimensions(pep, 2 * nev, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(PEPSolve(pep));
+  PetscCall(PEPGetConverged(pep, &nconv));
+  PetscCall(PetscMalloc6(nconv, &mag, nconv, &om, nconv, &gr, nconv, &res, nconv, &idx, nconv, &perm));
+  PetscCall(MatCreateVecs(p->A, &xr, NULL));
+  PetscCall(VecDuplicate(xr, &xi));
+  for (PetscInt i = 0; i < nconv; i++) {
+    PetscScalar kr, ki;
+    PetscCall(PEPGetEigenpair(pep, i, &kr, &ki, NULL, NULL));
+    lmax = PetscMax(lmax, PetscSqrtReal(PetscRealPart(kr) * PetscRealPart(kr) + PetscRealPart(ki) * PetscRealPart(ki)));
+  }
+  for (PetscInt i = 0; i < nconv; i++) {
+    PetscScalar     kr, ki;
+    PetscReal       re, im, m;
+    PetscCall(PEPGetEigenpair(pep, i, &kr, &ki, NULL, NULL));
+    re = PetscRealPart(kr), im = PetscRealPart(ki), m = PetscSqrtReal(re * re + im * im);
+    /* one of each pair: the one with im > 0, or the growing one of a real pair (re > 0) */
+    if (im < -1e-10 * lmax || (PetscAbsReal(im) <= 1e-10 * lmax && re < 0)) continue;
+    mag[n] = m, om[n] = PetscMax(im, 0.0), gr[n] = PetscAbsReal(re) > 1e-8 * m ? PetscAbsReal(re) : 0.0, idx[n] = i, perm[n] = n;
+    PetscCall(PEPComputeError(pep, i, PEP_ERROR_BACKWARD, &res[n]));
+    n++;
+  }
+  PetscCheck(n >= nev, p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: the quadratic eigensolver converged %" PetscInt_FMT " of the %" PetscInt_FMT " modes wanted (-linearized_nev); see -linearized_pep_monitor, -linearized_pep_ncv", n, nev);
+  PetscCall(PetscSortRealWithPermutation(n, mag, perm));
+  s->n     = nev;
+  s->nmech = 0;
+  PetscCall(PetscCalloc3(nev, &s->theta, nev, &s->resid, nev, &s->growth));
+  if (vectors) PetscCall(PetscCalloc1(nev, &s->x));
+  for (PetscInt k = 0; k < nev; k++) {
+    const PetscInt j = perm[k];
+    s->theta[k]  = om[j] * om[j];
+    s->growth[k] = gr[j];
+    s->resid[k]  = res[j];
+    if (vectors) {
+      /* the real shape at the phase where it is largest (a gyroscopic mode is complex: a travelling or elliptic motion) */
+      PetscReal nr, ni;
+      PetscCall(PEPGetEigenpair(pep, idx[j], NULL, NULL, xr, xi));
+      PetscCall(VecNorm(xr, NORM_2, &nr));
+      PetscCall(VecNorm(xi, NORM_2, &ni));
+      PetscCall(VecDuplicate(xr, &s->x[k]));
+      PetscCall(VecCopy(nr >= ni ? xr : xi, s->x[k]));
+    }
+  }
+  PetscCall(PetscFree6(mag, om, gr, res, idx, perm));
+  PetscCall(VecDestroy(&xr));
+  PetscCall(VecDestroy(&xi));
   PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -785,6 +962,38 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
   PetscFunctionReturn(0);
 }
 
+/* the parts' steady states (a prescribed spin's centrifugal stretch and its stress; at rest nothing moves) */
+static PetscErrorCode SteadyStates(Pencil *p)
+{
+  PhlexSystem sys = p->sys;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSystemGather(sys, p->X, sys->q));
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart    part = sys->parts[i];
+    PhlexPartVec pv;
+    if (!part->ops.steadystate) continue;
+    PetscCall(PhlexSystemPartVec(sys, part, p->X, sys->q, &pv));
+    PetscCall((*part->ops.steadystate)(part, &pv));
+    PetscCall(PhlexSystemPartVecRestore(sys, part, p->X, &pv));
+  }
+  PetscFunctionReturn(0);
+}
+
+/* the part on a prescribed spin (a spin sweep needs exactly one) */
+static PetscErrorCode SpinningPart(PhlexSystem sys, PhlexPart *spun, PetscInt *nspun)
+{
+  PetscFunctionBeginUser;
+  *spun  = NULL;
+  *nspun = 0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PetscReal rate = -1;
+    if (sys->parts[i]->ops.spinrate) PetscCall((*sys->parts[i]->ops.spinrate)(sys->parts[i], PETSC_FALSE, &rate));
+    if (rate >= 0) *spun = sys->parts[i], (*nspun)++;
+  }
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSceneSolveLinearized - linearised analysis of the assembly: the lowest frequencies and mode shapes of the
   whole mechanism linearised about configurations at rest, swept over a driven joint's position in one run
@@ -796,6 +1005,9 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
 . -linearized_sweep_joint <name>          - the driven joint whose position is swept (default: the only driven joint)
 . -linearized_sweep a,b,...               - its positions [deg or m, as -drive_initial]
 . -linearized_sweep_range start,stop,step - the same as a range (stop included)
+. -linearized_spin_sweep w1,w2,...       - spin rates [rad/s] of the body with -spin (its steady state for each)
+. -linearized_spin_sweep_range start,stop,step - the same as a range
+. -linearized_coriolis <bool>             - about a spin, keep the Coriolis coupling (default true: quadratic eigenproblem)
 . -linearized_fields_configuration <k>    - the configuration whose mode shapes are written (default 0; -1 none)
 . -expect_frequencies f1,f2,...           - self-check: elastic frequencies [Hz] of the first configuration
 . -expect_frequencies_rtol <r>            - its relative tolerance (default 1e-6)
@@ -803,7 +1015,9 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
 - -linearized_eps_*, -linearized_st_*     - SLEPc options (defaults: Krylov-Schur, shift-and-invert, LDL^T by MUMPS)
 
   Notes:
-  A driven joint is held at its position (its drive row is a constraint: a clamped crank). Writes
+  A driven joint is held at its position (its drive row is a constraint: a clamped crank). A body with -spin is
+  linearised about its steady spin in its rotating frame: the centrifugal stretch u0 and its stress (Newton with
+  -geometric_stiffening), the stiffness G(u0)^T Ms^{-1} G(u0) + K_sigma + Cen and the Coriolis coupling. Writes
   linearized_modes.csv (every mode of every configuration), linearized_sweep.csv (one row per configuration) and the
   mode shapes of one configuration.
 @*/
@@ -813,6 +1027,9 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   Pencil            p;
   PhlexJoint        joint = NULL;
   EPS               eps;
+  PEP               pep = NULL;
+  PhlexPart         spun = NULL;
+  PetscInt          nspun = 0;
   PetscViewer       csv, sweep;
   PetscReal         here = 0, worst = 0, *fexp = NULL, unit = 1;
   PetscInt          nconfig, nfexp = 0, Nd;
@@ -840,6 +1057,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body; rigid bodies and point masses on joints have no elastic modes about rest");
   }
   PetscCall(PetscMemzero(&p, sizeof(p)));
+  p.coriolis = o.coriolis;
   PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
   PetscCall(PetscTime(&t0));
   PetscCall(PhlexSystemCreateForScene(scene, &p.sys, &p.X));
@@ -849,14 +1067,24 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   if (p.sys->njoints) PetscCall(PhlexAssemblyClose(p.sys, 0.0, p.X, PETSC_TRUE, NULL));
   if (p.sys->njoints) PetscCall(PhlexSystemUpdateJoints(p.sys, p.X, 0.0));
   PetscCall(SetRest(&p));
+  PetscCall(SpinningPart(p.sys, &spun, &nspun));
+  if (o.nspins) {
+    PetscCheck(nspun == 1, scene->comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep: sweeps the rate of the body with -<body>_spin; the scene has %" PetscInt_FMT " such bodies", nspun);
+    PetscCall((*spun->ops.spinrate)(spun, PETSC_TRUE, &o.spins[0]));
+  }
+  PetscCall(SteadyStates(&p));
   PetscCall(CheckEquilibrium(&p));
   if (p.sys->nfparts) PetscCall(BuildFieldOperators(&p));
   else p.scale = 1.0;
+  if (p.Gyr && p.coriolis) {
+    PetscCall(LinearizedPEPCreate(scene->comm, &pep));
+    PetscCall(PEPSetFromOptions(pep));
+  }
   PetscCall(PetscTime(&t1));
   tbuild += t1 - t0;
 
   /* the configurations */
-  nconfig = PetscMax(o.nvalues, 1);
+  nconfig = PetscMax(PetscMax(o.nvalues, o.nspins), 1);
   if (o.nvalues || o.joint[0]) {
     PetscCall(SweepJoint(p.sys, o.joint, &joint));
     unit  = joint->drive_row == PHLEX_ROW_R3 ? PETSC_PI / 180.0 : 1.0;
@@ -866,7 +1094,19 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCheck(o.fields_configuration < nconfig, scene->comm, PETSC_ERR_USER_INPUT, "-linearized_fields_configuration %" PetscInt_FMT ": the run has %" PetscInt_FMT " configurations (0-based)", o.fields_configuration, nconfig);
   Nd = 0;
   if (p.sys->nfparts) PetscCall(MatGetSize(p.Mvv, &Nd, NULL));
-  PetscCall(PetscPrintf(scene->comm, "Linearised analysis of the assembly about rest: %" PetscInt_FMT " configuration%s", nconfig, nconfig == 1 ? "" : "s"));
+  if (spun) {
+    char      w[32];
+    PetscReal rate;
+    PetscCall((*spun->ops.spinrate)(spun, PETSC_FALSE, &rate));
+    PhlexFormatReal(rate, w, sizeof(w));
+    PetscCall(PetscPrintf(scene->comm, "Linearised analysis about the steady spin of body %s (%s rad/s%s; Coriolis coupling %s): %" PetscInt_FMT " configuration%s", spun->name, w, o.nspins > 1 ? " first" : "", pep ? "kept, quadratic eigenproblem" : (p.Gyr ? "left out" : "none"), nconfig, nconfig == 1 ? "" : "s"));
+    if (o.nspins > 1) {
+      char a[32], b[32];
+      PhlexFormatReal(o.spins[0], a, sizeof(a));
+      PhlexFormatReal(o.spins[o.nspins - 1], b, sizeof(b));
+      PetscCall(PetscPrintf(scene->comm, " of spin rate %s to %s rad/s", a, b));
+    }
+  } else PetscCall(PetscPrintf(scene->comm, "Linearised analysis of the assembly about rest: %" PetscInt_FMT " configuration%s", nconfig, nconfig == 1 ? "" : "s"));
   if (joint) {
     char a[32], b[32];
     PhlexFormatReal(o.nvalues ? o.values[0] : here / unit, a, sizeof(a));
@@ -876,18 +1116,18 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " elastic frequencies each\n", o.nev));
   PetscCall(PetscPrintf(scene->comm, "  pencil: %" PetscInt_FMT " field velocities, %" PetscInt_FMT " discrete velocities, %" PetscInt_FMT " constraint rows (stress eliminated, positions at rest dropped)\n", Nd, p.nqv, p.nqi));
 
-  PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_modes.csv", "configuration,position,mode,kind,frequency_hz,omega_rad_s,relative_residual", &csv));
+  PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_modes.csv", "configuration,position,mode,kind,frequency_hz,omega_rad_s,relative_residual,growth_rate_1_s", &csv));
   PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_sweep.csv", NULL, &sweep));
   PetscCall(PetscViewerASCIIPrintf(sweep, "configuration,position,mechanism_modes"));
   for (PetscInt m = 0; m < o.nev; m++) PetscCall(PetscViewerASCIIPrintf(sweep, ",omega%" PetscInt_FMT "_rad_s", m + 1));
   PetscCall(PetscViewerASCIIPrintf(sweep, "\n"));
   if (nconfig > 1) {
-    PetscCall(PetscPrintf(scene->comm, "  %6s %12s  %4s", "config", joint ? (joint->drive_row == PHLEX_ROW_R3 ? "angle [deg]" : "slide [m]") : "", "mech"));
+    PetscCall(PetscPrintf(scene->comm, "  %6s %12s  %4s", "config", joint ? (joint->drive_row == PHLEX_ROW_R3 ? "angle [deg]" : "slide [m]") : (o.nspins ? "spin [rad/s]" : ""), "mech"));
     for (PetscInt m = 0; m < o.nev; m++) PetscCall(PetscPrintf(scene->comm, "   f%-2" PetscInt_FMT " [Hz]    ", m + 1));
     PetscCall(PetscPrintf(scene->comm, "\n"));
   }
   for (PetscInt c = 0; c < nconfig; c++) {
-    const PetscReal pos = o.nvalues ? o.values[c] : here / unit;
+    const PetscReal pos = o.nvalues ? o.values[c] : (o.nspins ? o.spins[c] : here / unit);
     const PetscBool shapes = (PetscBool)(c == o.fields_configuration && scene->output->fields);
     PetscInt        nmech;
     Spectrum        s;
@@ -898,12 +1138,20 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
       PetscCall(SetRest(&p));
       PetscCall(CheckEquilibrium(&p));
     }
+    if (o.nspins && c > 0) {
+      /* the next spin rate: its steady state from the previous one, and the field operators about it */
+      PetscCall((*spun->ops.spinrate)(spun, PETSC_TRUE, &o.spins[c]));
+      PetscCall(SteadyStates(&p));
+      PetscCall(CheckEquilibrium(&p));
+      PetscCall(BuildFieldOperators(&p));
+    }
     PetscCall(BuildPencil(&p, &nmech));
     PetscCall(PetscTime(&t1));
     tbuild += t1 - t0;
     t0 = t1;
     PetscCall(PetscMemzero(&s, sizeof(s)));
-    PetscCall(SolvePencil(&p, eps, o.nev, nmech, shapes, &s));
+    if (pep) PetscCall(SolveGyroscopic(&p, pep, o.nev, nmech, shapes, &s));
+    else PetscCall(SolvePencil(&p, eps, o.nev, nmech, shapes, &s));
     PetscCall(PetscTime(&t1));
     tsolve += t1 - t0;
     if (nconfig == 1) {
@@ -914,9 +1162,17 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
       const PetscBool mech  = (PetscBool)(i < s.nmech);
       const PetscReal omega = mech ? 0.0 : PetscSqrtReal(PetscAbsReal(s.theta[i])) / scene->units.time;
       const PetscReal f     = omega / (2.0 * PETSC_PI);
-      if (nconfig == 1) PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-18.10g   %-9s  %.1e\n", i + 1, (double)f, (double)omega, mech ? "mechanism" : "elastic", (double)s.resid[i]));
-      else if (!mech && i - s.nmech < o.nev) PetscCall(PetscPrintf(scene->comm, "  %-14.8g", (double)f));
-      PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT ",%s,%.12e,%.12e,%.3e\n", c, (double)pos, i + 1, mech ? "mechanism" : "elastic", (double)f, (double)omega, (double)s.resid[i]));
+      const PetscReal grow  = s.growth[i] / scene->units.time; /* 1/s */
+      const char     *kind  = mech ? "mechanism" : (grow > 0 ? "unstable" : "elastic");
+      if (nconfig == 1) {
+        PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-18.10g   %-9s  %.1e", i + 1, (double)f, (double)omega, kind, (double)s.resid[i]));
+        if (grow > 0) PetscCall(PetscPrintf(scene->comm, "  (grows as exp(%.6g t))", (double)grow));
+        PetscCall(PetscPrintf(scene->comm, "\n"));
+      } else if (!mech && i - s.nmech < o.nev) {
+        if (grow > 0) PetscCall(PetscPrintf(scene->comm, "  %-14s", "unstable"));
+        else PetscCall(PetscPrintf(scene->comm, "  %-14.8g", (double)f));
+      }
+      PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT ",%s,%.12e,%.12e,%.3e,%.12e\n", c, (double)pos, i + 1, kind, (double)f, (double)omega, (double)s.resid[i], (double)grow));
       if (!mech && i - s.nmech < o.nev) PetscCall(PetscViewerASCIIPrintf(sweep, ",%.12e", (double)omega));
       if (!mech) worst = PetscMax(worst, s.resid[i]);
       if (c == 0 && o.nexp && !mech) {
@@ -930,7 +1186,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCall(SpectrumDestroy(&s));
     PetscCall(PhlexInterruptCheck(scene->comm, "linearized analysis"));
   }
-  PetscCall(PetscPrintf(scene->comm, "  time: %.3g s building the pencils (K and M once, the constraint rows per configuration), %.3g s in the eigensolver (%.3g s per configuration)\n", tbuild, tsolve, tsolve / nconfig));
+  PetscCall(PetscPrintf(scene->comm, "  time: %.3g s building the pencils (%s), %.3g s in the eigensolver (%.3g s per configuration)\n", tbuild, o.nspins ? "the steady state and K per spin rate, M once" : "K and M once, the constraint rows per configuration", tsolve, tsolve / nconfig));
   PetscCall(PetscLogStagePop());
   PetscCall(PetscViewerDestroy(&csv));
   PetscCall(PetscViewerDestroy(&sweep));
@@ -939,8 +1195,11 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   if (o.nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nfexp, fexp, o.nexp, o.expected, o.rtol));
   PetscCall(PetscFree(fexp));
   PetscCall(EPSDestroy(&eps));
+  PetscCall(PEPDestroy(&pep));
   PetscCall(MatDestroy(&p.A));
   PetscCall(MatDestroy(&p.B));
+  PetscCall(MatDestroy(&p.A1));
+  PetscCall(MatDestroy(&p.Gyr));
   PetscCall(MatDestroy(&p.K));
   PetscCall(MatDestroy(&p.Mvv));
   PetscCall(ISDestroy(&p.isV));

@@ -298,7 +298,7 @@ static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys)
   char    **argv;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscStrcpy(file, !sys->nfparts ? "options/solver/rigid.opts" : (sys->nq ? "options/solver/bordered.opts" : "options/solver/exact.opts")));
+  PetscCall(PetscStrcpy(file, !sys->nfparts ? "options/solver/rigid.opts" : (sys->nq ? "options/solver/bordered.opts" : (sys->inexact_schur ? "options/solver/exact_krylov.opts" : "options/solver/exact.opts"))));
   PetscCall(SolverPresetOption(comm, file));
   if (!file[0]) PetscFunctionReturn(0);
   PetscCall(PetscTestFile(file, 'r', &exists));

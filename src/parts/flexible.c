@@ -50,6 +50,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   char         *rptr[PHLEX_MAX_MATERIALS + 1], **pptr; /* room for one more region: too many are refused, not cut */
   PetscInt      nregions = PHLEX_MAX_MATERIALS + 1, nports;
   PetscBool     flg, flg_mesh = PETSC_FALSE, has_body_material, fcond = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE;
+  PetscBool     spin_given = PETSC_FALSE, center_given = PETSC_FALSE;
   PetscInt      motion = 0, inertia = 0, cond = PHLEX_FRAME_PATCH;
   const char   *given = NULL;
   char          who[PHLEX_NAME_LEN + 8];
@@ -86,7 +87,17 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCall(PhlexPoseSetFromOptions(PetscOptionsObject, part, &b->pose, &given));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_force", "Floating body: force on the frame origin P (body frame) [N]", "PhlexFlexibleSetFromOptions", 3, b->frame_force, &ff));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_moment", "Floating body: moment about the frame origin P (body frame) [N m]", "PhlexFlexibleSetFromOptions", 3, b->frame_moment, &fm));
+  PetscCall(PetscOptionsBool("-geometric_stiffening", "Green-Lagrange strain of the field in its frame (Saint Venant-Kirchhoff): the stress stiffens the field against transverse displacement (centrifugal stiffening of a spinning beam); the power balance still holds exactly", "PhlexFlexibleSetFromOptions", b->stiffening, &b->stiffening, NULL));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin", "Fixed body: constant angular velocity of its hub; the body's frame rotates uniformly about -spin_center (inertial loads of the rotating frame; the linearised analysis linearises about the steady spin) [rad/s]", "PhlexFlexibleSetFromOptions", 3, b->spin, &spin_given));
+  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin_center", "Fixed body with -spin: a point of the spin axis (mesh coordinates) [m]", "PhlexFlexibleSetFromOptions", 3, b->spin_center, &center_given));
   PetscOptionsEnd();
+  b->spinning = (PetscBool)(spin_given && (b->spin[0] != 0 || b->spin[1] != 0 || b->spin[2] != 0));
+  if (b->spinning) {
+    const PetscReal w = PetscSqrtReal(b->spin[0] * b->spin[0] + b->spin[1] * b->spin[1] + b->spin[2] * b->spin[2]);
+    for (PetscInt k = 0; k < 3; k++) b->spin_axis[k] = b->spin[k] / w;
+  }
+  PetscCheck(!spin_given || !motion, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin is the prescribed spin of a fixed body's hub; a floating body spins through its frame (-%sangular_velocity, or a driven joint)", b->name, b->prefix, b->prefix);
+  PetscCheck(!center_given || spin_given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin_center without -%sspin: give the spin's angular velocity", b->name, b->prefix, b->prefix);
   b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
   b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
   b->gyroscopic     = inertia == 1 ? PETSC_TRUE : PETSC_FALSE;
@@ -227,6 +238,7 @@ static PetscErrorCode SetUpLayout(PhlexPart part)
     part->nonlinear           = PETSC_TRUE;
     part->nonquadratic_energy = b->frozen_inertia ? PETSC_FALSE : PETSC_TRUE;
   }
+  if (b->stiffening) part->nonlinear = PETSC_TRUE; /* G(u) */
   PetscFunctionReturn(0);
 }
 
@@ -285,6 +297,13 @@ static PetscErrorCode FlexSetUp(PhlexPart part)
   }
   PetscCall(DMCreateGlobalVector(b->dm, &b->load));
   PetscCall(VecDuplicate(b->load, &b->work));
+  if (b->spinning) {
+    char w[3][32];
+    for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(b->spin[k], w[k], sizeof(w[k]));
+    /* the weight would turn in the rotating frame; a prescribed spin is its own world */
+    PetscCheck(part->gravity[0] == 0 && part->gravity[1] == 0 && part->gravity[2] == 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin %s,%s,%s with gravity: the weight turns in the spinning frame; remove -gravity (a spin much faster than the weight's effect) or model the hub as a driven joint", b->name, b->prefix, w[0], w[1], w[2]);
+    PetscCheck(b->frame_patch[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin %s,%s,%s needs the body clamped to its hub (-%sframe_patch <surface>)", b->name, b->prefix, w[0], w[1], w[2], b->prefix);
+  }
   if (!b->floating && (part->gravity[0] != 0 || part->gravity[1] != 0 || part->gravity[2] != 0)) {
     /* the weight of a fixed body as a nodal load: t(l) g_c on component c (gravity is a potential: no input power) */
     PetscScalar       *ga;
@@ -368,6 +387,8 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(VecDestroy(&b->bgrav));
   PetscCall(PetscFree3(b->port_ext, b->port_y, b->port_ubar));
   PetscCall(PetscFree(b->port_basis_col));
+  PetscCall(PhlexFlexibleStiffeningDestroy(b));
+  PetscCall(PhlexFlexibleSpinDestroy(b));
   PetscCall(PhlexFlexibleDestroyFE(b));
   PetscCall(PetscFree(part->data));
   PetscFunctionReturn(0);
@@ -385,6 +406,7 @@ static PetscErrorCode FlexEnergy(PhlexPart part, const PhlexPartVec *X, PetscRea
   PetscCall(PhlexFlexibleEnergy(b, X->v, X->s, kin, strain));
   *pot = 0.0;
   if (b->floating) PetscCall(PhlexFrameEnergy(&b->frame, &b->fs, X->v, kin, pot));
+  else if (b->spinning) PetscCall(PhlexFlexibleSpinEnergy(b, X->u, pot)); /* centrifugal potential */
   else if (b->bgrav) {
     /* V = -g . int rho (x + u) */
     PetscScalar gu;
@@ -561,6 +583,8 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   part->ops.refine         = PhlexFlexibleRefine;
   part->ops.modesorder     = PhlexFlexibleModesOrder;
   part->ops.modeskind      = PhlexFlexibleModesKind;
+  part->ops.steadystate    = PhlexFlexibleSpinSteadyState;
+  part->ops.spinrate       = PhlexFlexibleSpinRate;
   PetscCall(PhlexFlexibleSetDynamicsOps(part));
   PetscFunctionReturn(0);
 }

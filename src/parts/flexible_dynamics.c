@@ -363,21 +363,34 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
   PhlexFlexible   b = (PhlexFlexible)part->data;
   const PetscReal T = part->units->time;
 
+  Mat             G = b->G;
+
   PetscFunctionBeginUser;
   PetscCall(AddJointLoads(part));
+  if (b->stiffening) {
+    /* the Green-Lagrange coupling G(u) in both rows (flexible_stiffening.c) */
+    PetscCall(PhlexFlexibleCouplingUpdate(b, X->u));
+    G = b->Gu;
+  }
   /* F_u = T u' - v */
   PetscCall(VecAXPBYPCZ(F->u, T, -1.0, 0.0, Xdot->u, X->v));
   /* F_Sigma = G v - T Ms Sigma' */
   PetscCall(MatMult(b->Ms, Xdot->s, F->s));
   PetscCall(VecScale(F->s, -T));
-  PetscCall(MatMultAdd(b->G, X->v, F->s, F->s));
+  PetscCall(MatMultAdd(G, X->v, F->s, F->s));
   /* F_v = T Mv v' + G^T Sigma - b */
-  PetscCall(MatMultTranspose(b->G, X->s, F->v));
+  PetscCall(MatMultTranspose(G, X->s, F->v));
   PetscCall(VecScale(F->v, 1.0 / T));
   PetscCall(MatMultAdd(b->Mv, Xdot->v, F->v, F->v));
   PetscCall(VecScale(F->v, T));
   if (!b->floating) {
     PetscCall(VecAXPY(F->v, -1.0, b->load));
+    if (b->spinning) {
+      /* the hub's uniform spin: + Cor v + Cen (x - c + u) (flexible_spin.c) */
+      PetscCall(MatMultAdd(b->Cor, X->v, F->v, F->v));
+      PetscCall(MatMultAdd(b->Cen, X->u, F->v, F->v));
+      PetscCall(VecAXPY(F->v, 1.0, b->fcen));
+    }
     PetscFunctionReturn(0);
   }
   PetscCall(PetscLogEventBegin(PHLEX_FloatResidual, 0, 0, 0, 0));
@@ -466,6 +479,7 @@ static PetscErrorCode MatMult_Avu(Mat A, Vec x, Vec y)
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &b));
   PetscCall(NodeMassMult(b, 0.0, b->Bvu, x, y));
+  if (b->stiffening) PetscCall(MatMultAdd(b->Ksig, x, y, y)); /* the initial-stress stiffness */
   PetscFunctionReturn(0);
 }
 
@@ -501,9 +515,33 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       PetscCall(VecDuplicate(b->load, &b->vd));
       PetscCall(PetscCalloc4(PetscMax(n * part->nq, 1), &b->Bc, PetscMax(n * part->nq, 1), &b->Cu, PetscMax(n * part->nq, 1), &b->Cv, PetscMax(n * part->nq, 1), &b->Cpre));
     }
+    if (b->spinning) {
+      /* the spin's operators, and room for them in the preconditioner and the fixed body's Jvv */
+      PetscCall(PhlexFlexibleSpinSetUp(b, part->units));
+      PetscCall(MatAXPY(b->Sv, 0.0, b->Cen, DIFFERENT_NONZERO_PATTERN));
+      PetscCall(MatAXPY(b->Jvv, 0.0, b->Cor, DIFFERENT_NONZERO_PATTERN));
+      PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_FALSE));
+    }
+    if (b->stiffening) PetscCall(PhlexFlexibleStiffeningSetUp(b));
+    if (!b->floating && (b->spinning || b->stiffening)) {
+      /* the exact Schur complement is not symmetric (Coriolis, d(G(u) v)/du) */
+      PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_FALSE));
+      PetscCall(MatSetOption(b->Sv, MAT_SYMMETRIC, PETSC_FALSE));
+    }
+    if (!b->floating && (b->spinning || b->stiffening)) {
+      /* the fixed body's displacement columns: Cen + K_sigma */
+      PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, &b->Jvu));
+      PetscCall(MatZeroEntries(b->Jvu));
+      if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SUBSET_NONZERO_PATTERN));
+      PetscCall(PetscObjectSetName((PetscObject)b->Jvu, "velocity-displacement block"));
+    }
   }
-  ops->G         = b->G;
-  ops->Gt        = b->Gt;
+  ops->G         = b->stiffening ? b->Gu : b->G;
+  ops->Gt        = b->stiffening ? b->Gut : b->Gt;
+  ops->Jsu       = b->stiffening ? b->Jsu : NULL;
+  ops->Kstate    = b->floating ? (b->stiffening ? b->Ksig : NULL) : ((b->stiffening || b->spinning) ? b->Jvu : NULL);
+  ops->Gyro      = b->spinning ? b->Cor : NULL;
+  ops->inexact_schur = (PetscBool)(b->stiffening || b->spinning);
   ops->Ms        = b->Ms;
   ops->stress_bs = b->nb_s;
   ops->Jvv       = b->Jvv;
@@ -547,21 +585,44 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   const PetscInt n = b->nv_local, nq = part->nq;
   PetscReal      Arr[324];
 
+  PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift);
+
   PetscFunctionBeginUser;
-  if (PetscAbsReal(shift - b->shift) > 1e-12 * shift) {
+  if (new_shift) {
     b->shift = shift;
     if (!b->floating) {
-      PetscCall(MatCopy(b->Mvaij, b->Jvv, SAME_NONZERO_PATTERN));
+      PetscCall(MatCopy(b->Mvaij, b->Jvv, b->spinning ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
       PetscCall(MatScale(b->Jvv, shift));
+      if (b->spinning) PetscCall(MatAXPY(b->Jvv, 1.0, b->Cor, SUBSET_NONZERO_PATTERN));
       PetscCall(MatAssemblyBegin(b->Jvv, MAT_FINAL_ASSEMBLY));
       PetscCall(MatAssemblyEnd(b->Jvv, MAT_FINAL_ASSEMBLY));
     }
-    /* the preconditioner's condensed operator shift Mv + K/shift */
+  }
+  /* geometric stiffening: G(u), K_sigma, d(G(u) v)/du and the condensed stiffness at this state */
+  if (b->stiffening) PetscCall(PhlexFlexibleStiffeningJacobian(b, X->u, X->s, X->v));
+  if (new_shift || b->stiffening) {
+    /* the preconditioner's condensed operator shift Mv + (K [+ K_sigma + Cen])/shift; a fixed body's also with the
+       Coriolis term and G(u)^T Ms^{-1} d(G(u) v)/du / shift^2: the exact Schur complement of u and Sigma (not
+       symmetric, LU). A floating body's stays symmetric (its bordered preconditioner factors it by Cholesky): there
+       FGMRES takes care of those terms. */
     PetscCall(MatCopy(b->Kaij, b->Sv, SUBSET_NONZERO_PATTERN));
+    if (b->stiffening) PetscCall(MatAXPY(b->Sv, 1.0, b->Ksig, SUBSET_NONZERO_PATTERN));
+    if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cen, SUBSET_NONZERO_PATTERN));
+    if (b->stiffening && !b->floating) PetscCall(MatAXPY(b->Sv, 1.0 / shift, b->Nsu, SUBSET_NONZERO_PATTERN));
     PetscCall(MatScale(b->Sv, 1.0 / shift));
     PetscCall(MatAXPY(b->Sv, shift, b->Mvaij, SUBSET_NONZERO_PATTERN));
+    if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cor, SUBSET_NONZERO_PATTERN));
   }
-  if (!b->floating) PetscFunctionReturn(0);
+  if (!b->floating) {
+    /* the displacement columns K_sigma + Cen: K_sigma changes with the state, Cen with the spin rate (which resets
+       the shift) */
+    if (b->stiffening || (b->spinning && new_shift)) {
+      PetscCall(MatZeroEntries(b->Jvu));
+      if (b->stiffening) PetscCall(MatAXPY(b->Jvu, 1.0, b->Ksig, SUBSET_NONZERO_PATTERN));
+      if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SUBSET_NONZERO_PATTERN));
+    }
+    PetscFunctionReturn(0);
+  }
   PetscCall(PetscLogEventBegin(PHLEX_FloatJacobian, 0, 0, 0, 0));
   PetscCall(AddJointLoads(part));
   PetscCall(PhlexFrameJacobian(&b->frame, &b->fs, shift, X->u, X->v, b->Bc, b->Cu, b->Cv, n, b->Bvv, b->Bvu, Arr));

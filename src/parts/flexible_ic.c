@@ -149,7 +149,8 @@ static PetscErrorCode SetKinematicIC(PhlexPart part, const PhlexIC *ic, const ch
   PetscFunctionReturn(0);
 }
 
-/* Sigma_0 = Ms^{-1} G u_0 (the stress of the initial displacement, exact element by element) + a uniform stress */
+/* Sigma_0 = Ms^{-1} G u_0 (the stress of the initial displacement, exact element by element; with geometric stiffening
+   that of its Green-Lagrange strain) + a uniform stress */
 static PetscErrorCode SetStressIC(PhlexPart part, Vec u0, Vec s0)
 {
   PhlexFlexible     b = (PhlexFlexible)part->data;
@@ -158,7 +159,10 @@ static PetscErrorCode SetStressIC(PhlexPart part, Vec u0, Vec s0)
   PetscFunctionBeginUser;
   PetscCall(VecSet(s0, 0.0));
   PetscCall(VecNorm(u0, NORM_INFINITY, &unorm));
-  if (unorm > 0) {
+  if (unorm > 0 && b->stiffening) {
+    /* the Green-Lagrange strain's stress, Ms Sigma_0 = int psi : E(u_0) (flexible_stiffening.c) */
+    PetscCall(PhlexFlexibleStressOfDisplacement(b, u0, s0));
+  } else if (unorm > 0) {
     KSP ksp;
     PC  pc;
     Vec g;

@@ -155,6 +155,15 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     if (p->nonlinear) sys->nonlinear = PETSC_TRUE;
   }
   if (sys->njoints) sys->nonlinear = PETSC_TRUE; /* joint directions turn with the bodies */
+  /* a body on a prescribed spin lives in its rotating frame: its ports' velocities are not inertial, and a joint to
+     another part would join two different frames */
+  for (PetscInt k = 0; k < sys->njoints; k++)
+    for (PetscInt side = 0; side < 2; side++) {
+      PhlexPart p    = sys->joints[k]->side[side].part;
+      PetscReal rate = -1.0;
+      if (p && p->ops.spinrate) PetscCall((*p->ops.spinrate)(p, PETSC_FALSE, &rate));
+      PetscCheck(rate < 0, sys->comm, PETSC_ERR_USER_INPUT, "joint %s: body %s turns on a prescribed spin (-%sspin), in its own rotating frame; it cannot be jointed to other parts (model the hub as a driven revolute joint and the body as floating)", sys->joints[k]->name, p->name, p->prefix);
+    }
   PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &ops));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops[i]));
@@ -249,6 +258,13 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvu;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_DISPLACEMENT, &sys->Jvu));
+    /* geometric stiffening: the stress rows depend on u, and the field blocks change with the state */
+    for (PetscInt i = 0; i < sys->nfparts; i++) {
+      m[i] = ops[i].Jsu;
+      if (ops[i].Jsu) sys->state_dependent_fields = PETSC_TRUE;
+      if (ops[i].inexact_schur) sys->inexact_schur = PETSC_TRUE;
+    }
+    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_DISPLACEMENT, &sys->Jsu));
     PetscCall(PetscFree(m));
   }
   PetscCall(MatCreateDense(sys->comm, sys->qlocal, sys->qlocal, sys->nq, sys->nq, NULL, &sys->Dq));
@@ -264,7 +280,7 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(PetscCalloc1(nf * nf, &blocks));
     if (U >= 0) {
       blocks[U * nf + U] = sys->Juu, blocks[U * nf + V] = sys->Juv;
-      blocks[S * nf + S] = sys->Jss, blocks[S * nf + V] = sys->Jsv;
+      blocks[S * nf + S] = sys->Jss, blocks[S * nf + V] = sys->Jsv, blocks[S * nf + U] = sys->Jsu;
       blocks[V * nf + U] = sys->Jvu, blocks[V * nf + S] = sys->Jvs, blocks[V * nf + V] = sys->Jvv;
     }
     if (Q >= 0) {
@@ -499,7 +515,8 @@ PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, 
 /*@C
   PhlexSystemCondensedOperator - block diagonal over the bodies of one of their velocity-space operators: which = 0
   the condensed operators shift Mv + K/shift (each part's Sv, at the shift last evaluated), 1 the masses Mv, 2 the
-  condensed stiffnesses K; the part's own matrix for one body, else a MATNEST of them
+  condensed stiffnesses K, 3 the state's stiffnesses K_sigma + Cen, 4 the gyroscopic (Coriolis) matrices; the part's
+  own matrix for one body, else a MATNEST of them; NULL when no body has one (3, 4)
 
   Collective
 @*/
@@ -512,7 +529,7 @@ PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, PetscInt which, Mat
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : ops.K);
+    m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : (which == 2 ? ops.K : (which == 3 ? ops.Kstate : ops.Gyro)));
   }
   PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, N));
   PetscCall(PetscFree(m));
@@ -565,13 +582,13 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
     PetscCall(MatDenseRestoreArrayWrite(sys->Dq, &da));
   }
   /* the preconditioning matrices of the splits: the condensed velocity operators changed with the shift */
-  if (new_shift && sys->Sv && sys->nfparts > 1) {
+  if ((new_shift || sys->state_dependent_fields) && sys->Sv && sys->nfparts > 1) {
     Mat N;
     PetscCall(PhlexSystemCondensedOperator(sys, 0, &N));
     PetscCall(MatConvert(N, MATAIJ, MAT_REUSE_MATRIX, &sys->Sv));
     PetscCall(MatDestroy(&N));
   }
-  if (sys->Ssv && new_shift) {
+  if (sys->Ssv && (new_shift || sys->state_dependent_fields)) {
     Mat blocks[4] = {sys->Jss, sys->Jsv, sys->Jvs, sys->Jvv}, N;
     PetscCall(MatCreateNest(sys->comm, 2, NULL, 2, NULL, blocks, &N));
     PetscCall(MatConvert(N, MATAIJ, MAT_REUSE_MATRIX, &sys->Ssv));
@@ -586,6 +603,11 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
   }
   if (sys->Jvv && sys->nfparts > 1) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvv));
   if (sys->Jvu && sys->nfparts > 1) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvu));
+  if (sys->state_dependent_fields && sys->nfparts > 1) {
+    PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jsv));
+    PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvs));
+    PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jsu));
+  }
   PetscCall(PetscObjectStateIncrease((PetscObject)sys->J));
   if (sys->Pvq) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Pvq));
   if (sys->use_aij) {
@@ -774,6 +796,7 @@ PetscErrorCode PhlexSystemDestroy(PhlexSystem *system)
   PetscCall(MatDestroy(&sys->Jvs));
   PetscCall(MatDestroy(&sys->Jvv));
   PetscCall(MatDestroy(&sys->Jvu));
+  PetscCall(MatDestroy(&sys->Jsu));
   PetscCall(MatDestroy(&sys->Bvq));
   PetscCall(MatDestroy(&sys->Cqu));
   PetscCall(MatDestroy(&sys->Cqv));
