@@ -215,6 +215,8 @@ struct _p_PhlexFlexible {
   Mat               Gu, Gut;   /* G(u) (G's pattern) and its transpose: the coupling of the residual and the Jacobian */
   Mat               Ksig, Jsu; /* d(G(u)^T Sigma)/du (initial-stress stiffness, Kaij's pattern), d(G(u) v)/du (G's) */
   Mat               Nsu;       /* G(u)^T Ms^{-1} d(G(u) v)/du (Kaij's pattern, not symmetric): its term in the exact Schur complement */
+  Mat               Mvs;       /* Mv on Sv's pattern (stiffening or spin: Sv is rebuilt every Jacobian by fast same-pattern sums) */
+  MatStructure      kpattern;  /* SAME_NONZERO_PATTERN if Kaij (and Ksig, Nsu) have Sv's pattern, else SUBSET */
   Vec               uloc, vloc; /* local (ghosted) displacement and velocity */
   PetscInt         *cell_vloc;  /* per local cell: local-vector offsets of its velocity closure */
   PhlexElementBasis basis_v, basis_s;

@@ -515,10 +515,23 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       PetscCall(VecDuplicate(b->load, &b->vd));
       PetscCall(PetscCalloc4(PetscMax(n * part->nq, 1), &b->Bc, PetscMax(n * part->nq, 1), &b->Cu, PetscMax(n * part->nq, 1), &b->Cv, PetscMax(n * part->nq, 1), &b->Cpre));
     }
+    b->kpattern = SUBSET_NONZERO_PATTERN;
+    if (b->spinning || b->stiffening) {
+      MatInfo ik, is;
+      /* Sv is rebuilt at every Jacobian from K (G(u)), K_sigma, ...: same-pattern sums are fast, subset ones go row by
+         row through MatSetValues */
+      PetscCall(MatGetInfo(b->Kaij, MAT_LOCAL, &ik));
+      PetscCall(MatGetInfo(b->Sv, MAT_LOCAL, &is));
+      PetscInt same = ik.nz_used == is.nz_used ? 1 : 0; /* Sv holds Kaij's pattern: equal counts, equal patterns */
+      PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &same, 1, MPIU_INT, MPI_MIN, b->comm));
+      b->kpattern = same ? SAME_NONZERO_PATTERN : SUBSET_NONZERO_PATTERN;
+      PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, &b->Mvs));
+      PetscCall(MatZeroEntries(b->Mvs));
+      PetscCall(MatAXPY(b->Mvs, 1.0, b->Mvaij, SUBSET_NONZERO_PATTERN));
+    }
     if (b->spinning) {
-      /* the spin's operators, and room for them in the preconditioner and the fixed body's Jvv */
+      /* the spin's operators (on Sv's pattern), and room for them in the fixed body's Jvv */
       PetscCall(PhlexFlexibleSpinSetUp(b, part->units));
-      PetscCall(MatAXPY(b->Sv, 0.0, b->Cen, DIFFERENT_NONZERO_PATTERN));
       PetscCall(MatAXPY(b->Jvv, 0.0, b->Cor, DIFFERENT_NONZERO_PATTERN));
       PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_FALSE));
     }
@@ -532,7 +545,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       /* the fixed body's displacement columns: Cen + K_sigma */
       PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, &b->Jvu));
       PetscCall(MatZeroEntries(b->Jvu));
-      if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SUBSET_NONZERO_PATTERN));
+      if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SAME_NONZERO_PATTERN));
       PetscCall(PetscObjectSetName((PetscObject)b->Jvu, "velocity-displacement block"));
     }
   }
@@ -605,21 +618,21 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
        Coriolis term and G(u)^T Ms^{-1} d(G(u) v)/du / shift^2: the exact Schur complement of u and Sigma (not
        symmetric, LU). A floating body's stays symmetric (its bordered preconditioner factors it by Cholesky): there
        FGMRES takes care of those terms. */
-    PetscCall(MatCopy(b->Kaij, b->Sv, SUBSET_NONZERO_PATTERN));
-    if (b->stiffening) PetscCall(MatAXPY(b->Sv, 1.0, b->Ksig, SUBSET_NONZERO_PATTERN));
-    if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cen, SUBSET_NONZERO_PATTERN));
-    if (b->stiffening && !b->floating) PetscCall(MatAXPY(b->Sv, 1.0 / shift, b->Nsu, SUBSET_NONZERO_PATTERN));
+    PetscCall(MatCopy(b->Kaij, b->Sv, b->kpattern));
+    if (b->stiffening) PetscCall(MatAXPY(b->Sv, 1.0, b->Ksig, b->kpattern));
+    if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cen, SAME_NONZERO_PATTERN));
+    if (b->stiffening && !b->floating) PetscCall(MatAXPY(b->Sv, 1.0 / shift, b->Nsu, b->kpattern));
     PetscCall(MatScale(b->Sv, 1.0 / shift));
-    PetscCall(MatAXPY(b->Sv, shift, b->Mvaij, SUBSET_NONZERO_PATTERN));
-    if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cor, SUBSET_NONZERO_PATTERN));
+    PetscCall(MatAXPY(b->Sv, shift, b->Mvs ? b->Mvs : b->Mvaij, b->Mvs ? SAME_NONZERO_PATTERN : SUBSET_NONZERO_PATTERN));
+    if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cor, SAME_NONZERO_PATTERN));
   }
   if (!b->floating) {
     /* the displacement columns K_sigma + Cen: K_sigma changes with the state, Cen with the spin rate (which resets
        the shift) */
     if (b->stiffening || (b->spinning && new_shift)) {
       PetscCall(MatZeroEntries(b->Jvu));
-      if (b->stiffening) PetscCall(MatAXPY(b->Jvu, 1.0, b->Ksig, SUBSET_NONZERO_PATTERN));
-      if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SUBSET_NONZERO_PATTERN));
+      if (b->stiffening) PetscCall(MatAXPY(b->Jvu, 1.0, b->Ksig, b->kpattern));
+      if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SAME_NONZERO_PATTERN));
     }
     PetscFunctionReturn(0);
   }

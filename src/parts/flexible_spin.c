@@ -25,14 +25,14 @@ static PetscErrorCode RelativePosition(PetscInt dim, PetscReal t, const PetscRea
   return 0;
 }
 
-/* Mv (x) B (3 x 3 node-wise block B) on the velocity mass's pattern */
+/* Mv (x) B (3 x 3 node-wise block B), on the condensed operator's pattern */
 static PetscErrorCode NodeBlockMass(PhlexFlexible b, const PhlexUnits *u, const PetscReal B[9], Mat *A)
 {
   const PetscInt nv = b->nb_v / 3, n = b->nb_v;
   PetscReal     *Me;
 
   PetscFunctionBeginUser;
-  PetscCall(MatDuplicate(b->Mvaij, MAT_DO_NOT_COPY_VALUES, A));
+  PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, A)); /* Sv's pattern (it holds Mv's): same-pattern sums */
   PetscCall(MatSetOption(*A, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
   PetscCall(MatZeroEntries(*A));
   PetscCall(PetscMalloc1(n * n, &Me));
@@ -235,9 +235,9 @@ PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart part, PhlexPartVec *X)
     PetscCheck(it < maxit, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the steady state of the spin (-%sspin) did not converge in %" PetscInt_FMT " Newton iterations (|r| = %g of the centrifugal load %g): the spin rate is beyond the body's stability (it buckles or flies apart)", b->name, b->prefix, maxit, (double)rn, (double)fn);
     /* the tangent */
     PetscCall(MatZeroEntries(T));
-    PetscCall(MatAXPY(T, 1.0, b->Kaij, SUBSET_NONZERO_PATTERN));
-    PetscCall(MatAXPY(T, 1.0, b->Cen, SUBSET_NONZERO_PATTERN));
-    if (b->stiffening) PetscCall(MatAXPY(T, 1.0, b->Ksig, SUBSET_NONZERO_PATTERN));
+    PetscCall(MatAXPY(T, 1.0, b->Kaij, b->kpattern));
+    PetscCall(MatAXPY(T, 1.0, b->Cen, SAME_NONZERO_PATTERN));
+    if (b->stiffening) PetscCall(MatAXPY(T, 1.0, b->Ksig, b->kpattern));
     PetscCall(KSPSetOperators(b->steady_ksp, T, T));
     PetscCall(KSPSolve(b->steady_ksp, r, du));
     {

@@ -159,13 +159,13 @@ PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible b, Vec u, Vec s, Ve
   const PhlexUnits  *units = b->part->units;
   const PetscInt     nv = b->nb_v, ns = b->nb_s, nn = nv / 3;
   const PetscScalar *ua, *va, *sa;
-  PetscReal         *Ge, *Je, *Ke, *Kc, *Nc, *Mse, *work, A[36], ue[3 * PHLEX_MAX_NODES], ve[3 * PHLEX_MAX_NODES];
+  PetscReal         *Ge, *Je, *Ke, *Kc, *Nc, *W, *C, *Mse, *work, A[36], ue[3 * PHLEX_MAX_NODES], ve[3 * PHLEX_MAX_NODES];
   PetscInt           rstart;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BodyAssemble, 0, 0, 0, 0));
   PetscCall(PetscMalloc6(ns * nv, &Ge, ns * nv, &Je, nv * nv, &Ke, nv * nv, &Kc, ns * ns, &Mse, ns * nv, &work));
-  PetscCall(PetscMalloc1(nv * nv, &Nc));
+  PetscCall(PetscMalloc3(nv * nv, &Nc, 2 * ns * nv, &W, 2 * nv * nv, &C));
   PetscCall(MatZeroEntries(b->Ksig));
   PetscCall(MatZeroEntries(b->Nsu));
   PetscCall(MatZeroEntries(b->Kaij));
@@ -186,16 +186,26 @@ PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible b, Vec u, Vec s, Ve
     PhlexElementGeometricStiffness(&b->basis_v, &b->basis_s, g[0], &g[1], se, Ke);
     PhlexElementCompliance(mat->youngs_modulus / units->modulus, mat->poissons_ratio, A);
     PhlexElementComplianceMass(&b->ref, g[0], A, Mse);
-    PetscCheck(!PhlexElementCondense(ns, nv, Mse, Ge, work, Kc), PETSC_COMM_SELF, PETSC_ERR_PLIB, "body %s: compliance mass of cell %" PetscInt_FMT " is not positive definite", b->name, c);
-    /* Nc = Ge^T Mse^{-1} Je (Mse holds its Cholesky factor now) */
-    for (PetscInt i = 0; i < ns * nv; i++) work[i] = Je[i];
-    PhlexDenseCholeskySolve(ns, Mse, nv, work);
-    for (PetscInt a = 0; a < nv; a++)
-      for (PetscInt bb = 0; bb < nv; bb++) {
-        PetscReal sum = 0.0;
-        for (PetscInt j = 0; j < ns; j++) sum += Ge[j * nv + a] * work[j * nv + bb];
-        Nc[a * nv + bb] = sum;
-      }
+    {
+      /* [Kc | Nc] = Ge^T Mse^{-1} [Ge | Je] by LAPACK/BLAS: W = Mse^{-1} [Ge | Je] (column-major ns x 2nv), then
+         C = Ge^T W (nv x 2nv); Ge row-major ns x nv is Ge^T column-major with leading dimension nv */
+      PetscBLASInt bns = (PetscBLASInt)ns, bnv = (PetscBLASInt)nv, b2nv = (PetscBLASInt)(2 * nv), info;
+      const PetscReal one = 1.0, zero = 0.0;
+      for (PetscInt j = 0; j < ns; j++)
+        for (PetscInt a = 0; a < nv; a++) {
+          W[a * ns + j]        = Ge[j * nv + a];
+          W[(nv + a) * ns + j] = Je[j * nv + a];
+        }
+      PetscCallBLAS("LAPACKpotrf", LAPACKpotrf_("L", &bns, Mse, &bns, &info));
+      PetscCheck(!info, PETSC_COMM_SELF, PETSC_ERR_PLIB, "body %s: compliance mass of cell %" PetscInt_FMT " is not positive definite", b->name, c);
+      PetscCallBLAS("LAPACKpotrs", LAPACKpotrs_("L", &bns, &b2nv, Mse, &bns, W, &bns, &info));
+      PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &bnv, &b2nv, &bns, &one, Ge, &bnv, W, &bns, &zero, C, &bnv));
+      for (PetscInt a = 0; a < nv; a++)
+        for (PetscInt bb = 0; bb < nv; bb++) {
+          Kc[a * nv + bb] = C[bb * nv + a];
+          Nc[a * nv + bb] = C[(nv + bb) * nv + a];
+        }
+    }
     PetscCall(SetCouplingBlock(b, b->Gu, c, Ge, work));
     PetscCall(SetCouplingBlock(b, b->Jsu, c, Je, work));
     CellNodes(b, c, nodes);
@@ -207,7 +217,7 @@ PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible b, Vec u, Vec s, Ve
   PetscCall(VecRestoreArrayRead(b->uloc, &ua));
   PetscCall(VecRestoreArrayRead(b->vloc, &va));
   PetscCall(PetscFree6(Ge, Je, Ke, Kc, Mse, work));
-  PetscCall(PetscFree(Nc));
+  PetscCall(PetscFree3(Nc, W, C));
   PetscCall(MatAssemblyBegin(b->Gu, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(b->Gu, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyBegin(b->Jsu, MAT_FINAL_ASSEMBLY));
@@ -275,6 +285,7 @@ PetscErrorCode PhlexFlexibleStiffeningDestroy(PhlexFlexible b)
   PetscCall(MatDestroy(&b->Ksig));
   PetscCall(MatDestroy(&b->Jsu));
   PetscCall(MatDestroy(&b->Nsu));
+  PetscCall(MatDestroy(&b->Mvs));
   PetscCall(VecDestroy(&b->uloc));
   PetscCall(VecDestroy(&b->vloc));
   PetscCall(PetscFree(b->cell_vloc));

@@ -13,6 +13,7 @@
 static PhlexHelpMode help_mode = PHLEX_HELP_NONE;
 static PetscBool     capturing; /* collecting option names (PhlexHelpCaptureBegin), printing nothing */
 static PetscBool     capture_had_help;
+static PetscBool     bool_line; /* the line being printed is PETSc 3.18's bool option line, "<default : value>" */
 static char         *pending; /* the current line of stdout, built from several printf calls */
 static size_t        npending, maxpending;
 static char        **lines; /* help: the option lines printed so far (a repeated one is skipped); capture: names */
@@ -101,6 +102,12 @@ static PetscErrorCode RewriteValue(const char *line, char *out, size_t len)
   }
   nnow = (size_t)(sep - now);
   ndef = (size_t)(close - def);
+  if (bool_line) {
+    /* PETSc 3.18 prints a bool's default first and its value second (other types: value, then default) */
+    const char *t = now;
+    size_t      nt = nnow;
+    now = def, nnow = ndef, def = t, ndef = nt;
+  }
   if (nnow == ndef && !strncmp(now, def, nnow)) PetscCall(PetscSNPrintf(out, len, "%.*s<%.*s>%s", (int)(open - line), line, (int)nnow, now, close + 1));
   else PetscCall(PetscSNPrintf(out, len, "%.*s<%.*s; default %.*s>%s", (int)(open - line), line, (int)nnow, now, (int)ndef, def, close + 1));
   PetscFunctionReturn(0);
@@ -180,6 +187,7 @@ static PetscErrorCode FilterVFPrintf(FILE *fd, const char format[], va_list args
   }
   PetscCall(PetscVSNPrintf(piece, sizeof(piece), format, &len, args));
   len = strlen(piece);
+  if (strstr(format, ": <%s : %s> ")) bool_line = PETSC_TRUE; /* PetscOptionsBool's line (one call, one line) */
   if (npending + len + 1 > maxpending) {
     maxpending = PetscMax(2 * maxpending, npending + len + 256);
     PetscCall(PetscRealloc(maxpending, &pending));
@@ -189,7 +197,8 @@ static PetscErrorCode FilterVFPrintf(FILE *fd, const char format[], va_list args
     if (piece[i] == '\n') {
       pending[npending] = 0;
       PetscCall(EmitLine(pending));
-      npending = 0;
+      npending  = 0;
+      bool_line = PETSC_FALSE;
     }
   }
   PetscFunctionReturn(0);
