@@ -212,7 +212,8 @@ struct _p_PhlexFlexible {
 
   /* geometric stiffening (flexible_stiffening.c): the Green-Lagrange coupling G(u) */
   PetscBool         stiffening;
-  Mat               Gu, Gut;   /* G(u) (G's pattern) and its transpose: the coupling of the residual and the Jacobian */
+  Mat               Gu, Gut;   /* G(u) (G's pattern) and its transpose at the Jacobian's state: its blocks Jsv, Jvs */
+  Mat               Gres;      /* G(u) at the residual's state (its own matrix: a residual never changes the Jacobian) */
   Mat               Ksig, Jsu; /* d(G(u)^T Sigma)/du (initial-stress stiffness, Kaij's pattern), d(G(u) v)/du (G's) */
   Mat               Nsu;       /* G(u)^T Ms^{-1} d(G(u) v)/du (Kaij's pattern, not symmetric): its term in the exact Schur complement */
   Mat               Mvs;       /* Mv on Sv's pattern (stiffening or spin: Sv is rebuilt every Jacobian by fast same-pattern sums) */

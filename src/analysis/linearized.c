@@ -42,7 +42,7 @@ typedef struct {
 static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions *o)
 {
   PetscInt  nrange = 3, nsrange = 3;
-  PetscReal srange[3];
+  PetscReal srange[3] = {0, 0, 0};
   PetscBool has_spins = PETSC_FALSE, has_srange = PETSC_FALSE;
 
   PetscFunctionBeginUser;
@@ -106,7 +106,7 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
   for (PetscInt k = 0; k < o->nspins; k++) {
     char a[32];
     PhlexFormatReal(o->spins[k], a, sizeof(a));
-    PetscCheck(o->spins[k] >= 0 && !PetscIsInfOrNanReal(o->spins[k]), comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep: spin rate %s is not a finite rate >= 0 [rad/s] (the axis is the body's -spin: reverse it there)", a);
+    PetscCheck(o->spins[k] >= 0 && !PetscIsInfOrNanReal(o->spins[k]), comm, PETSC_ERR_USER_INPUT, "%s: spin rate %s is not a finite rate >= 0 [rad/s] (the axis is the body's -spin: reverse it there)", has_srange ? "-linearized_spin_sweep_range" : "-linearized_spin_sweep", a);
   }
   if (!o->has_exp) o->nexp = 0;
   PetscCheck(o->nexp <= 64, comm, PETSC_ERR_USER_INPUT, "-expect_frequencies: at most 64 values");
@@ -378,7 +378,8 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
     }
     PetscCall(VecNorm(yu1, NORM_2, &n1));
     PetscCall(VecNorm(yu2, NORM_2, &n2));
-    PetscCheck(PetscMax(n1, n2) <= 1e-10 * PetscMax(rel, ns), sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the displacement acts on the velocity equations at the linearisation point (relative size %g): a loaded or moving state; linearise about an unloaded configuration at rest or a prescribed steady spin", (double)(PetscMax(n1, n2) / rel));
+    /* (a fixed body's velocity-displacement block is its Kstate itself: the check bites on floating bodies) */
+    PetscCheck(PetscMax(n1, n2) <= 1e-10 * PetscMax(rel, ns), sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the displacement acts on the velocity equations at the linearisation point (relative size %g): a loaded or moving state; linearise about an unloaded configuration at rest or a prescribed steady spin", (double)(PetscMax(n1, n2) / PetscMax(rel, ns)));
   }
   PetscCall(MatDestroy(&Kst));
   PetscCall(MatDestroy(&Gyr));
@@ -863,8 +864,10 @@ static PetscErrorCode SolveGyroscopic(Pencil *p, PEP pep, PetscInt nev, PetscInt
     PetscReal       re, im, m;
     PetscCall(PEPGetEigenpair(pep, i, &kr, &ki, NULL, NULL));
     re = PetscRealPart(kr), im = PetscRealPart(ki), m = PetscSqrtReal(re * re + im * im);
-    /* one of each pair: the one with im > 0, or the growing one of a real pair (re > 0) */
+    /* one of each pair: the one with im > 0, or the growing one of a real pair (re > 0); of a flutter quadruple
+       +-sigma +- i omega the growing one with im > 0 */
     if (im < -1e-10 * lmax || (PetscAbsReal(im) <= 1e-10 * lmax && re < 0)) continue;
+    if (im > 1e-10 * lmax && re < -1e-8 * m) continue;
     mag[n] = m, om[n] = PetscMax(im, 0.0), gr[n] = PetscAbsReal(re) > 1e-8 * m ? PetscAbsReal(re) : 0.0, idx[n] = i, perm[n] = n;
     PetscCall(PEPComputeError(pep, i, PEP_ERROR_BACKWARD, &res[n]));
     n++;
@@ -1127,8 +1130,9 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCall(PetscPrintf(scene->comm, "\n"));
   }
   for (PetscInt c = 0; c < nconfig; c++) {
-    const PetscReal pos = o.nvalues ? o.values[c] : (o.nspins ? o.spins[c] : here / unit);
+    PetscReal pos = o.nvalues ? o.values[c] : (o.nspins ? o.spins[c] : here / unit);
     const PetscBool shapes = (PetscBool)(c == o.fields_configuration && scene->output->fields);
+    if (spun && !o.nspins && !joint) PetscCall((*spun->ops.spinrate)(spun, PETSC_FALSE, &pos)); /* the scene's spin rate */
     PetscInt        nmech;
     Spectrum        s;
     PetscCall(PetscTime(&t0));
@@ -1155,7 +1159,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCall(PetscTime(&t1));
     tsolve += t1 - t0;
     if (nconfig == 1) {
-      PetscCall(PetscPrintf(scene->comm, "  %" PetscInt_FMT " mechanism mode%s (zero frequency)\n  mode  frequency [Hz]       omega [rad/s]        kind       rel. residual\n", s.nmech, s.nmech == 1 ? "" : "s"));
+      PetscCall(PetscPrintf(scene->comm, "  %" PetscInt_FMT " mechanism mode%s (zero frequency)\n  mode  frequency [Hz]       omega [rad/s]        kind       %s\n", s.nmech, s.nmech == 1 ? "" : "s", pep ? "backward err." : "rel. residual"));
     } else PetscCall(PetscPrintf(scene->comm, "  %6" PetscInt_FMT " %12.6g  %4" PetscInt_FMT, c, (double)pos, s.nmech));
     PetscCall(PetscViewerASCIIPrintf(sweep, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT, c, (double)pos, s.nmech));
     for (PetscInt i = 0; i < s.n; i++) {

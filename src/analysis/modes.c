@@ -156,6 +156,13 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   for (PetscInt k = 0; k < scene->nparts; k++)
     if (scene->parts[k]->ops.modes) nbodies++;
   PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible body)");
+  for (PetscInt k = 0; k < scene->nparts; k++) {
+    PhlexPart p    = scene->parts[k];
+    PetscReal rate = -1;
+    if (p->ops.spinrate) PetscCall((*p->ops.spinrate)(p, PETSC_FALSE, &rate));
+    /* the body's modes about rest would silently ignore its spin */
+    PetscCheck(rate < 0, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: body %s spins (-%sspin, %g rad/s); its modes about the steady spin are the linearised analysis's (-analysis linearized)", p->name, p->prefix, (double)rate);
+  }
   PetscCheck(!nexp || nbodies == 1, scene->comm, PETSC_ERR_USER_INPUT, "-expect_frequencies checks the modes of one body; the scene has %" PetscInt_FMT, nbodies);
 
   PetscCall(PhlexOutputCSVOpen(scene->output, "modes.csv", "mode,frequency_hz,eigenvalue_rad2_s2,relative_residual,rigid,body", &csv));

@@ -550,7 +550,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(PetscPrintf(scene->comm, "Generalized-alpha: SNES newtonls (basic line search) instead of ksponly, so that the scheme's rate is taken at the solution\n"));
     }
   }
-  if (sys->nonlinear) {
+  if (sys->nonlinear || sys->inexact_schur) {
+    /* Newton (a preset's newtonls also on a linear spinning body: its tolerances are below the round-off floor,
+       options/solver/exact_krylov.opts) stops at that floor */
     SNES snes;
     PetscCall(TSGetSNES(ts, &snes));
     PetscCall(SNESSetConvergenceTest(snes, PhlexSystemSNESConverged, sys, NULL));

@@ -303,6 +303,9 @@ static PetscErrorCode FlexSetUp(PhlexPart part)
     /* the weight would turn in the rotating frame; a prescribed spin is its own world */
     PetscCheck(part->gravity[0] == 0 && part->gravity[1] == 0 && part->gravity[2] == 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin %s,%s,%s with gravity: the weight turns in the spinning frame; remove -gravity (a spin much faster than the weight's effect) or model the hub as a driven joint", b->name, b->prefix, w[0], w[1], w[2]);
     PetscCheck(b->frame_patch[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin %s,%s,%s needs the body clamped to its hub (-%sframe_patch <surface>)", b->name, b->prefix, w[0], w[1], w[2], b->prefix);
+    /* a fixed body's port loads are applied in its axes, which turn with the hub */
+    for (PetscInt q = 0; q < b->nports; q++)
+      PetscCheck(!b->ports[q].load.loaded || b->ports[q].load.frame != PHLEX_DIRECTION_INERTIAL, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin %s,%s,%s with -%sport_%s_direction inertial: the body lives in the hub's rotating frame, where a direction fixed in space turns; give the load in body directions (it turns with the hub) or model the hub as a driven joint", b->name, b->prefix, w[0], w[1], w[2], b->prefix, b->ports[q].name);
   }
   if (!b->floating && (part->gravity[0] != 0 || part->gravity[1] != 0 || part->gravity[2] != 0)) {
     /* the weight of a fixed body as a nodal load: t(l) g_c on component c (gravity is a potential: no input power) */

@@ -370,7 +370,7 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
   if (b->stiffening) {
     /* the Green-Lagrange coupling G(u) in both rows (flexible_stiffening.c) */
     PetscCall(PhlexFlexibleCouplingUpdate(b, X->u));
-    G = b->Gu;
+    G = b->Gres;
   }
   /* F_u = T u' - v */
   PetscCall(VecAXPBYPCZ(F->u, T, -1.0, 0.0, Xdot->u, X->v));

@@ -196,7 +196,7 @@ PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart part, PhlexPartVec *X)
   PhlexFlexible b = (PhlexFlexible)part->data;
   Mat           T;
   Vec           r, du;
-  PetscReal     rn = 0, fn, dn = 0, un = 0;
+  PetscReal     rn = 0, fn, dn = 0, un = 0, rate;
   PetscInt      it;
   const PetscInt maxit = 30;
 
@@ -219,6 +219,7 @@ PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart part, PhlexPartVec *X)
   PetscCall(VecDuplicate(X->u, &du));
   PetscCall(VecSet(X->v, 0.0));
   PetscCall(VecNorm(b->fcen, NORM_INFINITY, &fn));
+  rate = PetscSqrtReal(b->spin[0] * b->spin[0] + b->spin[1] * b->spin[1] + b->spin[2] * b->spin[2]);
   for (it = 0; it <= maxit; it++) {
     /* the residual at u */
     PetscCall(PhlexFlexibleStressOfDisplacement(b, X->u, X->s));
@@ -232,7 +233,7 @@ PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart part, PhlexPartVec *X)
        to 1e-12 of it), or a Newton correction below 1e-10 of the stretch (quadratic convergence: the next is at
        round-off) */
     if (rn <= 1e-12 * fn || rn == 0.0 || (it > 0 && (!b->stiffening || dn <= 1e-10 * un))) break; /* linear: one step; Newton: the next step would be at round-off */
-    PetscCheck(it < maxit, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the steady state of the spin (-%sspin) did not converge in %" PetscInt_FMT " Newton iterations (|r| = %g of the centrifugal load %g): the spin rate is beyond the body's stability (it buckles or flies apart)", b->name, b->prefix, maxit, (double)rn, (double)fn);
+    PetscCheck(it < maxit, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the steady state of the spin at %g rad/s (-%sspin) did not converge in %" PetscInt_FMT " Newton iterations (|r| = %g of the centrifugal load %g): the spin rate is beyond the body's stability (it buckles or flies apart)", b->name, (double)rate, b->prefix, maxit, (double)rn, (double)fn);
     /* the tangent */
     PetscCall(MatZeroEntries(T));
     PetscCall(MatAXPY(T, 1.0, b->Kaij, b->kpattern));
@@ -243,7 +244,7 @@ PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart part, PhlexPartVec *X)
     {
       KSPConvergedReason reason;
       PetscCall(KSPGetConvergedReason(b->steady_ksp, &reason));
-      PetscCheck(reason >= 0, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the steady spin's linear solve failed (%s): the tangent stiffness is singular at this spin rate (a critical speed)", b->name, KSPConvergedReasons[reason]);
+      PetscCheck(reason >= 0, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the steady spin's linear solve at %g rad/s failed (%s): the tangent stiffness is singular at this spin rate (a critical speed)", b->name, (double)rate, KSPConvergedReasons[reason]);
     }
     PetscCall(VecAXPY(X->u, -1.0, du));
     PetscCall(VecNorm(du, NORM_INFINITY, &dn));

@@ -108,6 +108,7 @@ PetscErrorCode PhlexFlexibleStiffeningSetUp(PhlexFlexible b)
   if (!b->uloc) PetscCall(DMCreateLocalVector(b->dm, &b->uloc));
   if (!b->vloc) PetscCall(DMCreateLocalVector(b->dm, &b->vloc));
   PetscCall(MatDuplicate(b->G, MAT_COPY_VALUES, &b->Gu));
+  PetscCall(MatDuplicate(b->G, MAT_COPY_VALUES, &b->Gres));
   PetscCall(MatTranspose(b->Gu, MAT_INITIAL_MATRIX, &b->Gut));
   PetscCall(MatDuplicate(b->G, MAT_DO_NOT_COPY_VALUES, &b->Jsu));
   PetscCall(MatDuplicate(b->Kaij, MAT_DO_NOT_COPY_VALUES, &b->Ksig));
@@ -119,7 +120,7 @@ PetscErrorCode PhlexFlexibleStiffeningSetUp(PhlexFlexible b)
 }
 
 /*@C
-  PhlexFlexibleCouplingUpdate - G(u) at the displacement u (the residual's coupling)
+  PhlexFlexibleCouplingUpdate - G(u) at the displacement u, into the residual's own matrix Gres
 
   Collective
 @*/
@@ -137,12 +138,12 @@ PetscErrorCode PhlexFlexibleCouplingUpdate(PhlexFlexible b, Vec u)
     const PetscReal *g = &b->cell_geom[10 * c];
     CellValues(b, c, ua, ue);
     PhlexElementCouplingDeformed(&b->basis_v, &b->basis_s, g[0], &g[1], ue, Ge);
-    PetscCall(SetCouplingBlock(b, b->Gu, c, Ge, work));
+    PetscCall(SetCouplingBlock(b, b->Gres, c, Ge, work));
   }
   PetscCall(VecRestoreArrayRead(b->uloc, &ua));
   PetscCall(PetscFree2(Ge, work));
-  PetscCall(MatAssemblyBegin(b->Gu, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(b->Gu, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(b->Gres, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(b->Gres, MAT_FINAL_ASSEMBLY));
   PetscCall(PetscLogEventEnd(PHLEX_BodyAssemble, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -281,6 +282,7 @@ PetscErrorCode PhlexFlexibleStiffeningDestroy(PhlexFlexible b)
 {
   PetscFunctionBeginUser;
   PetscCall(MatDestroy(&b->Gu));
+  PetscCall(MatDestroy(&b->Gres));
   PetscCall(MatDestroy(&b->Gut));
   PetscCall(MatDestroy(&b->Ksig));
   PetscCall(MatDestroy(&b->Jsu));
