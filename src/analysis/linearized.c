@@ -113,34 +113,24 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
   PetscFunctionReturn(0);
 }
 
-/* the eigensolver with phlex's defaults (Krylov-Schur, shift-and-invert, an indefinite LDL^T by MUMPS: the pencil
-   is a saddle point), options prefix linearized_ */
-static PetscErrorCode LinearizedEPSCreate(MPI_Comm comm, EPS *eps)
+/* shift-and-invert by a direct factorisation of the given type, MUMPS where available (options prefix linearized_st_) */
+static PetscErrorCode ShiftInvertDirect(ST st, PCType type)
 {
-  ST  st;
   KSP ksp;
   PC  pc;
 
   PetscFunctionBeginUser;
-  PetscCall(EPSCreate(comm, eps));
-  PetscCall(EPSSetOptionsPrefix(*eps, "linearized_"));
-  PetscCall(EPSSetProblemType(*eps, EPS_GHEP)); /* B = diag(M, 0): positive semi-definite; purification (default) removes its null-space components */
-  PetscCall(EPSSetType(*eps, EPSKRYLOVSCHUR));
-  PetscCall(EPSSetWhichEigenpairs(*eps, EPS_TARGET_MAGNITUDE));
-  PetscCall(EPSSetTolerances(*eps, 1e-12, PETSC_DEFAULT));
-  PetscCall(EPSGetST(*eps, &st));
   PetscCall(STSetType(st, STSINVERT));
   PetscCall(STGetKSP(st, &ksp));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCCHOLESKY));
+  PetscCall(PCSetType(pc, type));
   if (PetscDefined(HAVE_MUMPS)) {
-    PetscBool set;
-    PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
     /* the saddle point's delayed pivots outgrow MUMPS's default workspace (INFOG(1) = -9 on the four-bar with 16
        cells per link): 200 % more, unless given */
     char      solver[64] = "mumps";
-    PetscBool other;
+    PetscBool set, other;
+    PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
     PetscCall(PetscOptionsGetString(NULL, NULL, "-linearized_st_pc_factor_mat_solver_type", solver, sizeof(solver), NULL));
     PetscCall(PetscStrcmp(solver, "mumps", &other));
     other = (PetscBool)!other;
@@ -150,13 +140,29 @@ static PetscErrorCode LinearizedEPSCreate(MPI_Comm comm, EPS *eps)
   PetscFunctionReturn(0);
 }
 
+/* the eigensolver with phlex's defaults (Krylov-Schur, shift-and-invert, an indefinite LDL^T by MUMPS: the pencil
+   is a saddle point), options prefix linearized_ */
+static PetscErrorCode LinearizedEPSCreate(MPI_Comm comm, EPS *eps)
+{
+  ST st;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSCreate(comm, eps));
+  PetscCall(EPSSetOptionsPrefix(*eps, "linearized_"));
+  PetscCall(EPSSetProblemType(*eps, EPS_GHEP)); /* B = diag(M, 0): positive semi-definite; purification (default) removes its null-space components */
+  PetscCall(EPSSetType(*eps, EPSKRYLOVSCHUR));
+  PetscCall(EPSSetWhichEigenpairs(*eps, EPS_TARGET_MAGNITUDE));
+  PetscCall(EPSSetTolerances(*eps, 1e-12, PETSC_DEFAULT));
+  PetscCall(EPSGetST(*eps, &st));
+  PetscCall(ShiftInvertDirect(st, PCCHOLESKY));
+  PetscFunctionReturn(0);
+}
+
 /* the quadratic eigensolver of a spinning state (Coriolis kept): TOAR, shift-and-invert about 0 (the same saddle
    point factored), the same prefix linearized_ (-linearized_pep_*, -linearized_st_*) */
 static PetscErrorCode LinearizedPEPCreate(MPI_Comm comm, PEP *pep)
 {
-  ST  st;
-  KSP ksp;
-  PC  pc;
+  ST st;
 
   PetscFunctionBeginUser;
   PetscCall(PEPCreate(comm, pep));
@@ -167,12 +173,7 @@ static PetscErrorCode LinearizedPEPCreate(MPI_Comm comm, PEP *pep)
   PetscCall(PEPSetTarget(*pep, 0.0));
   PetscCall(PEPSetTolerances(*pep, 1e-12, PETSC_DEFAULT));
   PetscCall(PEPGetST(*pep, &st));
-  PetscCall(STSetType(st, STSINVERT));
-  PetscCall(STGetKSP(st, &ksp));
-  PetscCall(KSPSetType(ksp, KSPPREONLY));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCLU)); /* A0 + sigma A1 + sigma^2 A2 is not symmetric for a sigma other than 0 */
-  if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(ShiftInvertDirect(st, PCLU)); /* A0 + sigma A1 + sigma^2 A2 is not symmetric for a sigma other than 0 */
   PetscFunctionReturn(0);
 }
 

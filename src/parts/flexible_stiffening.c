@@ -50,6 +50,20 @@ static PetscErrorCode SetUpLocalDofs(PhlexFlexible b)
   PetscFunctionReturn(0);
 }
 
+/* the element bases, the cells' local dof offsets and a local displacement vector, once */
+static PetscErrorCode SetUpWorkspace(PhlexFlexible b)
+{
+  PetscFunctionBeginUser;
+  if (!b->have_basis) {
+    PetscCall(PhlexFlexibleGetBasis(b, PETSC_FALSE, &b->basis_v));
+    PetscCall(PhlexFlexibleGetBasis(b, PETSC_TRUE, &b->basis_s));
+    b->have_basis = PETSC_TRUE;
+  }
+  if (!b->cell_vloc) PetscCall(SetUpLocalDofs(b));
+  if (!b->uloc) PetscCall(DMCreateLocalVector(b->dm, &b->uloc));
+  PetscFunctionReturn(0);
+}
+
 /* the local (ghosted) copy of a velocity-space vector; constrained dofs (the clamp, the frame patch) are zero */
 static PetscErrorCode ToLocal(PhlexFlexible b, Vec x, Vec xloc, const PetscScalar **a)
 {
@@ -99,13 +113,7 @@ PetscErrorCode PhlexFlexibleStiffeningSetUp(PhlexFlexible b)
 {
   PetscFunctionBeginUser;
   if (b->Gu) PetscFunctionReturn(0);
-  if (!b->have_basis) {
-    PetscCall(PhlexFlexibleGetBasis(b, PETSC_FALSE, &b->basis_v));
-    PetscCall(PhlexFlexibleGetBasis(b, PETSC_TRUE, &b->basis_s));
-    b->have_basis = PETSC_TRUE;
-  }
-  if (!b->cell_vloc) PetscCall(SetUpLocalDofs(b));
-  if (!b->uloc) PetscCall(DMCreateLocalVector(b->dm, &b->uloc));
+  PetscCall(SetUpWorkspace(b));
   if (!b->vloc) PetscCall(DMCreateLocalVector(b->dm, &b->vloc));
   PetscCall(MatDuplicate(b->G, MAT_COPY_VALUES, &b->Gu));
   PetscCall(MatDuplicate(b->G, MAT_COPY_VALUES, &b->Gres));
@@ -250,13 +258,7 @@ PetscErrorCode PhlexFlexibleStressOfDisplacement(PhlexFlexible b, Vec u, Vec s)
   PetscInt           rstart;
 
   PetscFunctionBeginUser;
-  if (!b->have_basis) {
-    PetscCall(PhlexFlexibleGetBasis(b, PETSC_FALSE, &b->basis_v));
-    PetscCall(PhlexFlexibleGetBasis(b, PETSC_TRUE, &b->basis_s));
-    b->have_basis = PETSC_TRUE;
-  }
-  if (!b->cell_vloc) PetscCall(SetUpLocalDofs(b));
-  if (!b->uloc) PetscCall(DMCreateLocalVector(b->dm, &b->uloc));
+  PetscCall(SetUpWorkspace(b));
   PetscCall(PetscMalloc1(ns * ns, &Mse));
   PetscCall(VecGetOwnershipRange(s, &rstart, NULL));
   PetscCall(ToLocal(b, u, b->uloc, &ua));
