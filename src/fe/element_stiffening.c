@@ -28,38 +28,46 @@ static void FieldGradient(PetscInt nn, const PetscReal *g, const PetscReal *w, P
       for (PetscInt x = 0; x < 3; x++) H[3 * c + x] += w[3 * a + c] * g[3 * a + x];
 }
 
-/* Ge (6ns x 3nv) = int psi_i E_s : sym(F^T Grad(phi_b e_c)), F = I + Grad u (u NULL: F = I, the linear coupling).
-   The Voigt row of a normal component a is F_ca g_a, of a shear (a, e) F_ca g_e + F_ce g_a (twice the tensor
-   entry, as the shear stress holds the tensor entry: Sigma : eps = sum_normal s e + 2 sum_shear s e). */
-void PhlexElementCouplingDeformed(const PhlexElementBasis *V, const PhlexElementBasis *S, PetscReal detJ, const PetscReal invJ[9], const PetscReal *ue, PetscReal *Ge)
+/* Ce (6ns x 3nv) = int psi_i E_s : sym(A^T Grad(phi_b e_c)) for the 3 x 3 field A = identity + Grad w (w NULL: A = I)
+   or A = Grad w alone. The Voigt row of a normal component a is A_ca g_a, of a shear (a, e) A_ca g_e + A_ce g_a
+   (twice the tensor entry, as the shear stress holds the tensor entry: Sigma : eps = sum_normal s e + 2 sum_shear s e).
+   With A = F = I + Grad u it is the coupling G(u); with A = Grad v, d(G(u) v)/du (sym(Grad(du)^T Grad v)). */
+static void CouplingWith(const PhlexElementBasis *V, const PhlexElementBasis *S, PetscReal detJ, const PetscReal invJ[9], const PetscReal *we, PetscBool identity, PetscReal *Ce)
 {
   const PetscInt nv = V->nnodes, ns = S->nnodes, ncol = 3 * nv;
   PetscReal      g[3 * PHLEX_MAX_NODES], F[9];
 
-  for (PetscInt i = 0; i < 6 * ns * ncol; i++) Ge[i] = 0.0;
+  for (PetscInt i = 0; i < 6 * ns * ncol; i++) Ce[i] = 0.0;
   for (PetscInt q = 0; q < V->nq; q++) {
     const PetscReal  w   = V->weights[q] * detJ;
     const PetscReal *psi = &S->node_phi[q * ns];
     NodeGradients(V, q, invJ, g);
-    if (ue) FieldGradient(nv, g, ue, F);
+    if (we) FieldGradient(nv, g, we, F);
     else
       for (PetscInt k = 0; k < 9; k++) F[k] = 0.0;
-    for (PetscInt k = 0; k < 3; k++) F[4 * k] += 1.0;
+    if (identity)
+      for (PetscInt k = 0; k < 3; k++) F[4 * k] += 1.0;
     for (PetscInt i = 0; i < ns; i++) {
       const PetscReal wp = w * psi[i];
       for (PetscInt b = 0; b < nv; b++) {
         const PetscReal *gb = &g[3 * b];
         for (PetscInt c = 0; c < 3; c++) {
           const PetscInt col = 3 * b + c;
-          for (PetscInt a = 0; a < 3; a++) Ge[(6 * i + a) * ncol + col] += wp * F[3 * c + a] * gb[a];
+          for (PetscInt a = 0; a < 3; a++) Ce[(6 * i + a) * ncol + col] += wp * F[3 * c + a] * gb[a];
           for (PetscInt k = 0; k < 3; k++) {
             const PetscInt a = VoigtPair[k][0], e = VoigtPair[k][1];
-            Ge[(6 * i + 3 + k) * ncol + col] += wp * (F[3 * c + a] * gb[e] + F[3 * c + e] * gb[a]);
+            Ce[(6 * i + 3 + k) * ncol + col] += wp * (F[3 * c + a] * gb[e] + F[3 * c + e] * gb[a]);
           }
         }
       }
     }
   }
+}
+
+/* Ge (6ns x 3nv) = int psi_i E_s : sym(F^T Grad(phi_b e_c)), F = I + Grad u (u NULL: F = I, the linear coupling) */
+void PhlexElementCouplingDeformed(const PhlexElementBasis *V, const PhlexElementBasis *S, PetscReal detJ, const PetscReal invJ[9], const PetscReal *ue, PetscReal *Ge)
+{
+  CouplingWith(V, S, detJ, invJ, ue, PETSC_TRUE, Ge);
 }
 
 /* be (6ns) = int psi_i E_s-pairing of the Green-Lagrange strain E(u) (nonlinear; else the linear strain sym H):
@@ -121,32 +129,9 @@ void PhlexElementGeometricStiffness(const PhlexElementBasis *V, const PhlexEleme
   }
 }
 
-/* Je (6ns x 3nv) = d/du of Ge(u) v for a velocity field ve: the coupling of sym(Grad(du)^T Grad v),
-   normal a: g_a (Grad v)_ca, shear (a, e): g_a (Grad v)_ce + g_e (Grad v)_ca, for du = phi_b e_c with g = g_b */
+/* Je (6ns x 3nv) = d/du of Ge(u) v for a velocity field ve: the coupling of sym(Grad(du)^T Grad v), i.e. CouplingWith
+   A = Grad v: normal a: g_a (Grad v)_ca, shear (a, e): g_a (Grad v)_ce + g_e (Grad v)_ca, for du = phi_b e_c, g = g_b */
 void PhlexElementCouplingDerivative(const PhlexElementBasis *V, const PhlexElementBasis *S, PetscReal detJ, const PetscReal invJ[9], const PetscReal *ve, PetscReal *Je)
 {
-  const PetscInt nv = V->nnodes, ns = S->nnodes, ncol = 3 * nv;
-  PetscReal      g[3 * PHLEX_MAX_NODES], L[9];
-
-  for (PetscInt i = 0; i < 6 * ns * ncol; i++) Je[i] = 0.0;
-  for (PetscInt q = 0; q < V->nq; q++) {
-    const PetscReal  w   = V->weights[q] * detJ;
-    const PetscReal *psi = &S->node_phi[q * ns];
-    NodeGradients(V, q, invJ, g);
-    FieldGradient(nv, g, ve, L);
-    for (PetscInt i = 0; i < ns; i++) {
-      const PetscReal wp = w * psi[i];
-      for (PetscInt b = 0; b < nv; b++) {
-        const PetscReal *gb = &g[3 * b];
-        for (PetscInt c = 0; c < 3; c++) {
-          const PetscInt col = 3 * b + c;
-          for (PetscInt a = 0; a < 3; a++) Je[(6 * i + a) * ncol + col] += wp * gb[a] * L[3 * c + a];
-          for (PetscInt k = 0; k < 3; k++) {
-            const PetscInt a = VoigtPair[k][0], e = VoigtPair[k][1];
-            Je[(6 * i + 3 + k) * ncol + col] += wp * (gb[a] * L[3 * c + e] + gb[e] * L[3 * c + a]);
-          }
-        }
-      }
-    }
-  }
+  CouplingWith(V, S, detJ, invJ, ve, PETSC_FALSE, Je);
 }
