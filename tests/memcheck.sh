@@ -18,6 +18,8 @@ heavy_top|-options_file options/heavy_top.yaml -ts_max_steps 3|0
 swinging_tip_body|-options_file tests/scenes/swinging_tip_body.yaml -ts_max_steps 2|0
 fourbar_linearized|-options_file options/fourbar.yaml -linearized_sweep 0,30 -body0_dm_plex_filename meshes/fourbar_crank_nx4.msh -body1_dm_plex_filename meshes/fourbar_coupler_nx4.msh -body2_dm_plex_filename meshes/fourbar_follower_nx4.msh|0
 crankslider_constant|-options_file options/crankslider.yaml -body1_inertia constant -body1_dm_plex_filename meshes/crankslider_coupler_nx8.msh -ts_max_steps 2|0
+rotating_linearized|-options_file options/rotating_cantilever.yaml -body0_dm_plex_filename meshes/rotating_beam_nx8.msh -linearized_spin_sweep_range 0,360,180|0
+rotating_transient|-options_file options/rotating_cantilever.yaml -analysis transient -body0_dm_plex_filename meshes/rotating_beam_nx8.msh -body0_spin 0,0,300 -ts_dt 1e-3 -ts_max_steps 2|0
 help|-help|0
 help_scene|-options_file options/cantilever.yaml -help|0
 misspelt_option|-options_file options/cantilever.yaml -ts_max_steps 2 -body0_petscspace_degree 1 -body0_densty 3 -ts_typ bdf|2
