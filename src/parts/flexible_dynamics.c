@@ -533,16 +533,12 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       /* the spin's operators (on Sv's pattern), and room for them in the fixed body's Jvv */
       PetscCall(PhlexFlexibleSpinSetUp(b, part->units));
       PetscCall(MatAXPY(b->Jvv, 0.0, b->Cor, DIFFERENT_NONZERO_PATTERN));
-      PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_FALSE));
     }
     if (b->stiffening) PetscCall(PhlexFlexibleStiffeningSetUp(b));
     if (!b->floating && (b->spinning || b->stiffening)) {
-      /* the exact Schur complement is not symmetric (Coriolis, d(G(u) v)/du) */
+      /* the exact Schur complement is not symmetric (Coriolis, d(G(u) v)/du); the displacement columns Cen + K_sigma */
       PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_FALSE));
       PetscCall(MatSetOption(b->Sv, MAT_SYMMETRIC, PETSC_FALSE));
-    }
-    if (!b->floating && (b->spinning || b->stiffening)) {
-      /* the fixed body's displacement columns: Cen + K_sigma */
       PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, &b->Jvu));
       PetscCall(MatZeroEntries(b->Jvu));
       if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SAME_NONZERO_PATTERN));
