@@ -79,6 +79,7 @@ PETSC_EXTERN int PhlexSceneFilesCheck(int, char **);
 /* interrupt.c: SIGINT/SIGTERM end the run at the next step */
 PETSC_EXTERN PetscErrorCode PhlexInterruptPush(void);
 PETSC_EXTERN PetscErrorCode PhlexInterruptCheck(MPI_Comm, const char[]);
+PETSC_EXTERN PetscErrorCode PhlexInterruptPending(MPI_Comm, int *);
 PETSC_EXTERN int            PhlexInterruptExitCode(void);
 
 /* profile.c: scalar time profiles f(t) multiplying an input */

@@ -38,6 +38,16 @@ struct _p_PhlexOutput {
   PetscInt  ncommitted; /* files renamed to their final names so far */
   PetscBool made_dir;   /* this run created the directory (rank 0) */
   PetscBool locked;     /* this run holds <dir>/.phlex.lock */
+  /* checkpoints (checkpoint.c, output.c): the series and field writers a checkpoint records */
+  PetscViewer *csv;                       /* per file: its CSV viewer, or NULL */
+  PetscInt     nwriters;
+  void       **writers;                   /* the field writers (PhlexFieldWriter) */
+  PetscBool    keep_tmp;                  /* a checkpoint refers to the temporary files: an error keeps them */
+  PetscViewer  restart;                   /* the checkpoint a restarted run continues (HDF5, read), or NULL */
+  char         restart_dir[PETSC_MAX_PATH_LEN]; /* where the interrupted run's series and field segments are */
+  PetscInt     nrestart_csv;
+  char       (*restart_csv)[PETSC_MAX_PATH_LEN];
+  PetscReal   *restart_csv_length;        /* bytes of each series at the checkpoint */
 };
 
 /* What to do with redundant constraint components found at set-up. */
@@ -99,6 +109,10 @@ PETSC_INTERN PetscErrorCode PhlexOutputCSVOpen(PhlexOutput, const char[], const 
 PETSC_INTERN PetscErrorCode PhlexOutputCommit(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputAbort(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputDestroy(PhlexOutput *);
+PETSC_INTERN PetscErrorCode PhlexOutputSaveState(PhlexOutput, PetscViewer);
+PETSC_INTERN PetscErrorCode PhlexOutputSetRestart(PhlexOutput, PetscViewer, const char[]);
+PETSC_INTERN PetscErrorCode PhlexOutputRestoreFile(PhlexOutput, const char[], const char[], PetscReal);
+PETSC_INTERN PetscErrorCode PhlexFieldWriterSaveState(PhlexFieldWriter, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterCreate(PhlexOutput, PhlexFlexible, const char[], PhlexFieldWriter *);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterBeginStep(PhlexFieldWriter, PetscReal);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter, const char[], Vec, PetscReal, const PetscReal *, const PetscReal *, PetscBool);
@@ -107,6 +121,18 @@ PETSC_INTERN PetscErrorCode PhlexFieldWriterStress(PhlexFieldWriter, Vec, PetscR
 PETSC_INTERN PetscErrorCode PhlexFieldWriterSetOutputRotation(PhlexFieldWriter, const PetscReal[9]);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterSetGeometryField(PhlexFieldWriter, const char[]);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *);
+
+/* checkpoint.c: checkpoint files (HDF5), written atomically */
+PETSC_INTERN PetscErrorCode PhlexCheckpointOpenWrite(MPI_Comm, const char[], char[], PetscViewer *);
+PETSC_INTERN PetscErrorCode PhlexCheckpointCommit(MPI_Comm, const char[], const char[], PetscViewer *);
+PETSC_INTERN PetscErrorCode PhlexCheckpointOpenRead(MPI_Comm, const char[], PetscViewer *);
+PETSC_INTERN PetscErrorCode PhlexFileSync(MPI_Comm, const char[]);
+PETSC_INTERN PetscErrorCode PhlexCheckpointWriteReals(PetscViewer, const char[], const char[], PetscInt, const PetscReal[]);
+PETSC_INTERN PetscErrorCode PhlexCheckpointReadReals(PetscViewer, const char[], const char[], PetscInt, PetscReal[]);
+PETSC_INTERN PetscErrorCode PhlexCheckpointWriteInt(PetscViewer, const char[], const char[], PetscInt);
+PETSC_INTERN PetscErrorCode PhlexCheckpointReadInt(PetscViewer, const char[], const char[], PetscInt *);
+PETSC_INTERN PetscErrorCode PhlexCheckpointWriteString(PetscViewer, const char[], const char[], const char[]);
+PETSC_INTERN PetscErrorCode PhlexCheckpointReadString(PetscViewer, const char[], const char[], char[], size_t);
 
 /* error.c: option input with checked length */
 PETSC_INTERN PetscErrorCode PhlexOptionsRealN(PetscOptionItems *, MPI_Comm, const char[], const char[], const char[], const char[], const char[], PetscInt, PetscReal[], PetscBool *);

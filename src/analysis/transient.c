@@ -9,31 +9,8 @@
    theta methods (where the scheme enforces the constraints); for the other schemes lambda . g(t), the scheme holding
    c = g. */
 #include <phlex_impl.h>
+#include <private/transient.h>
 
-typedef struct {
-  PhlexScene  scene;
-  PhlexSystem sys;
-  Vec         Xprev, Xstage, Xmid;
-  PetscReal   tstage;
-  PetscBool   have_stage;
-  PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax, Emax; /* Emax: largest kinetic + strain energy */
-  PetscViewer energy_csv, monitor;
-  PetscInt    interval, last_written;
-  PetscBool   theta, endpoint;
-  PetscReal   theta_value;
-  PetscReal  *qprev, *lambda; /* discrete unknowns of the previous step, multipliers (step averages) */
-  PetscReal  *jpower;         /* power through each joint over the step, with the scheme's quadrature */
-  /* momenta of a free system, rotations */
-  PetscBool   free_system;
-  PetscReal   P0[3], L0[3], Pscale, Lscale, max_dP, max_dL, max_orth, max_defect;
-  /* joints */
-  PetscReal   max_gap, project_dH, step_project_dH;
-  PetscInt    nprojections;
-  /* watchdogs: stop a run whose numbers went wrong (0: off) */
-  PetscReal   watch_balance, watch_gap;
-  PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
-  PhlexProgress progress;
-} MonitorContext;
 
 static PetscErrorCode TransientProgress(TS, MonitorContext *, PetscInt, PetscReal);
 static PetscErrorCode Watchdogs(MonitorContext *, PetscInt, PetscReal, PetscReal, PetscReal);
@@ -192,6 +169,8 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   PetscBool         fields;
 
   PetscFunctionBeginUser;
+  /* a restarted run: the checkpoint's step was monitored by the run that wrote it */
+  if (m->first_step > 0 && step == m->first_step) PetscFunctionReturn(0);
   PetscCall(PetscLogEventBegin(PHLEX_MonitorEnergy, 0, 0, 0, 0));
   for (PetscInt k = 0; k < sys->njoints; k++) m->jpower[k] = 0.0;
   if (step == 0 && sys->njoints) {
@@ -244,6 +223,15 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   m->tprev      = t;
   m->have_stage = PETSC_FALSE;
   PetscCall(PetscLogEventEnd(PHLEX_MonitorEnergy, 0, 0, 0, 0));
+  if (step > 0 && (m->ck_interval > 0 || m->ck_wall > 0)) {
+    /* a checkpoint when due, and before stopping on SIGINT/SIGTERM */
+    PetscBool due;
+    int       sig;
+    PetscCall(PhlexTransientCheckpointDue(m, step, &due));
+    PetscCall(PhlexInterruptPending(m->scene->comm, &sig));
+    if (due || sig) PetscCall(PhlexTransientCheckpointWrite(ts, m, X));
+    PetscCheck(!sig, m->scene->comm, PETSC_ERR_SIG, "interrupted by %s at step %" PetscInt_FMT ", t = %g s: checkpoint written to %s; continue the run with -restart %s", sig == 2 ? "SIGINT" : "SIGTERM", step, (double)t, m->ck_file, m->ck_file);
+  }
   if (step > 0) PetscCall(TransientProgress(ts, m, step, t));
   PetscFunctionReturn(0);
 }
@@ -356,6 +344,12 @@ static PetscErrorCode TransientRereadOptions(void *ctx)
   PetscCall(TransientSetFromOptions(comm, &o));
   PetscCall(PetscViewerDestroy(&o.monitor));
   PetscCall(SolverPresetOption(comm, file));
+  {
+    MonitorContext m;
+    char           restart[PETSC_MAX_PATH_LEN];
+    PetscBool      restarting;
+    PetscCall(PhlexTransientCheckpointOptions(comm, NULL, &m, restart, &restarting));
+  }
   /* a new TS: the run's own prints its options once only */
   PetscCall(TSCreate(comm, &ts));
   PetscCall(TSSetFromOptions(ts));
@@ -372,7 +366,7 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
   char      drift[96] = "";
 
   PetscFunctionBeginUser;
-  if (step == 1) PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
+  if (step == m->first_step + 1) PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
   PetscCall(TSGetMaxTime(ts, &tmax));
   PetscCall(TSGetMaxSteps(ts, &smax));
   done = PetscMax(tmax < PETSC_MAX_REAL ? t / tmax : 0.0, smax < PETSC_MAX_INT ? (PetscReal)step / smax : 0.0);
@@ -441,10 +435,14 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscInt           nsteps;
   TSConvergedReason  reason;
   const PhlexUnits  *u = &scene->units;
+  PetscViewer        checkpoint = NULL; /* the checkpoint a restart continues */
+  char               restart[PETSC_MAX_PATH_LEN];
+  PetscBool          restarting = PETSC_FALSE, checkpointing;
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(&m, sizeof(m)));
   PetscCall(TransientSetFromOptions(scene->comm, &o));
+  PetscCall(PhlexTransientCheckpointOptions(scene->comm, scene->output, &m, restart, &restarting));
   m.monitor = o.monitor;
   if (PhlexHelpGetMode() == PHLEX_HELP_OPTIONS) {
     char file[PETSC_MAX_PATH_LEN] = "";
@@ -577,9 +575,11 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(VecDestroy(&Xdot));
     PetscCall(TSSetIJacobian(ts, sys->Jaij, sys->Jaij, PhlexSystemIJacobian, sys));
   }
-  /* a mechanism starts consistent: loops closed, velocities on the constraints, multipliers solved */
-  if (sys->njoints) PetscCall(PhlexAssemblyClose(sys, 0.0, X, PETSC_TRUE, NULL));
-  if (sys->nq) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
+  /* a mechanism starts consistent: loops closed, velocities on the constraints, multipliers solved (a restart
+     continues a consistent state) */
+  if (sys->njoints && !restarting) PetscCall(PhlexAssemblyClose(sys, 0.0, X, PETSC_TRUE, NULL));
+  if (sys->nq && !restarting) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
+  checkpointing = (m.ck_interval > 0 || m.ck_wall > 0) ? PETSC_TRUE : PETSC_FALSE;
 
   /* monitor and outputs */
   m.scene    = scene;
@@ -599,6 +599,12 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
   m.watch_balance   = o.watch_balance;
   m.watch_gap       = o.watch_gap;
+  if (restarting) {
+    /* the checkpoint belongs to this run; the outputs continue its */
+    PetscCall(PhlexCheckpointOpenRead(scene->comm, restart, &checkpoint));
+    PetscCall(PhlexTransientRestartCheck(ts, &m, checkpoint, restart, X));
+    PetscCall(PhlexOutputSetRestart(scene->output, checkpoint, restart));
+  }
   PetscCall(PhlexOutputCSVOpen(scene->output, "energy.csv", "step,time,kinetic,strain,potential,total,input_power,supplied_work,balance_residual", &m.energy_csv));
   for (PetscInt i = 0; i < sys->nparts; i++) PetscCall((*sys->parts[i]->ops.outputopen)(sys->parts[i], scene->output, scene->output->fields));
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputOpen(sys->joints[k], scene->output));
@@ -607,6 +613,12 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(TSSetPreStep(ts, PreStep));
   PetscCall(TSSetPostStep(ts, PostStep));
   PetscCall(TSSetPostStage(ts, PostStage));
+  if (restarting) {
+    PetscCall(PhlexTransientRestart(ts, &m, checkpoint, restart, X));
+    PetscCall(PetscViewerDestroy(&checkpoint));
+    scene->output->restart = NULL;
+  }
+  PetscCall(PetscTime(&m.ck_last));
 
   PetscCall(PhlexLogStagePush("Phlex Transient", &PHLEX_StageTransient));
   PetscCall(PhlexProgressStart(&m.progress));
@@ -630,6 +642,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     }
   }
 
+  /* the final state's checkpoint: the run can be continued further (-restart with a later -ts_max_time) */
+  if (checkpointing) PetscCall(PhlexTransientCheckpointWrite(ts, &m, X));
+
   {
     TSType type;
     PetscCall(TSGetType(ts, &type));
@@ -646,6 +661,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
         break;
       }
     if (m.free_system) PetscCall(PetscPrintf(scene->comm, "  momenta: max drift of P %.3e, of L %.3e (largest component of P - P0, L - L0, relative to %.6e kg m/s, %.6e kg m^2/s)\n", (double)m.max_dP, (double)m.max_dL, (double)(m.Pscale * u->mass * u->velocity), (double)(m.Lscale * u->mass * u->velocity * u->length)));
+    if (checkpointing) PetscCall(PetscPrintf(scene->comm, "  checkpoint: %s (step %" PetscInt_FMT ")\n", m.ck_file, m.ck_step));
+    if (m.first_step) PetscCall(PetscPrintf(scene->comm, "  restarted at step %" PetscInt_FMT "\n", m.first_step));
     if (sys->njoints) {
       PetscCall(PetscPrintf(scene->comm, "  joints: max position-level violation %.3e (m or rad)", (double)m.max_gap));
       if (m.nprojections) PetscCall(PetscPrintf(scene->comm, "; %" PetscInt_FMT " projections changed the energy by %.3e J", m.nprojections, (double)(m.project_dH * u->energy)));

@@ -19,7 +19,116 @@ struct _p_PhlexFieldWriter {
   char        geometry_field[PHLEX_NAME_LEN];   /* vertex field holding time-dependent coordinates, or "" */
   PetscBool   rotate_out;                       /* vertex fields are turned by Rout after composing (inertial components) */
   PetscReal   Rout[9];
+  /* segments: each checkpoint closes the HDF5 file being written (a closed file stays valid whatever happens to
+     the run); the next snapshot opens segment seg, <name>_seg<seg>.h5 (segment 0: <name>.h5, with the mesh) */
+  PetscInt    seg, seg_first;                   /* the current segment, its first snapshot */
+  PetscInt   *snap_seg;                         /* segment of each snapshot */
 };
+
+static PetscErrorCode SegmentName(PhlexFieldWriter w, PetscInt seg, char name[], size_t len)
+{
+  PetscFunctionBeginUser;
+  if (seg) PetscCall(PetscSNPrintf(name, len, "%s_seg%" PetscInt_FMT ".h5", w->name, seg));
+  else PetscCall(PetscSNPrintf(name, len, "%s.h5", w->name));
+  PetscFunctionReturn(0);
+}
+
+/* opens the HDF5 file of the current segment (the first one holds the mesh, which the XDMF index of every snapshot
+   refers to) */
+static PetscErrorCode OpenSegment(PhlexFieldWriter w)
+{
+  char file[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(SegmentName(w, w->seg, file, sizeof(file)));
+  PetscCall(PhlexOutputFile(w->out, file, w->h5tmp));
+  PetscCall(PetscViewerHDF5Open(w->out->comm, w->h5tmp, FILE_MODE_WRITE, &w->viewer));
+  if (!w->seg) {
+    PetscCall(PetscViewerPushFormat(w->viewer, PETSC_VIEWER_HDF5_VIZ));
+    PetscCall(DMView(w->body->dm, w->viewer));
+    PetscCall(PetscViewerPopFormat(w->viewer));
+  }
+  w->seg_first = w->nsteps;
+  PetscFunctionReturn(0);
+}
+
+/* a restarted run: the snapshots and segments the checkpoint records (the segments copied or kept, PhlexOutputRestoreFile) */
+static PetscErrorCode RestoreState(PhlexFieldWriter w)
+{
+  PetscViewer v = w->out->restart;
+  char        group[PETSC_MAX_PATH_LEN], list[8 * PHLEX_NAME_LEN + 16], file[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
+  PetscBool   has;
+  PetscReal  *buf;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(group, sizeof(group), "/output/fields_%s", w->name));
+  PetscCall(PetscViewerHDF5HasGroup(v, group, &has));
+  PetscCheck(has, w->out->comm, PETSC_ERR_FILE_UNEXPECTED, "the checkpoint (option -restart) has no fields of body %s: it was written for another scene, or with -output_fields 0", w->name);
+  PetscCall(PhlexCheckpointReadInt(v, group, "nsteps", &w->nsteps));
+  PetscCall(PhlexCheckpointReadInt(v, group, "nseg", &w->seg));
+  PetscCall(PetscMalloc2(w->nsteps + 1, &w->times, w->nsteps + 1, &w->snap_seg));
+  PetscCall(PetscMalloc1(w->nsteps + 1, &buf));
+  PetscCall(PhlexCheckpointReadReals(v, group, "times", w->nsteps, w->times));
+  PetscCall(PhlexCheckpointReadReals(v, group, "segments", w->nsteps, buf));
+  for (PetscInt k = 0; k < w->nsteps; k++) w->snap_seg[k] = (PetscInt)buf[k];
+  PetscCall(PetscFree(buf));
+  PetscCall(PhlexCheckpointReadString(v, group, "vertex_fields", list, sizeof(list)));
+  for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) PetscCall(PetscStrncpy(w->vfields[w->nvfields++], tok, PHLEX_NAME_LEN));
+  PetscCall(PhlexCheckpointReadString(v, group, "cell_fields", list, sizeof(list)));
+  for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
+    char *colon = strchr(tok, ':');
+    PetscCheck(colon, w->out->comm, PETSC_ERR_FILE_UNEXPECTED, "the checkpoint's cell fields of body %s are malformed", w->name);
+    *colon                    = 0;
+    w->cfield_nc[w->ncfields] = atoi(colon + 1);
+    PetscCall(PetscStrncpy(w->cfields[w->ncfields++], tok, PHLEX_NAME_LEN));
+  }
+  for (PetscInt s = 0; s < w->seg; s++) {
+    PetscCall(SegmentName(w, s, file, sizeof(file)));
+    PetscCall(PhlexOutputFile(w->out, file, tmp));
+    PetscCall(PhlexOutputRestoreFile(w->out, file, tmp, -1));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFieldWriterSaveState - for a checkpoint: closes the current segment (the snapshots written so far stay valid
+  whatever happens to the run) and records the snapshots and segments
+
+  Collective
+@*/
+PetscErrorCode PhlexFieldWriterSaveState(PhlexFieldWriter w, PetscViewer v)
+{
+  char       group[PETSC_MAX_PATH_LEN], list[8 * PHLEX_NAME_LEN + 16] = "";
+  PetscReal *buf;
+  size_t     len;
+
+  PetscFunctionBeginUser;
+  if (w->viewer) {
+    PetscCall(PetscViewerDestroy(&w->viewer));
+    PetscCall(PhlexFileSync(w->out->comm, w->h5tmp));
+    w->seg++;
+  }
+  PetscCall(PetscSNPrintf(group, sizeof(group), "/output/fields_%s", w->name));
+  PetscCall(PhlexCheckpointWriteInt(v, group, "nsteps", w->nsteps));
+  PetscCall(PhlexCheckpointWriteInt(v, group, "nseg", w->seg));
+  PetscCall(PetscMalloc1(w->nsteps + 1, &buf));
+  for (PetscInt k = 0; k < w->nsteps; k++) buf[k] = (PetscReal)w->snap_seg[k];
+  PetscCall(PhlexCheckpointWriteReals(v, group, "times", w->nsteps, w->times));
+  PetscCall(PhlexCheckpointWriteReals(v, group, "segments", w->nsteps, buf));
+  PetscCall(PetscFree(buf));
+  for (PetscInt f = 0; f < w->nvfields; f++) {
+    PetscCall(PetscStrlen(list, &len));
+    PetscCall(PetscSNPrintf(list + len, sizeof(list) - len, "%s%s", f ? "," : "", w->vfields[f]));
+  }
+  PetscCall(PhlexCheckpointWriteString(v, group, "vertex_fields", list));
+  list[0] = 0;
+  for (PetscInt f = 0; f < w->ncfields; f++) {
+    PetscCall(PetscStrlen(list, &len));
+    PetscCall(PetscSNPrintf(list + len, sizeof(list) - len, "%s%s:%d", f ? "," : "", w->cfields[f], (int)w->cfield_nc[f]));
+  }
+  PetscCall(PhlexCheckpointWriteString(v, group, "cell_fields", list));
+  PetscFunctionReturn(0);
+}
 
 static PetscErrorCode CreateOutputDM(DM dm, PetscInt degree, PetscInt nc, const char name[], DM *odm)
 {
@@ -54,8 +163,16 @@ PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexFlexible body, const
   w->out  = out;
   w->body = body;
   PetscCall(PetscStrncpy(w->name, name, sizeof(w->name)));
-  PetscCall(PetscSNPrintf(file, sizeof(file), "%s.h5", name));
-  PetscCall(PhlexOutputFile(out, file, w->h5tmp));
+  {
+    void **list;
+    PetscCall(PetscMalloc1(out->nwriters + 1, &list));
+    if (out->nwriters) PetscCall(PetscArraycpy(list, out->writers, out->nwriters));
+    list[out->nwriters] = w;
+    PetscCall(PetscFree(out->writers));
+    out->writers = list;
+    out->nwriters++;
+  }
+  if (out->restart) PetscCall(RestoreState(w));
   PetscCall(PetscSNPrintf(file, sizeof(file), "%s.xmf", name));
   PetscCall(PhlexOutputFile(out, file, w->xmftmp));
   PetscCall(CreateOutputDM(body->dm, 1, 3, "vertex", &w->dm_vertex));
@@ -68,10 +185,7 @@ PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexFlexible body, const
   }
   PetscCall(CreateOutputDM(body->dm, 0, 1, "scalar", &w->dm_cell1));
   PetscCall(DMCreateLocalVector(body->dm, &w->lv));
-  PetscCall(PetscViewerHDF5Open(out->comm, w->h5tmp, FILE_MODE_WRITE, &w->viewer));
-  PetscCall(PetscViewerPushFormat(w->viewer, PETSC_VIEWER_HDF5_VIZ));
-  PetscCall(DMView(body->dm, w->viewer));
-  PetscCall(PetscViewerPopFormat(w->viewer));
+  if (!out->restart) PetscCall(OpenSegment(w));
   PetscCall(DMPlexGetDepthStratum(body->dm, 0, &vStart, &vEnd));
   PetscCall(DMPlexGetHeightStratum(body->dm, 0, &cStart, &cEnd));
   {
@@ -97,16 +211,22 @@ PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexFlexible body, const
 PetscErrorCode PhlexFieldWriterBeginStep(PhlexFieldWriter w, PetscReal t)
 {
   PetscReal *times;
+  PetscInt  *seg;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(w->nsteps + 1, &times));
+  if (!w->viewer) PetscCall(OpenSegment(w));
+  PetscCall(PetscMalloc2(w->nsteps + 1, &times, w->nsteps + 1, &seg));
   if (w->nsteps) PetscCall(PetscArraycpy(times, w->times, w->nsteps));
+  if (w->nsteps) PetscCall(PetscArraycpy(seg, w->snap_seg, w->nsteps));
   times[w->nsteps] = t;
-  PetscCall(PetscFree(w->times));
-  w->times = times;
-  PetscCall(DMSetOutputSequenceNumber(w->dm_vertex, w->nsteps, t));
-  PetscCall(DMSetOutputSequenceNumber(w->dm_cell6, w->nsteps, t));
-  PetscCall(DMSetOutputSequenceNumber(w->dm_cell1, w->nsteps, t));
+  seg[w->nsteps]   = w->seg;
+  PetscCall(PetscFree2(w->times, w->snap_seg));
+  w->times    = times;
+  w->snap_seg = seg;
+  /* the index of the snapshot in its segment's datasets */
+  PetscCall(DMSetOutputSequenceNumber(w->dm_vertex, w->nsteps - w->seg_first, t));
+  PetscCall(DMSetOutputSequenceNumber(w->dm_cell6, w->nsteps - w->seg_first, t));
+  PetscCall(DMSetOutputSequenceNumber(w->dm_cell1, w->nsteps - w->seg_first, t));
   w->nsteps++;
   PetscFunctionReturn(0);
 }
@@ -345,39 +465,45 @@ static PetscErrorCode WriteXDMF(PhlexFieldWriter w)
 {
   FILE       *fp;
   PetscMPIInt rank;
-  char        h5name[PETSC_MAX_PATH_LEN];
+  char        h5name[PETSC_MAX_PATH_LEN], mesh[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(w->out->comm, &rank));
   if (rank) PetscFunctionReturn(0);
-  PetscCall(PetscSNPrintf(h5name, sizeof(h5name), "%s.h5", w->name));
+  PetscCall(SegmentName(w, 0, mesh, sizeof(mesh)));
   fp = fopen(w->xmftmp, "w");
   PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "cannot write '%s'", w->xmftmp);
   fprintf(fp, "<?xml version=\"1.0\" ?>\n<!DOCTYPE Xdmf SYSTEM \"Xdmf.dtd\" []>\n<Xdmf Version=\"2.0\">\n <Domain>\n");
   fprintf(fp, "  <Grid Name=\"%s\" GridType=\"Collection\" CollectionType=\"Temporal\">\n", w->name);
   for (PetscInt k = 0; k < w->nsteps; k++) {
+    /* the snapshot's segment, its index there and the segment's number of snapshots */
+    PetscInt first = k, count = 0, i;
+    while (first > 0 && w->snap_seg[first - 1] == w->snap_seg[k]) first--;
+    while (first + count < w->nsteps && w->snap_seg[first + count] == w->snap_seg[k]) count++;
+    i = k - first;
+    PetscCall(SegmentName(w, w->snap_seg[k], h5name, sizeof(h5name)));
     fprintf(fp, "   <Grid Name=\"%s_%d\" GridType=\"Uniform\">\n    <Time Value=\"%.12g\"/>\n", w->name, (int)k, (double)w->times[k]);
-    fprintf(fp, "    <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%d\">\n     <DataItem Dimensions=\"%d 4\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n    </Topology>\n", (int)w->ncells, (int)w->ncells, h5name);
+    fprintf(fp, "    <Topology TopologyType=\"Tetrahedron\" NumberOfElements=\"%d\">\n     <DataItem Dimensions=\"%d 4\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n    </Topology>\n", (int)w->ncells, (int)w->ncells, mesh);
     if (w->geometry_field[0]) {
       fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/moving_geometry/step_%d</DataItem>\n    </Geometry>\n", (int)w->nvertex, h5name, (int)k);
     } else {
-      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n    </Geometry>\n", (int)w->nvertex, h5name);
+      fprintf(fp, "    <Geometry GeometryType=\"XYZ\">\n     <DataItem Dimensions=\"%d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n    </Geometry>\n", (int)w->nvertex, mesh);
     }
     for (PetscInt f = 0; f < w->nvfields; f++) {
       fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"Vector\" Center=\"Node\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d 3\" Type=\"HyperSlab\">\n", w->vfields[f], (int)w->nvertex);
-      fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d 3</DataItem>\n", (int)k, (int)w->nvertex);
-      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->nvertex, h5name, w->vfields[f]);
+      fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d 3</DataItem>\n", (int)i, (int)w->nvertex);
+      fprintf(fp, "      <DataItem Dimensions=\"%d %d 3\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s_vertex</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)count, (int)w->nvertex, h5name, w->vfields[f]);
     }
     for (PetscInt f = 0; f < w->ncfields; f++) {
       const PetscInt nc = w->cfield_nc[f];
       if (nc == 1) { /* PETSc stores one-component cell fields as (step, cell) */
         fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Cell\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d\" Type=\"HyperSlab\">\n", w->cfields[f], (int)w->ncells);
-        fprintf(fp, "      <DataItem Dimensions=\"3 2\" Format=\"XML\">%d 0 1 1 1 %d</DataItem>\n", (int)k, (int)w->ncells);
-        fprintf(fp, "      <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s_scalar</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->ncells, h5name, w->cfields[f]);
+        fprintf(fp, "      <DataItem Dimensions=\"3 2\" Format=\"XML\">%d 0 1 1 1 %d</DataItem>\n", (int)i, (int)w->ncells);
+        fprintf(fp, "      <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s_scalar</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)count, (int)w->ncells, h5name, w->cfields[f]);
       } else {
         fprintf(fp, "    <Attribute Name=\"%s\" AttributeType=\"Matrix\" Center=\"Cell\">\n     <DataItem ItemType=\"HyperSlab\" Dimensions=\"1 %d %d\" Type=\"HyperSlab\">\n", w->cfields[f], (int)w->ncells, (int)nc);
-        fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d %d</DataItem>\n", (int)k, (int)w->ncells, (int)nc);
-        fprintf(fp, "      <DataItem Dimensions=\"%d %d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s_cell</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)w->nsteps, (int)w->ncells, (int)nc, h5name, w->cfields[f]);
+        fprintf(fp, "      <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d %d</DataItem>\n", (int)i, (int)w->ncells, (int)nc);
+        fprintf(fp, "      <DataItem Dimensions=\"%d %d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s_cell</DataItem>\n     </DataItem>\n    </Attribute>\n", (int)count, (int)w->ncells, (int)nc, h5name, w->cfields[f]);
       }
     }
     fprintf(fp, "   </Grid>\n");
@@ -404,7 +530,7 @@ PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *writer)
   PetscCall(DMDestroy(&w->dm_cell6));
   PetscCall(DMDestroy(&w->dm_cell1));
   PetscCall(VecDestroy(&w->lv));
-  PetscCall(PetscFree(w->times));
+  PetscCall(PetscFree2(w->times, w->snap_seg));
   PetscCall(PetscFree(*writer));
   PetscFunctionReturn(0);
 }

@@ -1,7 +1,7 @@
 /* Output of a run: one directory with the CSV series and, per flexible body, HDF5 fields plus an XDMF index for
    ParaView (fields.c). Every file is written under a temporary name and renamed when the run completes, so an
    error never leaves a half-written result under a final name. */
-#define _POSIX_C_SOURCE 200809L /* kill, gethostname, open flags */
+#define _XOPEN_SOURCE 700 /* kill, gethostname, open flags, realpath, truncate, fsync */
 #include <phlex_impl.h>
 #include <petscviewerhdf5.h>
 #include <fcntl.h>
@@ -172,17 +172,21 @@ PetscErrorCode PhlexOutputFile(PhlexOutput out, const char name[], char tmp[])
   }
   if (k == out->maxfiles) {
     char(*tmp)[PETSC_MAX_PATH_LEN], (*fin)[PETSC_MAX_PATH_LEN];
+    PetscViewer   *csv;
     const PetscInt n = PetscMax(16, 2 * out->maxfiles);
-    PetscCall(PetscMalloc2(n, &tmp, n, &fin));
+    PetscCall(PetscMalloc3(n, &tmp, n, &fin, n, &csv));
     if (k) {
       PetscCall(PetscArraycpy(tmp, out->tmp, k));
       PetscCall(PetscArraycpy(fin, out->final, k));
+      PetscCall(PetscArraycpy(csv, out->csv, k));
     }
-    PetscCall(PetscFree2(out->tmp, out->final));
+    PetscCall(PetscFree3(out->tmp, out->final, out->csv));
     out->tmp      = tmp;
     out->final    = fin;
+    out->csv      = csv;
     out->maxfiles = n;
   }
+  out->csv[k] = NULL;
   PetscCall(PetscSNPrintf(out->final[k], PETSC_MAX_PATH_LEN, "%s/%s", out->dir, name));
   PetscCall(PetscSNPrintf(out->tmp[k], PETSC_MAX_PATH_LEN, "%s/.%s.tmp", out->dir, name));
   PetscCall(PetscStrcpy(tmp, out->tmp[k]));
@@ -241,7 +245,10 @@ PetscErrorCode PhlexOutputAbort(PhlexOutput out)
   if (!out) return 0;
   MPI_Comm_rank(out->comm, &rank);
   Unlock(out);
-  if (rank == 0) {
+  if (rank == 0 && out->keep_tmp) {
+    /* a checkpoint continues them (-restart) */
+    fprintf(stderr, "phlex: the partial series and fields in '%s' were kept for the checkpoint (continue with -restart)\n", out->dir);
+  } else if (rank == 0) {
     for (PetscInt k = 0; k < out->nfiles; k++) (void)remove(out->tmp[k]);
     /* a directory this run made and left empty would look like a result: removed (rmdir fails if not empty) */
     if (out->made_dir && !out->ncommitted) (void)rmdir(out->dir);
@@ -260,11 +267,181 @@ PetscErrorCode PhlexOutputCSVOpen(PhlexOutput out, const char name[], const char
 {
   char tmp[PETSC_MAX_PATH_LEN];
 
+  PetscInt k = -1;
+
   PetscFunctionBeginUser;
   PetscCall(PhlexOutputFile(out, name, tmp));
-  PetscCall(PetscViewerASCIIOpen(out->comm, tmp, viewer));
+  for (PetscInt i = 0; i < out->nrestart_csv; i++) {
+    PetscBool same;
+    PetscCall(PetscStrcmp(out->restart_csv[i], name, &same));
+    if (same) k = i;
+  }
+  if (k >= 0) {
+    PetscCheck(header, out->comm, PETSC_ERR_PLIB, "series '%s' continued by a restart must be opened with its header", name);
+    /* a restarted run: the series up to the checkpoint (its header included), then this run's rows appended */
+    PetscCall(PhlexOutputRestoreFile(out, name, tmp, out->restart_csv_length[k]));
+    PetscCall(PetscViewerCreate(out->comm, viewer));
+    PetscCall(PetscViewerSetType(*viewer, PETSCVIEWERASCII));
+    PetscCall(PetscViewerFileSetMode(*viewer, FILE_MODE_APPEND));
+    PetscCall(PetscViewerFileSetName(*viewer, tmp));
+  } else {
+    PetscCheck(!out->restart, out->comm, PETSC_ERR_FILE_UNEXPECTED, "the checkpoint (option -restart) has no series '%s': it was written for another scene or other outputs", name);
+    PetscCall(PetscViewerASCIIOpen(out->comm, tmp, viewer));
+  }
   PetscCall(PetscViewerPushFormat(*viewer, PETSC_VIEWER_ASCII_CSV));
-  if (header) PetscCall(PetscViewerASCIIPrintf(*viewer, "%s\n", header));
+  if (header && k < 0) PetscCall(PetscViewerASCIIPrintf(*viewer, "%s\n", header));
+  out->csv[out->nfiles - 1] = *viewer;
+  PetscFunctionReturn(0);
+}
+
+/* rank 0: copies the first length bytes (all if length < 0) of src to dst; 0 or an errno, *short_src if src is
+   shorter */
+static int CopyPrefix(const char src[], const char dst[], PetscReal length, PetscBool *short_src)
+{
+  FILE  *in = fopen(src, "rb"), *out;
+  char   buf[1 << 16];
+  double left = length < 0 ? 1e300 : (double)length;
+  int    err  = 0;
+
+  *short_src = PETSC_FALSE;
+  if (!in) return errno;
+  out = fopen(dst, "wb");
+  if (!out) {
+    err = errno;
+    fclose(in);
+    return err;
+  }
+  while (left > 0) {
+    size_t want = left < (double)sizeof(buf) ? (size_t)left : sizeof(buf), got = fread(buf, 1, want, in);
+    if (got && fwrite(buf, 1, got, out) != got) {
+      err = errno ? errno : EIO;
+      break;
+    }
+    left -= (double)got;
+    if (got < want) break;
+  }
+  if (length >= 0 && left > 0 && !err) *short_src = PETSC_TRUE;
+  fclose(in);
+  if (fclose(out) && !err) err = errno;
+  return err;
+}
+
+/*@C
+  PhlexOutputRestoreFile - the file "name" of the interrupted run a restart continues, up to its length at the
+  checkpoint (all of it if length < 0), as this run's temporary file tmp: truncated in place when the restart writes
+  to the same directory, copied otherwise. The interrupted run's file is its temporary file, or its final name if
+  that run completed.
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputRestoreFile(PhlexOutput out, const char name[], const char tmp[], PetscReal length)
+{
+  PetscMPIInt rank;
+  int         err = 0;
+  PetscBool   short_src = PETSC_FALSE, found = PETSC_TRUE;
+  char        src[PETSC_MAX_PATH_LEN + 8];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
+  if (rank == 0) {
+    char        rsrc[PETSC_MAX_PATH_LEN], rdst[PETSC_MAX_PATH_LEN];
+    struct stat st;
+    snprintf(src, sizeof(src), "%s/.%s.tmp", out->restart_dir, name);
+    if (stat(src, &st)) {
+      snprintf(src, sizeof(src), "%s/%s", out->restart_dir, name);
+      if (stat(src, &st)) found = PETSC_FALSE;
+    }
+    if (found && realpath(src, rsrc) && realpath(tmp, rdst) && !strcmp(rsrc, rdst)) {
+      /* the same file: cut what the interrupted run wrote after its checkpoint */
+      if (length >= 0 && (double)st.st_size < (double)length) short_src = PETSC_TRUE;
+      else if (length >= 0 && truncate(tmp, (off_t)length)) err = errno;
+    } else if (found) err = CopyPrefix(src, tmp, length, &short_src);
+  }
+  PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, out->comm));
+  PetscCallMPI(MPI_Bcast(&found, 1, MPIU_BOOL, 0, out->comm));
+  PetscCallMPI(MPI_Bcast(&short_src, 1, MPIU_BOOL, 0, out->comm));
+  PetscCheck(found, out->comm, PETSC_ERR_FILE_OPEN, "the checkpoint (option -restart) continues '%s' of the run in '%s', but neither %s/.%s.tmp nor %s/%s exists: were the interrupted run's files removed?", name, out->restart_dir, out->restart_dir, name, out->restart_dir, name);
+  PetscCheck(!short_src, out->comm, PETSC_ERR_FILE_UNEXPECTED, "the checkpoint (option -restart) continues '%s' of the run in '%s' at %.0f bytes, but that file is shorter: it is not the file the checkpoint was written with", name, out->restart_dir, (double)length);
+  PetscCheck(!err, out->comm, PETSC_ERR_FILE_WRITE, "cannot continue '%s' of the run in '%s' into '%s': %s", name, out->restart_dir, tmp, strerror(err));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputSaveState - records in a checkpoint where every series stands (flushed to disk, its length) and each
+  field writer's snapshots (PhlexFieldWriterSaveState closes its current segment); from now on an error keeps the
+  temporary files, which the checkpoint continues
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputSaveState(PhlexOutput out, PetscViewer viewer)
+{
+  PetscMPIInt rank;
+  PetscInt    ncsv = 0;
+  char        dir[PETSC_MAX_PATH_LEN] = "", key[32];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
+  for (PetscInt k = 0; k < out->nfiles; k++) {
+    PetscReal length = 0;
+    if (!out->csv[k]) continue;
+    PetscCall(PetscViewerFlush(out->csv[k]));
+    if (rank == 0) {
+      FILE *fp;
+      PetscCall(PetscViewerASCIIGetPointer(out->csv[k], &fp));
+      PetscCheck(!fflush(fp) && !fsync(fileno(fp)), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write '%s': %s", out->tmp[k], strerror(errno));
+      length = (PetscReal)ftell(fp);
+    }
+    PetscCallMPI(MPI_Bcast(&length, 1, MPIU_REAL, 0, out->comm));
+    PetscCall(PetscSNPrintf(key, sizeof(key), "csv_%" PetscInt_FMT, ncsv));
+    PetscCall(PhlexCheckpointWriteString(viewer, "/output", key, out->final[k] + strlen(out->dir) + 1));
+    PetscCall(PetscSNPrintf(key, sizeof(key), "csv_length_%" PetscInt_FMT, ncsv));
+    PetscCall(PhlexCheckpointWriteReals(viewer, "/output", key, 1, &length));
+    ncsv++;
+  }
+  PetscCall(PhlexCheckpointWriteInt(viewer, "/output", "ncsv", ncsv));
+  if (rank == 0 && !realpath(out->dir, dir)) PetscCall(PetscStrncpy(dir, out->dir, sizeof(dir)));
+  PetscCallMPI(MPI_Bcast(dir, sizeof(dir), MPI_CHAR, 0, out->comm));
+  PetscCall(PhlexCheckpointWriteString(viewer, "/output", "dir", dir));
+  for (PetscInt w = 0; w < out->nwriters; w++) PetscCall(PhlexFieldWriterSaveState((PhlexFieldWriter)out->writers[w], viewer));
+  out->keep_tmp = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputSetRestart - a restarted run: its series and field writers continue those recorded in the checkpoint
+  (the interrupted run's files are found in the directory it recorded, else next to the checkpoint)
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputSetRestart(PhlexOutput out, PetscViewer viewer, const char checkpoint[])
+{
+  PetscBool isdir = PETSC_FALSE;
+  char      key[32], mine[PETSC_MAX_PATH_LEN] = "", theirs[PETSC_MAX_PATH_LEN] = "";
+
+  PetscFunctionBeginUser;
+  out->restart = viewer;
+  PetscCall(PhlexCheckpointReadString(viewer, "/output", "dir", out->restart_dir, sizeof(out->restart_dir)));
+  PetscCall(PetscTestDirectory(out->restart_dir, 'r', &isdir));
+  if (!isdir) {
+    const char *slash = strrchr(checkpoint, '/');
+    if (slash) PetscCall(PetscSNPrintf(out->restart_dir, sizeof(out->restart_dir), "%.*s", (int)(slash - checkpoint), checkpoint));
+    else PetscCall(PetscStrcpy(out->restart_dir, "."));
+  }
+  PetscCall(PhlexCheckpointReadInt(viewer, "/output", "ncsv", &out->nrestart_csv));
+  PetscCall(PetscMalloc2(out->nrestart_csv, &out->restart_csv, out->nrestart_csv, &out->restart_csv_length));
+  for (PetscInt k = 0; k < out->nrestart_csv; k++) {
+    PetscCall(PetscSNPrintf(key, sizeof(key), "csv_%" PetscInt_FMT, k));
+    PetscCall(PhlexCheckpointReadString(viewer, "/output", key, out->restart_csv[k], sizeof(out->restart_csv[k])));
+    PetscCall(PetscSNPrintf(key, sizeof(key), "csv_length_%" PetscInt_FMT, k));
+    PetscCall(PhlexCheckpointReadReals(viewer, "/output", key, 1, &out->restart_csv_length[k]));
+  }
+  /* continuing in place: an error before this run's first checkpoint keeps the files the old one continues */
+  {
+    PetscMPIInt rank;
+    PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
+    if (rank == 0 && realpath(out->dir, mine) && realpath(out->restart_dir, theirs) && !strcmp(mine, theirs)) out->keep_tmp = PETSC_TRUE;
+    PetscCallMPI(MPI_Bcast(&out->keep_tmp, 1, MPIU_BOOL, 0, out->comm));
+  }
   PetscFunctionReturn(0);
 }
 
@@ -276,7 +453,9 @@ PetscErrorCode PhlexOutputDestroy(PhlexOutput *out)
   PetscFunctionBeginUser;
   if (!*out) PetscFunctionReturn(0);
   Unlock(*out);
-  PetscCall(PetscFree2((*out)->tmp, (*out)->final));
+  PetscCall(PetscFree3((*out)->tmp, (*out)->final, (*out)->csv));
+  PetscCall(PetscFree((*out)->writers));
+  PetscCall(PetscFree2((*out)->restart_csv, (*out)->restart_csv_length));
   PetscCall(PetscFree(*out));
   PetscFunctionReturn(0);
 }

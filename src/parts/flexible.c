@@ -453,22 +453,29 @@ static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool 
     if (b->floating) PetscCall(PhlexFieldWriterSetGeometryField((PhlexFieldWriter)b->writer, "inertial_position"));
   }
   if (b->nports || b->floating) {
-    PetscViewer csv;
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", b->name));
-    PetscCall(PhlexOutputCSVOpen(out, name, NULL, &csv));
-    b->ports_csv = csv;
-    PetscCall(PetscViewerASCIIPrintf(csv, "time"));
+    /* the header in one piece: a restarted run continues the series without it */
+    const size_t len = (size_t)((b->nports + 1) * 15 + 1) * (PHLEX_NAME_LEN + 8);
+    char        *h;
+    size_t       n;
+    PetscViewer  csv;
+    PetscCall(PetscMalloc1(len, &h));
+    PetscCall(PetscStrcpy(h, "time"));
     /* the frame of a floating body first (its patch, or "frame" with mean axes), then the ports */
     for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
-      const char *n = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      PetscCall(PetscViewerASCIIPrintf(csv, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
+      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
+      PetscCall(PetscStrlen(h, &n));
+      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn));
     }
     /* then the inertial positions of the port points (the mean of the patch's displaced points) */
     for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
-      const char *n = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      PetscCall(PetscViewerASCIIPrintf(csv, ",%s_x,%s_y,%s_z", n, n, n));
+      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
+      PetscCall(PetscStrlen(h, &n));
+      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_x,%s_y,%s_z", pn, pn, pn));
     }
-    PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", b->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, h, &csv));
+    PetscCall(PetscFree(h));
+    b->ports_csv = csv;
   }
   if (b->floating) {
     PetscCall(PhlexFrameWriteHeader(header, sizeof(header)));

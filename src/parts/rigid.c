@@ -366,15 +366,24 @@ static PetscErrorCode RigidOutputOpen(PhlexPart part, PhlexOutput out, PetscBool
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_rigid.csv", part->name));
   PetscCall(PhlexOutputCSVOpen(out, name, header, &r->rigid_csv));
   if (r->nports) {
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part->name));
-    PetscCall(PhlexOutputCSVOpen(out, name, NULL, &r->ports_csv));
-    PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "time"));
+    /* the header in one piece: a restarted run continues the series without it */
+    const size_t len = (size_t)(r->nports * 15 + 1) * (PHLEX_NAME_LEN + 8);
+    char        *h;
+    size_t       n;
+    PetscCall(PetscMalloc1(len, &h));
+    PetscCall(PetscStrcpy(h, "time"));
     for (PetscInt p = 0; p < r->nports; p++) {
-      const char *n = r->port_name[p];
-      PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", n, n, n, n, n, n, n, n, n, n, n, n));
+      const char *pn = r->port_name[p];
+      PetscCall(PetscStrlen(h, &n));
+      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn));
     }
-    for (PetscInt p = 0; p < r->nports; p++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%s_x,%s_y,%s_z", r->port_name[p], r->port_name[p], r->port_name[p]));
-    PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "\n"));
+    for (PetscInt p = 0; p < r->nports; p++) {
+      PetscCall(PetscStrlen(h, &n));
+      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_x,%s_y,%s_z", r->port_name[p], r->port_name[p], r->port_name[p]));
+    }
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, h, &r->ports_csv));
+    PetscCall(PetscFree(h));
   }
   PetscFunctionReturn(0);
 }

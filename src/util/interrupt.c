@@ -59,6 +59,22 @@ PetscErrorCode PhlexInterruptCheck(MPI_Comm comm, const char where[])
 }
 
 /*@C
+  PhlexInterruptPending - the signal (SIGINT or SIGTERM) any rank received, 0 if none, on every rank; the run then
+  stops at PhlexInterruptCheck (or raises PETSC_ERR_SIG itself after saving what it can: a checkpoint)
+
+  Collective
+@*/
+PetscErrorCode PhlexInterruptPending(MPI_Comm comm, int *sig)
+{
+  int mine = (int)phlex_signal;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Allreduce(&mine, sig, 1, MPI_INT, MPI_MAX, comm));
+  if (*sig) phlex_signal = *sig;
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexInterruptExitCode - 128 + the signal that interrupted the run (130 for SIGINT, 143 for SIGTERM)
 @*/
 int PhlexInterruptExitCode(void)

@@ -1,0 +1,44 @@
+/* The transient analysis' monitor context, shared by transient.c (the energy monitor) and transient_checkpoint.c
+   (what a checkpoint holds besides the outputs: the state, the time, the monitor's accumulators). */
+#ifndef PHLEX_PRIVATE_TRANSIENT_H
+#define PHLEX_PRIVATE_TRANSIENT_H
+
+typedef struct {
+  PhlexScene  scene;
+  PhlexSystem sys;
+  Vec         Xprev, Xstage, Xmid;
+  PetscReal   tstage;
+  PetscBool   have_stage;
+  PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax, Emax; /* Emax: largest kinetic + strain energy */
+  PetscViewer energy_csv, monitor;
+  PetscInt    interval, last_written;
+  PetscBool   theta, endpoint;
+  PetscReal   theta_value;
+  PetscReal  *qprev, *lambda; /* discrete unknowns of the previous step, multipliers (step averages) */
+  PetscReal  *jpower;         /* power through each joint over the step, with the scheme's quadrature */
+  /* momenta of a free system, rotations */
+  PetscBool   free_system;
+  PetscReal   P0[3], L0[3], Pscale, Lscale, max_dP, max_dL, max_orth, max_defect;
+  /* joints */
+  PetscReal   max_gap, project_dH, step_project_dH;
+  PetscInt    nprojections;
+  /* watchdogs: stop a run whose numbers went wrong (0: off) */
+  PetscReal   watch_balance, watch_gap;
+  PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
+  PhlexProgress progress;
+  /* checkpoints (transient_checkpoint.c) */
+  PetscInt       first_step;   /* the step the run starts from (a restart's checkpoint; 0 otherwise) */
+  PetscInt       ck_interval;  /* every n steps (0: off) */
+  PetscReal      ck_wall;      /* every s seconds of wall clock (0: off) */
+  PetscLogDouble ck_last;      /* wall clock of the last checkpoint (or of the start) */
+  PetscInt       ck_step;      /* step of the last checkpoint written (-1: none) */
+  char           ck_file[PETSC_MAX_PATH_LEN];
+} MonitorContext;
+
+PETSC_INTERN PetscErrorCode PhlexTransientCheckpointOptions(MPI_Comm, PhlexOutput, MonitorContext *, char[], PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexTransientCheckpointDue(MonitorContext *, PetscInt, PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexTransientCheckpointWrite(TS, MonitorContext *, Vec);
+PETSC_INTERN PetscErrorCode PhlexTransientRestartCheck(TS, MonitorContext *, PetscViewer, const char[], Vec);
+PETSC_INTERN PetscErrorCode PhlexTransientRestart(TS, MonitorContext *, PetscViewer, const char[], Vec);
+
+#endif

@@ -1,0 +1,301 @@
+/* Checkpoint and restart of a transient run.
+
+   A checkpoint (HDF5, written atomically by checkpoint.c) holds everything the run needs to go on as if it had not
+   stopped: the global state X (every part's fields and discrete unknowns: rigid frames, lumped states, the joints'
+   impulses), the time, the step number and the next step size, the multipliers of the last step, the energy
+   monitor's accumulators (H0, the supplied work, the largest drifts ...), and where the outputs stand: the length of
+   every CSV series and the field snapshots written (output.c, fields.c). A restarted run continues the series (they
+   are cut at the checkpoint, never duplicated) and the field index.
+
+   The default scheme, the implicit midpoint rule (and every theta method, Crank-Nicolson included), is a one-step
+   method: the state is its whole history, and a restarted run takes the very same steps as an uninterrupted one.
+   BDF and generalized-alpha keep a history of past steps inside PETSc's TS, which PETSc 3.18 gives no access to: a
+   restart starts them again (BDF at first order, alpha with its start-up step), which is said at restart; the
+   difference is of the order of the scheme's local error. An adaptive step's first error estimate after a restart
+   likewise lacks the previous step. */
+#include <phlex_impl.h>
+#include <private/transient.h>
+#include <petscviewerhdf5.h>
+
+#define CHECKPOINT_NMONITOR 27 /* the accumulators of PackMonitor */
+
+/* the energy monitor's accumulators, in a fixed order */
+static void PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMONITOR])
+{
+  PetscInt k = 0;
+  a[k++] = m->H0, a[k++] = m->Hprev, a[k++] = m->tprev, a[k++] = m->work_total, a[k++] = m->max_drift;
+  a[k++] = m->max_residual, a[k++] = m->max_work, a[k++] = m->Hmax, a[k++] = m->Emax;
+  for (PetscInt c = 0; c < 3; c++) a[k++] = m->P0[c];
+  for (PetscInt c = 0; c < 3; c++) a[k++] = m->L0[c];
+  a[k++] = m->Pscale, a[k++] = m->Lscale, a[k++] = m->max_dP, a[k++] = m->max_dL, a[k++] = m->max_orth;
+  a[k++] = m->max_defect, a[k++] = m->max_gap, a[k++] = m->project_dH, a[k++] = (PetscReal)m->nprojections;
+  a[k++] = (PetscReal)m->last_written;
+}
+
+static void UnpackMonitor(MonitorContext *m, const PetscReal a[CHECKPOINT_NMONITOR])
+{
+  PetscInt k = 0;
+  m->H0 = a[k++], m->Hprev = a[k++], m->tprev = a[k++], m->work_total = a[k++], m->max_drift = a[k++];
+  m->max_residual = a[k++], m->max_work = a[k++], m->Hmax = a[k++], m->Emax = a[k++];
+  for (PetscInt c = 0; c < 3; c++) m->P0[c] = a[k++];
+  for (PetscInt c = 0; c < 3; c++) m->L0[c] = a[k++];
+  m->Pscale = a[k++], m->Lscale = a[k++], m->max_dP = a[k++], m->max_dL = a[k++], m->max_orth = a[k++];
+  m->max_defect = a[k++], m->max_gap = a[k++], m->project_dH = a[k++], m->nprojections = (PetscInt)a[k++];
+  m->last_written = (PetscInt)a[k++];
+}
+
+/* what the state vector means: the parts and joints by name and kind, the sizes, the scales; a restart checks that
+   its own run has the same */
+static PetscErrorCode Fingerprint(MonitorContext *m, char parts[], size_t len, PetscReal units[4])
+{
+  PhlexSystem sys = m->sys;
+  size_t      n;
+
+  PetscFunctionBeginUser;
+  parts[0] = 0;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PetscCall(PetscStrlen(parts, &n));
+    PetscCall(PetscSNPrintf(parts + n, len - n, "%s%s:%s:%" PetscInt_FMT ":%" PetscInt_FMT, i ? " " : "", sys->parts[i]->name, sys->parts[i]->type, sys->parts[i]->Nu + sys->parts[i]->Ns + sys->parts[i]->Nv, sys->parts[i]->nq));
+  }
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PetscCall(PetscStrlen(parts, &n));
+    PetscCall(PetscSNPrintf(parts + n, len - n, " joint %s:%" PetscInt_FMT, sys->joints[k]->name, sys->joints[k]->nc));
+  }
+  units[0] = m->scene->units.length, units[1] = m->scene->units.density, units[2] = m->scene->units.modulus, units[3] = m->scene->units.mass;
+  PetscFunctionReturn(0);
+}
+
+/* X as a plain vector with the same layout (a DM's vector would be viewed by its DM) */
+static PetscErrorCode PlainVec(Vec X, Vec *P)
+{
+  PetscInt n, N;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(X, &n));
+  PetscCall(VecGetSize(X, &N));
+  PetscCall(VecCreateMPI(PetscObjectComm((PetscObject)X), n, N, P));
+  PetscCall(PetscObjectSetName((PetscObject)*P, "X"));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexTransientCheckpointOptions - reads the checkpoint and restart options
+
+  Collective
+
+  Options Database Keys:
++ -checkpoint_interval <n>        - write a checkpoint every n steps (0: off)
+. -checkpoint_wall_interval <s>   - write a checkpoint every s seconds of wall-clock time (0: off)
+. -checkpoint_file <file>         - the checkpoint (default <output_dir>/checkpoint.h5), overwritten atomically
+- -restart <file>                 - continue the run a checkpoint was written by
+@*/
+PetscErrorCode PhlexTransientCheckpointOptions(MPI_Comm comm, PhlexOutput out, MonitorContext *m, char restart[], PetscBool *restarting)
+{
+  PetscFunctionBeginUser;
+  m->ck_interval = 0;
+  m->ck_wall     = 0;
+  m->ck_step     = -1;
+  PetscCall(PetscSNPrintf(m->ck_file, sizeof(m->ck_file), "%s/checkpoint.h5", out ? out->dir : "output"));
+  restart[0] = 0;
+  PetscOptionsBegin(comm, NULL, "Checkpoint and restart", NULL);
+  PetscCall(PetscOptionsInt("-checkpoint_interval", "Write a checkpoint every n steps (0: off); SIGINT/SIGTERM then also write one before stopping", "PhlexSceneSolveTransient", m->ck_interval, &m->ck_interval, NULL));
+  PetscCall(PetscOptionsReal("-checkpoint_wall_interval", "Write a checkpoint every s seconds of wall-clock time (0: off)", "PhlexSceneSolveTransient", m->ck_wall, &m->ck_wall, NULL));
+  PetscCall(PetscOptionsString("-checkpoint_file", "The checkpoint, overwritten atomically each time (default <output_dir>/checkpoint.h5)", "PhlexSceneSolveTransient", m->ck_file, m->ck_file, sizeof(m->ck_file), NULL));
+  PetscCall(PetscOptionsString("-restart", "Continue the run that wrote this checkpoint (same scene, same number of processes)", "PhlexSceneSolveTransient", restart, restart, PETSC_MAX_PATH_LEN, restarting));
+  PetscOptionsEnd();
+  PetscCheck(m->ck_interval >= 0, comm, PETSC_ERR_USER_INPUT, "-checkpoint_interval must be >= 0 steps (0: off), got %" PetscInt_FMT, m->ck_interval);
+  PetscCheck(m->ck_wall >= 0 && !PetscIsInfOrNanReal(m->ck_wall), comm, PETSC_ERR_USER_INPUT, "-checkpoint_wall_interval must be a finite number of seconds >= 0 (0: off), got %g", (double)m->ck_wall);
+  PetscCheck(m->ck_file[0], comm, PETSC_ERR_USER_INPUT, "-checkpoint_file must not be empty");
+  PetscCheck(!*restarting || restart[0], comm, PETSC_ERR_USER_INPUT, "-restart needs the checkpoint file to continue from");
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexTransientCheckpointDue - whether a checkpoint is due after this step (the interval in steps or in wall time;
+  the same answer on every rank)
+
+  Collective
+@*/
+PetscErrorCode PhlexTransientCheckpointDue(MonitorContext *m, PetscInt step, PetscBool *due)
+{
+  PetscFunctionBeginUser;
+  *due = PETSC_FALSE;
+  if (step <= m->first_step) PetscFunctionReturn(0);
+  if (m->ck_interval > 0 && step % m->ck_interval == 0) *due = PETSC_TRUE;
+  if (m->ck_wall > 0) {
+    PetscLogDouble now;
+    PetscCall(PetscTime(&now));
+    if (now - m->ck_last >= m->ck_wall) *due = PETSC_TRUE;
+    /* the clocks of the ranks differ: rank 0 decides */
+    PetscCallMPI(MPI_Bcast(due, 1, MPIU_BOOL, 0, m->scene->comm));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexTransientCheckpointWrite - writes the checkpoint of the step just completed (after the monitor)
+
+  Collective
+@*/
+PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
+{
+  MPI_Comm    comm = m->scene->comm;
+  PhlexSystem sys  = m->sys;
+  PetscViewer v;
+  Vec         P;
+  TSType      type;
+  PetscInt    step, n;
+  PetscReal   t, dt, mon[CHECKPOINT_NMONITOR], units[4];
+  PetscMPIInt size;
+  char        tmp[PETSC_MAX_PATH_LEN], parts[4096];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_Output, 0, 0, 0, 0));
+  PetscCall(TSGetStepNumber(ts, &step));
+  PetscCall(TSGetTime(ts, &t));
+  PetscCall(TSGetTimeStep(ts, &dt));
+  PetscCall(TSGetType(ts, &type));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(Fingerprint(m, parts, sizeof(parts), units));
+  PetscCall(PhlexCheckpointOpenWrite(comm, m->ck_file, tmp, &v));
+  PetscCall(PhlexCheckpointWriteInt(v, "/", "phlex_checkpoint", 1));
+  PetscCall(PhlexCheckpointWriteInt(v, "/run", "step", step));
+  PetscCall(PhlexCheckpointWriteReals(v, "/run", "time", 1, &t));
+  PetscCall(PhlexCheckpointWriteReals(v, "/run", "dt", 1, &dt));
+  PetscCall(PhlexCheckpointWriteReals(v, "/run", "theta", 1, &m->theta_value));
+  PetscCall(PhlexCheckpointWriteReals(v, "/run", "units", 4, units));
+  PetscCall(PhlexCheckpointWriteString(v, "/run", "ts_type", type));
+  PetscCall(PhlexCheckpointWriteString(v, "/run", "parts", parts));
+  PetscCall(PhlexCheckpointWriteInt(v, "/run", "nranks", size));
+  {
+    /* the layout of X over the ranks: a restart needs the same */
+    PetscReal *sizes;
+    PetscInt   nloc;
+    PetscCall(VecGetLocalSize(X, &nloc));
+    PetscCall(PetscMalloc1(size, &sizes));
+    {
+      PetscReal mine = (PetscReal)nloc;
+      PetscCallMPI(MPI_Allgather(&mine, 1, MPIU_REAL, sizes, 1, MPIU_REAL, comm));
+    }
+    PetscCall(PhlexCheckpointWriteReals(v, "/run", "local_sizes", size, sizes));
+    PetscCall(PetscFree(sizes));
+  }
+  PetscCall(PlainVec(X, &P));
+  PetscCall(VecCopy(X, P));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/state"));
+  PetscCall(VecView(P, v));
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(VecDestroy(&P));
+  n = sys->nq;
+  PetscCall(PhlexCheckpointWriteInt(v, "/state", "nq", n));
+  PetscCall(PhlexCheckpointWriteReals(v, "/state", "q_previous", n, m->qprev));
+  PetscCall(PhlexCheckpointWriteReals(v, "/state", "multipliers", n, m->lambda));
+  PackMonitor(m, mon);
+  PetscCall(PhlexCheckpointWriteReals(v, "/monitor", "accumulators", CHECKPOINT_NMONITOR, mon));
+  PetscCall(PhlexOutputSaveState(m->scene->output, v));
+  PetscCall(PhlexCheckpointCommit(comm, tmp, m->ck_file, &v));
+  m->ck_step = step;
+  PetscCall(PetscTime(&m->ck_last));
+  PetscCall(PetscLogEventEnd(PHLEX_Output, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexTransientRestartCheck - before anything is written: the checkpoint was written for this scene, on this many
+  processes, with this scheme, and its run is not already at the end of this one
+
+  Collective
+@*/
+PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer v, const char file[], Vec X)
+{
+  MPI_Comm    comm = m->scene->comm;
+  TSType      type;
+  PetscInt    step, nranks;
+  PetscReal   t, theta, units[4], ck_units[4], tmax;
+  PetscMPIInt size;
+  PetscBool   same;
+  char        parts[4096], ck_parts[4096], ck_type[64];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PhlexCheckpointReadInt(v, "/run", "nranks", &nranks));
+  PetscCheck(nranks == size, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written by a run on %" PetscInt_FMT " processes: restart it on as many (mpiexec -n %" PetscInt_FMT "), not %d", file, nranks, nranks, (int)size);
+  PetscCall(Fingerprint(m, parts, sizeof(parts), units));
+  PetscCall(PhlexCheckpointReadString(v, "/run", "parts", ck_parts, sizeof(ck_parts)));
+  PetscCall(PetscStrcmp(parts, ck_parts, &same));
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written for another scene: its parts and joints (name:kind:field unknowns:discrete unknowns) are '%s', this scene's '%s'", file, ck_parts, parts);
+  PetscCall(PhlexCheckpointReadReals(v, "/run", "units", 4, ck_units));
+  for (PetscInt k = 0; k < 4; k++) PetscCheck(PetscAbsReal(units[k] - ck_units[k]) <= 1e-14 * PetscAbsReal(units[k]), comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with other reference scales (length %g m, density %g kg/m^3, modulus %g Pa, mass %g kg; this run %g, %g, %g, %g): use the same -scale_* options and materials", file, (double)ck_units[0], (double)ck_units[1], (double)ck_units[2], (double)ck_units[3], (double)units[0], (double)units[1], (double)units[2], (double)units[3]);
+  {
+    PetscReal  *sizes, mine;
+    PetscInt    nloc;
+    PetscBool   ok;
+    PetscMPIInt rank;
+    PetscCallMPI(MPI_Comm_rank(comm, &rank));
+    PetscCall(VecGetLocalSize(X, &nloc));
+    mine = (PetscReal)nloc;
+    PetscCall(PetscMalloc1(size, &sizes));
+    PetscCall(PhlexCheckpointReadReals(v, "/run", "local_sizes", size, sizes));
+    ok = sizes[rank] == mine ? PETSC_TRUE : PETSC_FALSE;
+    PetscCall(PetscFree(sizes));
+    PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPIU_BOOL, MPI_LAND, comm));
+    PetscCheck(ok, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with another distribution of the meshes over the processes: restart with the same meshes, partitioner and number of processes", file);
+  }
+  PetscCall(TSGetType(ts, &type));
+  PetscCall(PhlexCheckpointReadString(v, "/run", "ts_type", ck_type, sizeof(ck_type)));
+  PetscCall(PetscStrcmp(type, ck_type, &same));
+  PetscCall(PhlexCheckpointReadReals(v, "/run", "theta", 1, &theta));
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with -ts_type %s, this run has -ts_type %s: restart with the same scheme", file, ck_type, type);
+  PetscCheck(theta == m->theta_value, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with -ts_theta_theta %g, this run has %g: restart with the same scheme", file, (double)theta, (double)m->theta_value);
+  if (!m->theta) PetscCall(PetscPrintf(comm, "Restart: TS %s keeps a history of past steps that PETSc does not checkpoint: it starts again from the checkpoint's state (the first steps differ from an uninterrupted run by the scheme's local error)\n", type));
+  PetscCall(PhlexCheckpointReadInt(v, "/run", "step", &step));
+  PetscCall(PhlexCheckpointReadReals(v, "/run", "time", 1, &t));
+  PetscCall(TSGetMaxTime(ts, &tmax));
+  {
+    PetscInt smax;
+    PetscCall(TSGetMaxSteps(ts, &smax));
+    PetscCheck(t < tmax && step < smax, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) is at step %" PetscInt_FMT ", t = %g s: the run is already there (-ts_max_time %g s, -ts_max_steps %" PetscInt_FMT "); raise them to continue it", file, step, (double)t, (double)tmax, smax);
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexTransientRestart - continues from a checkpoint (checked by PhlexTransientRestartCheck): sets the state X, the
+  time, the step and the step size, the multipliers and the monitor's accumulators (the outputs were opened
+  continuing the checkpoint's, PhlexOutputSetRestart)
+
+  Collective
+@*/
+PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, const char file[], Vec X)
+{
+  MPI_Comm    comm = m->scene->comm;
+  PhlexSystem sys  = m->sys;
+  Vec         P;
+  PetscInt    step, nq;
+  PetscReal   t, dt, mon[CHECKPOINT_NMONITOR];
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexCheckpointReadInt(v, "/run", "step", &step));
+  PetscCall(PhlexCheckpointReadReals(v, "/run", "time", 1, &t));
+  PetscCall(PhlexCheckpointReadReals(v, "/run", "dt", 1, &dt));
+  PetscCall(PlainVec(X, &P));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/state"));
+  PetscCall(VecLoad(P, v));
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(VecCopy(P, X));
+  PetscCall(VecDestroy(&P));
+  PetscCall(PhlexCheckpointReadInt(v, "/state", "nq", &nq));
+  PetscCheck(nq == sys->nq, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) has %" PetscInt_FMT " discrete unknowns, this scene %" PetscInt_FMT, file, nq, sys->nq);
+  PetscCall(PhlexCheckpointReadReals(v, "/state", "q_previous", nq, m->qprev));
+  PetscCall(PhlexCheckpointReadReals(v, "/state", "multipliers", nq, m->lambda));
+  PetscCall(PhlexCheckpointReadReals(v, "/monitor", "accumulators", CHECKPOINT_NMONITOR, mon));
+  UnpackMonitor(m, mon);
+  PetscCall(TSSetTime(ts, t));
+  PetscCall(TSSetStepNumber(ts, step));
+  PetscCall(TSSetTimeStep(ts, dt));
+  PetscCall(VecCopy(X, m->Xprev));
+  m->first_step = step;
+  m->ck_step    = step;
+  PetscCall(PetscPrintf(comm, "Restart from %s: step %" PetscInt_FMT ", t = %g s, time step %g s\n", file, step, (double)t, (double)dt));
+  PetscFunctionReturn(0);
+}
