@@ -172,7 +172,9 @@ PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexFlexible body, const
     out->writers = list;
     out->nwriters++;
   }
+  /* the HDF5 file(s) first, then the index (the order of the list of results) */
   if (out->restart) PetscCall(RestoreState(w));
+  else PetscCall(OpenSegment(w));
   PetscCall(PetscSNPrintf(file, sizeof(file), "%s.xmf", name));
   PetscCall(PhlexOutputFile(out, file, w->xmftmp));
   PetscCall(CreateOutputDM(body->dm, 1, 3, "vertex", &w->dm_vertex));
@@ -185,7 +187,6 @@ PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexFlexible body, const
   }
   PetscCall(CreateOutputDM(body->dm, 0, 1, "scalar", &w->dm_cell1));
   PetscCall(DMCreateLocalVector(body->dm, &w->lv));
-  if (!out->restart) PetscCall(OpenSegment(w));
   PetscCall(DMPlexGetDepthStratum(body->dm, 0, &vStart, &vEnd));
   PetscCall(DMPlexGetHeightStratum(body->dm, 0, &cStart, &cEnd));
   {
