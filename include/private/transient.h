@@ -26,6 +26,10 @@ typedef struct {
   PetscReal   watch_balance, watch_gap;
   PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
   PhlexProgress progress;
+  /* adaptive steps: a step that breaks a watchdog, or whose Newton fails, is retried with a smaller step */
+  PetscBool   adaptive;
+  PetscInt    nretries;
+  char        last_retry[256]; /* why the last step was retried */
   /* checkpoints (transient_checkpoint.c) */
   PetscInt       first_step;   /* the step the run starts from (a restart's checkpoint; 0 otherwise) */
   PetscInt       ck_interval;  /* every n steps (0: off) */

@@ -13,6 +13,8 @@
 
 
 static PetscErrorCode TransientProgress(TS, MonitorContext *, PetscInt, PetscReal);
+static PetscErrorCode ReportRetry(TS, MonitorContext *, const char[]);
+static PetscErrorCode InputPower(MonitorContext *, PetscReal, Vec, PetscReal, PetscBool, PetscReal *);
 static PetscErrorCode Watchdogs(MonitorContext *, PetscInt, PetscReal, PetscReal, PetscReal);
 
 /* ---------------------------------------------------------------------------------------------------------- */
@@ -107,6 +109,94 @@ static PetscErrorCode PostStage(TS ts, PetscReal t, PetscInt index, Vec *Y)
   PetscCall(VecCopy(Y[0], m->Xstage));
   m->tstage     = t;
   m->have_stage = PETSC_TRUE;
+  if (m->adaptive) {
+    /* a Newton failure: TS retries the step with a smaller one (TSAdaptCheckStage) */
+    SNES                snes;
+    SNESConvergedReason reason;
+    PetscCall(TSGetSNES(ts, &snes));
+    PetscCall(SNESGetConvergedReason(snes, &reason));
+    if (reason < 0) {
+      char why[64];
+      PetscCall(PetscSNPrintf(why, sizeof(why), "Newton did not converge (%s)", SNESConvergedReasons[reason]));
+      PetscCall(ReportRetry(ts, m, why));
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/* a step about to be retried with a smaller one: one line, and the reason kept for the message if retries run out */
+static PetscErrorCode ReportRetry(TS ts, MonitorContext *m, const char why[])
+{
+  PetscInt  step;
+  PetscReal t, dt;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetStepNumber(ts, &step));
+  PetscCall(TSGetTime(ts, &t));
+  PetscCall(TSGetTimeStep(ts, &dt));
+  PetscCall(PetscSNPrintf(m->last_retry, sizeof(m->last_retry), "%s", why));
+  m->nretries++;
+  PetscCall(PetscPrintf(m->scene->comm, "retry: step %" PetscInt_FMT " from t = %g s with time step %g s: %s; the step is retried with a smaller one\n", step + 1, (double)t, (double)dt, why));
+  PetscFunctionReturn(0);
+}
+
+/* Adaptive steps (TSAdapt's stage check): a step that would break a watchdog is rejected before it is accepted, and TS
+   retries it with dt x -ts_adapt_scale_solve_failed (at most -ts_max_reject times in a row), instead of the run
+   stopping. The checks are those of Watchdogs, on the state the step would end at (the midpoint rule's stage Y is
+   the step's middle: X_{n+1} = X_n + (Y - X_n)/theta). */
+static PetscErrorCode CheckStage(TSAdapt adapt, TS ts, PetscReal t, Vec Y, PetscBool *accept)
+{
+  MonitorContext   *m;
+  PhlexSystem       sys;
+  const PhlexUnits *u;
+  PetscReal         dt, norm;
+  Vec               Xe;
+  char              why[200] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetApplicationContext(ts, &m));
+  sys     = m->sys;
+  u       = &m->scene->units;
+  *accept = PETSC_TRUE;
+  PetscCall(TSGetTimeStep(ts, &dt));
+  PetscCall(VecNorm(Y, NORM_INFINITY, &norm));
+  if (PetscIsInfOrNanReal(norm)) PetscCall(PetscSNPrintf(why, sizeof(why), "the state holds NaN or Inf"));
+  else {
+    Xe = m->Xmid; /* scratch: the monitor sets it before using it */
+    if (m->theta && !m->endpoint) PetscCall(VecAXPBYPCZ(Xe, 1.0 / m->theta_value, 1.0 - 1.0 / m->theta_value, 0.0, Y, m->Xprev));
+    else PetscCall(VecCopy(Y, Xe));
+    PetscCall(PhlexSystemGather(sys, Xe, sys->q));
+    if (m->lossless_scheme && m->watch_balance > 0) {
+      const PetscReal dtn = dt / u->time;
+      PetscReal       P, kin, strain, pot, residual, scale;
+      for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dtn : 0.0;
+      PetscCall(InputPower(m, t, Y, 1.0, PETSC_TRUE, &P));
+      PetscCall(PhlexSystemEnergy(sys, m->tprev + dt, Xe, &kin, &strain, &pot));
+      residual = kin + strain + pot - m->Hprev - dtn * P;
+      scale    = PetscMax(PetscMax(m->Emax, kin + strain), PetscAbsReal(m->H0));
+      if (PetscIsInfOrNanReal(residual)) PetscCall(PetscSNPrintf(why, sizeof(why), "the power balance of the step is not a number"));
+      else if (PetscAbsReal(residual) > m->watch_balance * scale) PetscCall(PetscSNPrintf(why, sizeof(why), "watchdog: the power balance of the step is off by %.3e J, %.2e of the energy (bound -watchdog_balance_rtol %g)", (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)m->watch_balance));
+      PetscCall(PhlexSystemGather(sys, Xe, sys->q));
+    }
+    if (!why[0] && sys->njoints && m->watch_gap > 0) {
+      const PetscReal bound = m->watch_gap * PetscMin(u->length, 1.0);
+      PetscReal       gmax  = 0;
+      for (PetscInt k = 0; k < sys->njoints; k++) {
+        PhlexJoint   j = sys->joints[k];
+        PhlexPartVec pv[2];
+        PetscReal    gap[7];
+        PetscCall(PhlexSystemJointSides(sys, j, Xe, sys->q, pv));
+        PetscCall(PhlexJointGap(j, m->tprev + dt, &pv[0], &pv[1], gap));
+        PetscCall(PhlexSystemJointSidesRestore(sys, j, Xe, pv));
+        for (PetscInt r = 0; r < j->nc; r++) gmax = PetscMax(gmax, PetscAbsReal(gap[r]) * (j->row[r] <= PHLEX_ROW_T3 ? u->length : 1.0));
+      }
+      if (gmax > bound) PetscCall(PetscSNPrintf(why, sizeof(why), "watchdog: a joint would open by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m))", (double)gmax, (double)bound, (double)m->watch_gap));
+    }
+  }
+  if (why[0]) {
+    *accept = PETSC_FALSE;
+    PetscCall(ReportRetry(ts, m, why));
+  }
   PetscFunctionReturn(0);
 }
 
@@ -530,6 +620,20 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   /* a failed step is reported below with the time, the step and what to try */
   PetscCall(TSSetErrorIfStepFails(ts, PETSC_FALSE));
   {
+    /* adaptive steps retry a step whose Newton fails or that breaks a watchdog, with a smaller one (PETSc's default
+       stops at the first Newton failure; -ts_max_snes_failures keeps a user's bound) */
+    TSAdapt   adapt;
+    PetscBool none, bound;
+    PetscCall(TSGetAdapt(ts, &adapt));
+    PetscCall(PetscObjectTypeCompare((PetscObject)adapt, TSADAPTNONE, &none));
+    m.adaptive = none ? PETSC_FALSE : PETSC_TRUE;
+    if (m.adaptive) {
+      PetscCall(TSAdaptSetCheckStage(adapt, CheckStage));
+      PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_snes_failures", &bound));
+      if (!bound) PetscCall(TSSetMaxSNESFailures(ts, -1));
+    }
+  }
+  {
     /* PETSc 3.18's generalized-alpha keeps the rate V_{n+1} it computed in the last function evaluation of the step;
        SNES ksponly (the linear presets) evaluates the function only before its solve, so V_{n+1} would be the
        initial guess's and the scheme a different, dissipative one (the cantilever lost 25 % of its energy in 200
@@ -628,8 +732,13 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(TSGetSolveTime(ts, &tfinal));
   PetscCall(TSGetConvergedReason(ts, &reason));
   PetscCall(TSGetTimeStep(ts, &dtlast));
+  if (reason < 0 && m.last_retry[0]) {
+    PetscInt maxrej = 10; /* PETSc's default; TS has no getter */
+    PetscCall(PetscOptionsGetInt(NULL, NULL, "-ts_max_reject", &maxrej, NULL));
+    SETERRQ(scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s) after retries down to a time step of %g s, the last one because: %s; allow more retries (-ts_max_reject, now %" PetscInt_FMT ") or a smaller step (-ts_adapt_dt_min), tighten the solvers, or check the inputs; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast, m.last_retry, maxrej);
+  }
   PetscCheck(reason >= 0, scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s, time step %g s): %s; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast,
-             reason == TS_DIVERGED_NONLINEAR_SOLVE ? "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic), or see why with -snes_converged_reason -ksp_converged_reason" : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
+             reason == TS_DIVERGED_NONLINEAR_SOLVE ? "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic: a failed step is then retried with a smaller one), or see why with -snes_converged_reason -ksp_converged_reason" : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
   if (m.last_written != nsteps && scene->output->fields) {
     /* the last state's fields (the monitor wrote its series) */
     for (PetscInt i = 0; i < sys->nparts; i++) {
@@ -661,6 +770,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
         break;
       }
     if (m.free_system) PetscCall(PetscPrintf(scene->comm, "  momenta: max drift of P %.3e, of L %.3e (largest component of P - P0, L - L0, relative to %.6e kg m/s, %.6e kg m^2/s)\n", (double)m.max_dP, (double)m.max_dL, (double)(m.Pscale * u->mass * u->velocity), (double)(m.Lscale * u->mass * u->velocity * u->length)));
+    if (m.nretries) PetscCall(PetscPrintf(scene->comm, "  retried steps: %" PetscInt_FMT " (adaptive steps; the last because: %s)\n", m.nretries, m.last_retry));
     if (checkpointing) PetscCall(PetscPrintf(scene->comm, "  checkpoint: %s (step %" PetscInt_FMT ")\n", m.ck_file, m.ck_step));
     if (m.first_step) PetscCall(PetscPrintf(scene->comm, "  restarted at step %" PetscInt_FMT "\n", m.first_step));
     if (sys->njoints) {
