@@ -12,6 +12,8 @@ outputs.  Called from meshes/Makefile; standard library only.
   bad_empty_group.msh   bar_h0.05.msh plus $PhysicalNames entry 2 9 "empty" (no elements)
   bad_not_a_mesh.msh    a few lines of prose
   bad_truncated.msh     bar_h0.05.msh cut halfway through its $Elements section
+  stress_sliver.msh     bar_h0.05.msh with five interior nodes moved so that five tetrahedra become slivers
+                        (flatness 1e-3; legal input, a stress test of poorly shaped elements)
 
 Usage:
   tools/make_bad_meshes.py [--meshdir DIR] [--gmsh GMSH] [NAME ...]
@@ -280,6 +282,97 @@ def make_bad_truncated(meshdir, gmsh):
           % (SOURCE, cut, len(lines) - 1, begin + 1, end + 1))
 
 
+def interior_nodes(lines):
+    """Tags of the nodes of volume entities (dim 3): moving them keeps the boundary."""
+    begin, end = section(lines, "Nodes")
+    num_blocks = int(lines[begin + 1].split()[0])
+    tags = set()
+    i = begin + 2
+    for _ in range(num_blocks):
+        dim, _tag, _parametric, count = map(int, lines[i].split())
+        if dim == 3:
+            tags.update(int(lines[i + 1 + k]) for k in range(count))
+        i += 1 + 2 * count
+    return tags
+
+
+def flatness(p):
+    """Smallest altitude over shortest edge, 1 for the regular tetrahedron (phlex warns below 0.02)."""
+    def area(a, b, c):
+        u = [b[k] - a[k] for k in range(3)]
+        v = [c[k] - a[k] for k in range(3)]
+        cr = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+        return 0.5 * sum(x * x for x in cr) ** 0.5
+    faces = [area(p[1], p[2], p[3]), area(p[0], p[2], p[3]), area(p[0], p[1], p[3]), area(p[0], p[1], p[2])]
+    hmin = min(sum((p[i][k] - p[j][k]) ** 2 for k in range(3)) ** 0.5 for i in range(4) for j in range(i + 1, 4))
+    return 3 * abs(signed_volume(*p)) / max(faces) / (hmin * (2.0 / 3.0) ** 0.5)
+
+
+def make_stress_sliver(meshdir, gmsh, target=1e-3, count=5):
+    lines = read_lines(os.path.join(meshdir, SOURCE))
+    nodes = read_nodes(lines)
+    tets = tetrahedra(lines)
+    lo_box = [min(p[k] for p in nodes.values()) for k in range(3)]
+    hi_box = [max(p[k] for p in nodes.values()) for k in range(3)]
+    around = {}
+    for t in tets:
+        for n in t[2]:
+            around.setdefault(n, []).append(t)
+    moved, used = [], set()
+    for node in sorted(around):
+        if len(moved) == count or node in used:
+            continue
+        p = nodes[node]
+        # a node on a face of the box stays on it: it moves only along the face
+        fixed = [k for k in range(3) if p[k] in (lo_box[k], hi_box[k])]
+        for t in sorted(around[node], key=lambda t: t[1]):
+            # move the node towards the plane of its opposite face, until that tet's flatness is the target
+            others = [nodes[n] for n in t[2] if n != node]
+            u = [others[1][k] - others[0][k] for k in range(3)]
+            v = [others[2][k] - others[0][k] for k in range(3)]
+            nrm = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]]
+            ln = sum(x * x for x in nrm) ** 0.5
+            nrm = [x / ln for x in nrm]
+            h = sum((p[k] - others[0][k]) * nrm[k] for k in range(3))  # signed height over the plane
+            d = [0.0 if k in fixed else -h * nrm[k] for k in range(3)]  # towards the plane, along the faces
+            rate = -sum(d[k] * nrm[k] for k in range(3)) / h if h else 0.0  # share of the height removed per unit step
+            if rate < 0.3:
+                continue
+            reach = min(1.0 / rate, 1.0 / (rate + 1e-300) * 0.999)
+            a, b = 0.0, reach
+            for _ in range(60):  # bisection on the step
+                f = 0.5 * (a + b)
+                q = [p[k] + f * d[k] for k in range(3)]
+                pts = [q if n == node else nodes[n] for n in t[2]]
+                a, b = (f, b) if flatness(pts) > target else (a, f)
+            q = tuple(p[k] + a * d[k] for k in range(3))
+            trial = dict(nodes)
+            trial[node] = q
+            ok = flatness([trial[n] for n in t[2]]) < 1.5 * target
+            ok = ok and all(signed_volume(*(trial[n] for n in s[2])) > 0 for s in around[node])
+            ok = ok and all(flatness([trial[n] for n in s[2]]) > 0.02 for s in around[node] if s[1] != t[1])
+            if ok:
+                nodes[node] = q
+                moved.append((node, t[1], flatness([q if n == node else nodes[n] for n in t[2]])))
+                used.update(n for s in around[node] for n in s[2])
+                break
+    assert len(moved) == count, "found %d slivers" % len(moved)
+    # rewrite the moved nodes' coordinate lines
+    begin, end = section(lines, "Nodes")
+    num_blocks = int(lines[begin + 1].split()[0])
+    i = begin + 2
+    for _ in range(num_blocks):
+        _dim, _tag, _parametric, n = map(int, lines[i].split())
+        tags = [int(lines[i + 1 + k]) for k in range(n)]
+        for k, tag in enumerate(tags):
+            if tag in {m[0] for m in moved}:
+                lines[i + 1 + n + k] = " ".join("%.17g" % x for x in nodes[tag])
+        i += 1 + 2 * n
+    write_file(os.path.join(meshdir, "stress_sliver.msh"), "\n".join(lines))
+    for node, tag, q in moved:
+        print("# stress_sliver.msh: node %d moved, element %d flatness %.3g" % (node, tag, q))
+
+
 MAKERS = {
     "bad_2d": make_bad_2d,
     "bad_hex": make_bad_hex,
@@ -288,6 +381,7 @@ MAKERS = {
     "bad_empty_group": make_bad_empty_group,
     "bad_not_a_mesh": make_bad_not_a_mesh,
     "bad_truncated": make_bad_truncated,
+    "stress_sliver": make_stress_sliver,
 }
 
 

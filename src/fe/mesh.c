@@ -332,10 +332,13 @@ PetscErrorCode PhlexMeshCheckGeometry(PhlexFlexible body)
   PetscInt     n;
   PetscMPIInt  rank;
 
+  PetscReal    worst[4] = {PETSC_MAX_REAL, 0, 0, 0}; /* the flattest cell: flatness, centroid */
+  PetscInt     nflat = 0;
+
   PetscFunctionBeginUser;
   PetscCall(DMPlexGetHeightStratum(body->dm, 0, &cStart, &cEnd));
   for (PetscInt c = cStart; c < cEnd && info[0] < 0; c++) {
-    PetscReal          hmax = 0, xs[4][3];
+    PetscReal          hmax = 0, hmin = PETSC_MAX_REAL, amax = 0, flat, xs[4][3];
     PetscInt           nc;
     PetscBool          isDG;
     const PetscScalar *array;
@@ -350,7 +353,24 @@ PetscErrorCode PhlexMeshCheckGeometry(PhlexFlexible body)
         PetscReal e = 0;
         for (PetscInt d = 0; d < 3; d++) e += PetscSqr(xs[i][d] - xs[j][d]);
         hmax = PetscMax(hmax, PetscSqrtReal(e));
+        hmin = PetscMin(hmin, PetscSqrtReal(e));
       }
+    for (PetscInt f = 0; f < 4; f++) {
+      /* the face opposite vertex f */
+      const PetscInt a = (f + 1) % 4, b = (f + 2) % 4, o = (f + 3) % 4;
+      PetscReal      u[3], v[3], w[3];
+      for (PetscInt d = 0; d < 3; d++) u[d] = xs[b][d] - xs[a][d], v[d] = xs[o][d] - xs[a][d];
+      PhlexCross(u, v, w);
+      amax = PetscMax(amax, 0.5 * PhlexNorm3(w));
+    }
+    /* flatness: the smallest altitude 3V/A_max over the shortest edge, 1 for the regular tetrahedron (a sliver has
+       comparable edges and almost no volume; long thin cells of a beam are not flat) */
+    flat = 3.0 * PetscAbsReal(detJ) * 4.0 / 3.0 / amax / (hmin * PetscSqrtReal(2.0 / 3.0));
+    if (flat < 0.02) nflat++;
+    if (flat < worst[0]) {
+      worst[0] = flat;
+      for (PetscInt d = 0; d < 3; d++) worst[1 + d] = 0.25 * (xs[0][d] + xs[1][d] + xs[2][d] + xs[3][d]);
+    }
     /* the reference tetrahedron has volume 4/3, so the cell volume is detJ 4/3 */
     if (PetscAbsReal(detJ) * 4.0 / 3.0 <= 1e-10 * hmax * hmax * hmax) info[0] = 1;
     else if (detJ < 0) info[0] = 2;
@@ -371,6 +391,20 @@ PetscErrorCode PhlexMeshCheckGeometry(PhlexFlexible body)
   }
   PetscCheck(ginfo[0] != 1, body->comm, PETSC_ERR_USER_INPUT, "body %s: mesh file '%s' has a degenerate (zero-volume) tetrahedron near (%g, %g, %g)", body->name, body->mesh_file, (double)bad_centroid[0], (double)bad_centroid[1], (double)bad_centroid[2]);
   PetscCheck(ginfo[0] != 2, body->comm, PETSC_ERR_USER_INPUT, "body %s: mesh file '%s' has an inverted tetrahedron (negative volume, node order reversed) near (%g, %g, %g)", body->name, body->mesh_file, (double)bad_centroid[0], (double)bad_centroid[1], (double)bad_centroid[2]);
+  {
+    /* slivers are legal but suspicious: a warning with the count, the worst one and where it is */
+    PetscInt gflat;
+    struct {
+      PetscReal   v;
+      PetscMPIInt r;
+    } in = {worst[0], rank}, out;
+    PetscCallMPI(MPI_Allreduce(&nflat, &gflat, 1, MPIU_INT, MPI_SUM, body->comm));
+    if (gflat) {
+      PetscCallMPI(MPI_Allreduce(&in, &out, 1, MPI_DOUBLE_INT, MPI_MINLOC, body->comm));
+      PetscCallMPI(MPI_Bcast(worst, 4, MPIU_REAL, out.r, body->comm));
+      PetscCall(PetscFPrintf(body->comm, PETSC_STDERR, "phlex: warning: body %s: mesh file '%s' has %" PetscInt_FMT " flat tetrahedra (slivers: smallest altitude below 0.02 of the shortest edge, 1 for a regular tetrahedron), the flattest %.2g near (%g, %g, %g) m: they degrade the stress near them and the conditioning of the solves; remesh (gmsh -optimize_netgen) where the results matter\n", body->name, body->mesh_file, gflat, (double)worst[0], (double)worst[1], (double)worst[2], (double)worst[3]));
+    }
+  }
 
   /* bounding box */
   for (PetscInt d = 0; d < 3; d++) {
