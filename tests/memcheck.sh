@@ -20,6 +20,9 @@ fourbar_linearized|-options_file options/fourbar.yaml -linearized_sweep 0,30 -bo
 crankslider_constant|-options_file options/crankslider.yaml -body1_inertia constant -body1_dm_plex_filename meshes/crankslider_coupler_nx8.msh -ts_max_steps 2|0
 rotating_linearized|-options_file options/rotating_cantilever.yaml -body0_dm_plex_filename meshes/rotating_beam_nx8.msh -linearized_spin_sweep_range 0,360,180|0
 rotating_transient|-options_file options/rotating_cantilever.yaml -analysis transient -body0_dm_plex_filename meshes/rotating_beam_nx8.msh -body0_spin 0,0,300 -ts_dt 1e-3 -ts_max_steps 2|0
+checkpoint|-options_file options/flexible_double_pendulum.yaml -body0_dm_plex_filename meshes/bar_struct_n1.msh -body1_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1 -body1_petscspace_degree 1 -ts_max_steps 3 -output_interval 1 -checkpoint_interval 2|0
+restart|-options_file options/flexible_double_pendulum.yaml -body0_dm_plex_filename meshes/bar_struct_n1.msh -body1_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1 -body1_petscspace_degree 1 -ts_max_steps 5 -output_interval 1 -checkpoint_interval 2 -restart build/memcheck/checkpoint/run/checkpoint.h5|0
+adaptive_retry|-options_file options/pendulum.yaml -ts_dt 2.75 -ts_max_time 6 -ts_adapt_type basic|0
 help|-help|0
 help_scene|-options_file options/cantilever.yaml -help|0
 misspelt_option|-options_file options/cantilever.yaml -ts_max_steps 2 -body0_petscspace_degree 1 -body0_densty 3 -ts_typ bdf|2

@@ -17,10 +17,10 @@
 #include <private/transient.h>
 #include <petscviewerhdf5.h>
 
-#define CHECKPOINT_NMONITOR 27 /* the accumulators of PackMonitor */
+#define CHECKPOINT_NMONITOR 25 /* the accumulators of PackMonitor */
 
-/* the energy monitor's accumulators, in a fixed order */
-static void PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMONITOR])
+/* the energy monitor's accumulators, in a fixed order; returns how many */
+static PetscInt PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMONITOR])
 {
   PetscInt k = 0;
   a[k++] = m->H0, a[k++] = m->Hprev, a[k++] = m->tprev, a[k++] = m->work_total, a[k++] = m->max_drift;
@@ -30,6 +30,7 @@ static void PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMONITOR
   a[k++] = m->Pscale, a[k++] = m->Lscale, a[k++] = m->max_dP, a[k++] = m->max_dL, a[k++] = m->max_orth;
   a[k++] = m->max_defect, a[k++] = m->max_gap, a[k++] = m->project_dH, a[k++] = (PetscReal)m->nprojections;
   a[k++] = (PetscReal)m->last_written;
+  return k;
 }
 
 static void UnpackMonitor(MonitorContext *m, const PetscReal a[CHECKPOINT_NMONITOR])
@@ -190,7 +191,7 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
   PetscCall(PhlexCheckpointWriteInt(v, "/state", "nq", n));
   PetscCall(PhlexCheckpointWriteReals(v, "/state", "q_previous", n, m->qprev));
   PetscCall(PhlexCheckpointWriteReals(v, "/state", "multipliers", n, m->lambda));
-  PackMonitor(m, mon);
+  PetscCheck(PackMonitor(m, mon) == CHECKPOINT_NMONITOR, comm, PETSC_ERR_PLIB, "the checkpoint's list of accumulators is out of date");
   PetscCall(PhlexCheckpointWriteReals(v, "/monitor", "accumulators", CHECKPOINT_NMONITOR, mon));
   PetscCall(PhlexOutputSaveState(m->scene->output, v));
   PetscCall(PhlexCheckpointCommit(comm, tmp, m->ck_file, &v));
