@@ -23,7 +23,7 @@ typedef struct {
   PetscReal   max_gap, project_dH, step_project_dH;
   PetscInt    nprojections;
   /* watchdogs: stop a run whose numbers went wrong (0: off) */
-  PetscReal   watch_balance, watch_gap;
+  PetscReal   watch_balance, watch_gap, watch_orth;
   PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
   PhlexProgress progress;
   /* adaptive steps: a step that breaks a watchdog, or whose Newton fails, is retried with a smaller step */

@@ -230,8 +230,13 @@ static PetscErrorCode PostStep(TS ts)
   PetscFunctionBeginUser;
   PetscCall(TSGetApplicationContext(ts, &m));
   PetscCall(TSGetSolution(ts, &X));
-  PetscCall(PhlexSystemPostStep(m->sys, X, &defect));
-  m->max_defect = PetscMax(m->max_defect, defect);
+  if (m->theta) {
+    /* PETSc restarts a scheme whose post-step changed the solution (TSPostStep): harmless for the one-step theta
+       methods, but BDF would fall back to first order and generalized-alpha to its start-up step at every step. Their
+       rotations are left as the scheme makes them (the drift of R^T R - I is reported). */
+    PetscCall(PhlexSystemPostStep(m->sys, X, &defect));
+    m->max_defect = PetscMax(m->max_defect, defect);
+  }
   PetscCall(TSGetStepNumber(ts, &step));
   if (m->scene->project_interval > 0 && m->sys->njoints && step % m->scene->project_interval == 0) {
     PetscReal t, dH;
@@ -347,6 +352,8 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
     PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently; tighten -snes_rtol/-ksp_rtol or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
                step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance);
   }
+  /* a scheme whose rotations are not re-orthonormalised (BDF, alpha): R^T R - I drifts with the scheme's error */
+  PetscCheck(m->theta || m->watch_orth <= 0 || m->max_orth <= m->watch_orth, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): a rotation matrix is off SO(3) by ||R^T R - I||_F = %.3e, more than -watchdog_orthogonality %g: this scheme does not keep rotations orthogonal (re-orthonormalising them would restart it at every step); use the implicit midpoint rule or smaller steps (-watchdog_orthogonality 0 turns this check off); no result was written", step, (double)t, (double)m->max_orth, (double)m->watch_orth);
   if (m->sys->njoints && m->watch_gap > 0) {
     const PetscReal bound = m->watch_gap * PetscMin(u->length, 1.0);
     PetscCheck(m->max_gap <= bound, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): a joint is open by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m)): the constraints drift (a dissipative scheme with large steps?); use the implicit midpoint rule, smaller steps or -joints_project_interval (-watchdog_joint_drift 0 turns this check off); no result was written",
@@ -390,7 +397,7 @@ static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys)
 /* the options of the transient analysis (the self-checks and the energy monitor; TS, SNES and KSP read theirs) */
 typedef struct {
   PetscReal   drift_max, drift_abs_max, balance_rtol, momentum_max, linear_max, angular_max, orth_max, gap_max;
-  PetscReal   watch_balance, watch_gap;
+  PetscReal   watch_balance, watch_gap, watch_orth;
   PetscViewer monitor;
 } TransientOptions;
 
@@ -403,6 +410,7 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   o->monitor                                                                                                             = NULL;
   o->watch_balance                                                                                                       = 1e-6;
   o->watch_gap                                                                                                           = 1e-2;
+  o->watch_orth                                                                                                          = 1e-2;
   PetscOptionsBegin(comm, NULL, "Transient analysis options", NULL);
   PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", o->drift_max, &o->drift_max, NULL));
   PetscCall(PetscOptionsReal("-expect_energy_drift_abs_max", "Self-check: bound on max |H - H0| [J] (when H0 is no scale: a mechanism starting at rest)", "PhlexSceneSolveTransient", o->drift_abs_max, &o->drift_abs_max, NULL));
@@ -413,10 +421,11 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCall(PetscOptionsReal("-expect_orthogonality_max", "Self-check (moving frames): bound on max ||R^T R - I||_F", "PhlexSceneSolveTransient", o->orth_max, &o->orth_max, NULL));
   PetscCall(PetscOptionsReal("-expect_joint_drift_max", "Self-check (joints): bound on the largest position-level violation of any joint [m, rad]", "PhlexSceneSolveTransient", o->gap_max, &o->gap_max, NULL));
   PetscCall(PetscOptionsReal("-watchdog_balance_rtol", "Watchdog (implicit midpoint rule): stop when a step's power-balance residual exceeds this share of the energy (0: off)", "PhlexSceneSolveTransient", o->watch_balance, &o->watch_balance, NULL));
+  PetscCall(PetscOptionsReal("-watchdog_orthogonality", "Watchdog (BDF, alpha: rotations not re-orthonormalised): stop when ||R^T R - I||_F of a frame exceeds this (0: off)", "PhlexSceneSolveTransient", o->watch_orth, &o->watch_orth, NULL));
   PetscCall(PetscOptionsReal("-watchdog_joint_drift", "Watchdog: stop when a joint opens by more than this times min(L, 1 m) [m or rad] (0: off)", "PhlexSceneSolveTransient", o->watch_gap, &o->watch_gap, NULL));
   PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
   PetscOptionsEnd();
-  PetscCheck(o->watch_balance >= 0 && o->watch_gap >= 0, comm, PETSC_ERR_USER_INPUT, "-watchdog_balance_rtol and -watchdog_joint_drift must be >= 0 (0: off), got %g and %g", (double)o->watch_balance, (double)o->watch_gap);
+  PetscCheck(o->watch_balance >= 0 && o->watch_gap >= 0 && o->watch_orth >= 0, comm, PETSC_ERR_USER_INPUT, "-watchdog_balance_rtol, -watchdog_joint_drift and -watchdog_orthogonality must be >= 0 (0: off), got %g, %g and %g", (double)o->watch_balance, (double)o->watch_gap, (double)o->watch_orth);
   PetscFunctionReturn(0);
 }
 
@@ -703,6 +712,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
   m.watch_balance   = o.watch_balance;
   m.watch_gap       = o.watch_gap;
+  m.watch_orth      = o.watch_orth;
   if (restarting) {
     /* the checkpoint belongs to this run; the outputs continue its */
     PetscCall(PhlexCheckpointOpenRead(scene->comm, restart, &checkpoint));
@@ -766,7 +776,12 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PetscPrintf(scene->comm, "  supplied work: %.8e J, max power-balance residual %.3e J\n", (double)(m.work_total * u->energy), (double)(m.max_residual * u->energy)));
     for (PetscInt i = 0; i < sys->nparts; i++)
       if (sys->parts[i]->frame.R >= 0) {
-        PetscCall(PetscPrintf(scene->comm, "  rotations: max ||R^T R - I||_F = %.3e (largest per-step defect removed %.3e, same norm)\n", (double)m.max_orth, (double)m.max_defect));
+        if (m.theta) PetscCall(PetscPrintf(scene->comm, "  rotations: max ||R^T R - I||_F = %.3e (largest per-step defect removed %.3e, same norm)\n", (double)m.max_orth, (double)m.max_defect));
+        else {
+          TSType type;
+          PetscCall(TSGetType(ts, &type));
+          PetscCall(PetscPrintf(scene->comm, "  rotations: max ||R^T R - I||_F = %.3e (not re-orthonormalised after a step: that would restart TS %s)\n", (double)m.max_orth, type));
+        }
         break;
       }
     if (m.free_system) PetscCall(PetscPrintf(scene->comm, "  momenta: max drift of P %.3e, of L %.3e (largest component of P - P0, L - L0, relative to %.6e kg m/s, %.6e kg m^2/s)\n", (double)m.max_dP, (double)m.max_dL, (double)(m.Pscale * u->mass * u->velocity), (double)(m.Lscale * u->mass * u->velocity * u->length)));
