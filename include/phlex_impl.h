@@ -48,6 +48,7 @@ struct _p_PhlexOutput {
   PetscInt     nrestart_csv;
   char       (*restart_csv)[PETSC_MAX_PATH_LEN];
   PetscReal   *restart_csv_length;        /* bytes of each series at the checkpoint */
+  PetscBool   *restart_csv_used;          /* continued by this run */
 };
 
 /* What to do with redundant constraint components found at set-up. */
@@ -111,6 +112,7 @@ PETSC_INTERN PetscErrorCode PhlexOutputAbort(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputDestroy(PhlexOutput *);
 PETSC_INTERN PetscErrorCode PhlexOutputSaveState(PhlexOutput, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexOutputSetRestart(PhlexOutput, PetscViewer, const char[]);
+PETSC_INTERN PetscErrorCode PhlexOutputRestartCheckUsed(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputRestoreFile(PhlexOutput, const char[], const char[], PetscReal);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterSaveState(PhlexFieldWriter, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterCreate(PhlexOutput, PhlexFlexible, const char[], PhlexFieldWriter *);
@@ -148,6 +150,7 @@ PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);
 /* progress.c: progress lines of long runs (and the interrupt check) */
 typedef struct {
   PetscLogDouble start, last; /* wall clock: start of the run, last line */
+  PetscReal      done0;       /* the share of the run done at the start (a restart) */
   char           what[64];    /* what the eigensolver solves, e.g. "body arm" */
 } PhlexProgress;
 PETSC_INTERN PetscErrorCode PhlexProgressSetFromOptions(MPI_Comm);

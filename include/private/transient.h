@@ -28,10 +28,13 @@ typedef struct {
   PhlexProgress progress;
   /* adaptive steps: a step that breaks a watchdog, or whose Newton fails, is retried with a smaller step */
   PetscBool   adaptive;
-  PetscInt    nretries;
-  char        last_retry[256]; /* why the last step was retried */
+  PetscInt    nretries, snes_failures, max_snes_failures; /* retries over the run; Newton failures of this step, the user's bound (-1: none) */
+  char        last_retry[256]; /* why the step being taken was retried (cleared when a step is accepted) */
+  char        run_retry[256];  /* why the last retried step of the run was retried */
+  PetscReal   dt_nominal;      /* -ts_dt */
   /* checkpoints (transient_checkpoint.c) */
   PetscInt       first_step;   /* the step the run starts from (a restart's checkpoint; 0 otherwise) */
+  PetscInt       last_step;    /* the last step monitored (-1: none) */
   PetscInt       ck_interval;  /* every n steps (0: off) */
   PetscReal      ck_wall;      /* every s seconds of wall clock (0: off) */
   PetscLogDouble ck_last;      /* wall clock of the last checkpoint (or of the start) */

@@ -118,7 +118,9 @@ static PetscErrorCode PostStage(TS ts, PetscReal t, PetscInt index, Vec *Y)
     if (reason < 0) {
       char why[64];
       PetscCall(PetscSNPrintf(why, sizeof(why), "Newton did not converge (%s)", SNESConvergedReasons[reason]));
-      PetscCall(ReportRetry(ts, m, why));
+      /* TS gives up when a user's -ts_max_snes_failures is reached: then it is no retry */
+      if (m->max_snes_failures > 0 && ++m->snes_failures >= m->max_snes_failures) PetscCall(PetscSNPrintf(m->last_retry, sizeof(m->last_retry), "%s", why));
+      else PetscCall(ReportRetry(ts, m, why));
     }
   }
   PetscFunctionReturn(0);
@@ -135,15 +137,18 @@ static PetscErrorCode ReportRetry(TS ts, MonitorContext *m, const char why[])
   PetscCall(TSGetTime(ts, &t));
   PetscCall(TSGetTimeStep(ts, &dt));
   PetscCall(PetscSNPrintf(m->last_retry, sizeof(m->last_retry), "%s", why));
+  PetscCall(PetscSNPrintf(m->run_retry, sizeof(m->run_retry), "%s", why));
   m->nretries++;
   PetscCall(PetscPrintf(m->scene->comm, "retry: step %" PetscInt_FMT " from t = %g s with time step %g s: %s; the step is retried with a smaller one\n", step + 1, (double)t, (double)dt, why));
   PetscFunctionReturn(0);
 }
 
-/* Adaptive steps (TSAdapt's stage check): a step that would break a watchdog is rejected before it is accepted, and TS
-   retries it with dt x -ts_adapt_scale_solve_failed (at most -ts_max_reject times in a row), instead of the run
-   stopping. The checks are those of Watchdogs, on the state the step would end at (the midpoint rule's stage Y is
-   the step's middle: X_{n+1} = X_n + (Y - X_n)/theta). */
+/* Adaptive steps (TSAdapt's stage check): a step whose state holds NaN/Inf or whose power balance would break the
+   watchdog is rejected before it is accepted, and TS retries it with dt x -ts_adapt_scale_solve_failed (at most
+   -ts_max_reject times in a row), instead of the run stopping. These are the step's own failures, which a smaller
+   step cures; the joint drift and the rotations' drift accumulate over many steps, and stop the run in Watchdogs.
+   Checked on the state the step would end at (the midpoint rule's stage Y is the step's middle:
+   X_{n+1} = X_n + (Y - X_n)/theta), with the rotations cleaned as PostStep will. */
 static PetscErrorCode CheckStage(TSAdapt adapt, TS ts, PetscReal t, Vec Y, PetscBool *accept)
 {
   MonitorContext   *m;
@@ -161,37 +166,21 @@ static PetscErrorCode CheckStage(TSAdapt adapt, TS ts, PetscReal t, Vec Y, Petsc
   PetscCall(TSGetTimeStep(ts, &dt));
   PetscCall(VecNorm(Y, NORM_INFINITY, &norm));
   if (PetscIsInfOrNanReal(norm)) PetscCall(PetscSNPrintf(why, sizeof(why), "the state holds NaN or Inf"));
-  else {
+  else if (m->lossless_scheme && m->watch_balance > 0) {
+    /* the implicit midpoint rule: the step's power balance at its end state, cleaned as PostStep will */
+    const PetscReal dtn = dt / u->time;
+    PetscReal       P, kin, strain, pot, residual, scale, defect;
     Xe = m->Xmid; /* scratch: the monitor sets it before using it */
-    if (m->theta && !m->endpoint) PetscCall(VecAXPBYPCZ(Xe, 1.0 / m->theta_value, 1.0 - 1.0 / m->theta_value, 0.0, Y, m->Xprev));
-    else PetscCall(VecCopy(Y, Xe));
+    PetscCall(VecAXPBYPCZ(Xe, 1.0 / m->theta_value, 1.0 - 1.0 / m->theta_value, 0.0, Y, m->Xprev));
+    PetscCall(PhlexSystemPostStep(sys, Xe, &defect));
     PetscCall(PhlexSystemGather(sys, Xe, sys->q));
-    if (m->lossless_scheme && m->watch_balance > 0) {
-      const PetscReal dtn = dt / u->time;
-      PetscReal       P, kin, strain, pot, residual, scale;
-      for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dtn : 0.0;
-      PetscCall(InputPower(m, t, Y, 1.0, PETSC_TRUE, &P));
-      PetscCall(PhlexSystemEnergy(sys, m->tprev + dt, Xe, &kin, &strain, &pot));
-      residual = kin + strain + pot - m->Hprev - dtn * P;
-      scale    = PetscMax(PetscMax(m->Emax, kin + strain), PetscAbsReal(m->H0));
-      if (PetscIsInfOrNanReal(residual)) PetscCall(PetscSNPrintf(why, sizeof(why), "the power balance of the step is not a number"));
-      else if (PetscAbsReal(residual) > m->watch_balance * scale) PetscCall(PetscSNPrintf(why, sizeof(why), "watchdog: the power balance of the step is off by %.3e J, %.2e of the energy (bound -watchdog_balance_rtol %g)", (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)m->watch_balance));
-      PetscCall(PhlexSystemGather(sys, Xe, sys->q));
-    }
-    if (!why[0] && sys->njoints && m->watch_gap > 0) {
-      const PetscReal bound = m->watch_gap * PetscMin(u->length, 1.0);
-      PetscReal       gmax  = 0;
-      for (PetscInt k = 0; k < sys->njoints; k++) {
-        PhlexJoint   j = sys->joints[k];
-        PhlexPartVec pv[2];
-        PetscReal    gap[7];
-        PetscCall(PhlexSystemJointSides(sys, j, Xe, sys->q, pv));
-        PetscCall(PhlexJointGap(j, m->tprev + dt, &pv[0], &pv[1], gap));
-        PetscCall(PhlexSystemJointSidesRestore(sys, j, Xe, pv));
-        for (PetscInt r = 0; r < j->nc; r++) gmax = PetscMax(gmax, PetscAbsReal(gap[r]) * (j->row[r] <= PHLEX_ROW_T3 ? u->length : 1.0));
-      }
-      if (gmax > bound) PetscCall(PetscSNPrintf(why, sizeof(why), "watchdog: a joint would open by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m))", (double)gmax, (double)bound, (double)m->watch_gap));
-    }
+    for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dtn : 0.0;
+    PetscCall(InputPower(m, t, Y, 1.0, PETSC_TRUE, &P));
+    PetscCall(PhlexSystemEnergy(sys, m->tprev + dt, Xe, &kin, &strain, &pot));
+    residual = kin + strain + pot - m->Hprev - dtn * P;
+    scale    = PetscMax(PetscMax(m->Emax, kin + strain), PetscAbsReal(m->H0));
+    if (PetscIsInfOrNanReal(residual)) PetscCall(PetscSNPrintf(why, sizeof(why), "the power balance of the step is not a number"));
+    else if (PetscAbsReal(residual) > m->watch_balance * scale) PetscCall(PetscSNPrintf(why, sizeof(why), "watchdog: the power balance of the step is off by %.3e J, %.2e of the energy (bound -watchdog_balance_rtol %g)", (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)m->watch_balance));
   }
   if (why[0]) {
     *accept = PETSC_FALSE;
@@ -264,8 +253,13 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   PetscBool         fields;
 
   PetscFunctionBeginUser;
-  /* a restarted run: the checkpoint's step was monitored by the run that wrote it */
-  if (m->first_step > 0 && step == m->first_step) PetscFunctionReturn(0);
+  /* once per step: TSSolve monitors the last step again after a failed one, and a restarted run's first step is the
+     checkpoint's, which the run that wrote it monitored */
+  if (step == m->last_step) PetscFunctionReturn(0);
+  m->last_step = step;
+  /* a step was accepted: the retries of the next one start afresh */
+  m->last_retry[0] = 0;
+  m->snes_failures = 0;
   PetscCall(PetscLogEventBegin(PHLEX_MonitorEnergy, 0, 0, 0, 0));
   for (PetscInt k = 0; k < sys->njoints; k++) m->jpower[k] = 0.0;
   if (step == 0 && sys->njoints) {
@@ -540,6 +534,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(&m, sizeof(m)));
+  m.last_step = -1;
   PetscCall(TransientSetFromOptions(scene->comm, &o));
   PetscCall(PhlexTransientCheckpointOptions(scene->comm, scene->output, &m, restart, &restarting));
   m.monitor = o.monitor;
@@ -640,6 +635,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(TSAdaptSetCheckStage(adapt, CheckStage));
       PetscCall(PetscOptionsHasName(NULL, NULL, "-ts_max_snes_failures", &bound));
       if (!bound) PetscCall(TSSetMaxSNESFailures(ts, -1));
+      else PetscCall(PetscOptionsGetInt(NULL, NULL, "-ts_max_snes_failures", &m.max_snes_failures, NULL));
     }
   }
   {
@@ -670,6 +666,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   }
   PetscCall(TSGetTimeStep(ts, &dt));
   PetscCheck(dt > 0, scene->comm, PETSC_ERR_USER_INPUT, "transient analysis: set the time step with -ts_dt <s>");
+  m.dt_nominal = dt;
   {
     PetscReal tmax;
     PetscInt  smax;
@@ -728,6 +725,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(TSSetPostStep(ts, PostStep));
   PetscCall(TSSetPostStage(ts, PostStage));
   if (restarting) {
+    PetscCall(PhlexOutputRestartCheckUsed(scene->output));
     PetscCall(PhlexTransientRestart(ts, &m, checkpoint, restart, X));
     PetscCall(PetscViewerDestroy(&checkpoint));
     scene->output->restart = NULL;
@@ -736,6 +734,15 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
 
   PetscCall(PhlexLogStagePush("Phlex Transient", &PHLEX_StageTransient));
   PetscCall(PhlexProgressStart(&m.progress));
+  if (restarting) {
+    PetscReal tmax, t0;
+    PetscInt  smax, s0;
+    PetscCall(TSGetMaxTime(ts, &tmax));
+    PetscCall(TSGetMaxSteps(ts, &smax));
+    PetscCall(TSGetTime(ts, &t0));
+    PetscCall(TSGetStepNumber(ts, &s0));
+    m.progress.done0 = PetscMin(1.0, PetscMax(tmax < PETSC_MAX_REAL ? t0 / tmax : 0.0, smax < PETSC_MAX_INT ? (PetscReal)s0 / smax : 0.0));
+  }
   PetscCall(TSSolve(ts, X));
   PetscCall(PetscLogStagePop());
   PetscCall(TSGetStepNumber(ts, &nsteps));
@@ -743,12 +750,16 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(TSGetConvergedReason(ts, &reason));
   PetscCall(TSGetTimeStep(ts, &dtlast));
   if (reason < 0 && m.last_retry[0]) {
-    PetscInt maxrej = 10; /* PETSc's default; TS has no getter */
+    PetscInt  maxrej = 10; /* PETSc's default; TS has no getter */
+    PetscBool snes   = reason == TS_DIVERGED_NONLINEAR_SOLVE ? PETSC_TRUE : PETSC_FALSE;
     PetscCall(PetscOptionsGetInt(NULL, NULL, "-ts_max_reject", &maxrej, NULL));
-    SETERRQ(scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s) after retries down to a time step of %g s, the last one because: %s; allow more retries (-ts_max_reject, now %" PetscInt_FMT ") or a smaller step (-ts_adapt_dt_min), tighten the solvers, or check the inputs; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast, m.last_retry, maxrej);
+    SETERRQ(scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s), the last try with a time step of %g s because: %s; allow more retries (%s, now %" PetscInt_FMT ") or a smaller step (-ts_adapt_dt_min), tighten the solvers, or check the inputs; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast, m.last_retry, snes ? "-ts_max_snes_failures" : "-ts_max_reject", snes ? m.max_snes_failures : maxrej);
   }
   PetscCheck(reason >= 0, scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s, time step %g s): %s; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast,
              reason == TS_DIVERGED_NONLINEAR_SOLVE ? "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic: a failed step is then retried with a smaller one), or see why with -snes_converged_reason -ksp_converged_reason" : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
+  /* the final state's checkpoint: the run can be continued further (-restart with a later -ts_max_time); written
+     before the end-of-run snapshot below, which a longer run would not have */
+  if (checkpointing) PetscCall(PhlexTransientCheckpointWrite(ts, &m, X));
   if (m.last_written != nsteps && scene->output->fields) {
     /* the last state's fields (the monitor wrote its series) */
     for (PetscInt i = 0; i < sys->nparts; i++) {
@@ -760,9 +771,6 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(PhlexPartRestoreVec(p, X, &pv));
     }
   }
-
-  /* the final state's checkpoint: the run can be continued further (-restart with a later -ts_max_time) */
-  if (checkpointing) PetscCall(PhlexTransientCheckpointWrite(ts, &m, X));
 
   {
     TSType type;
@@ -785,7 +793,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
         break;
       }
     if (m.free_system) PetscCall(PetscPrintf(scene->comm, "  momenta: max drift of P %.3e, of L %.3e (largest component of P - P0, L - L0, relative to %.6e kg m/s, %.6e kg m^2/s)\n", (double)m.max_dP, (double)m.max_dL, (double)(m.Pscale * u->mass * u->velocity), (double)(m.Lscale * u->mass * u->velocity * u->length)));
-    if (m.nretries) PetscCall(PetscPrintf(scene->comm, "  retried steps: %" PetscInt_FMT " (adaptive steps; the last because: %s)\n", m.nretries, m.last_retry));
+    if (m.nretries) PetscCall(PetscPrintf(scene->comm, "  retried steps: %" PetscInt_FMT " (adaptive steps; the last because: %s)\n", m.nretries, m.run_retry));
     if (checkpointing) PetscCall(PetscPrintf(scene->comm, "  checkpoint: %s (step %" PetscInt_FMT ")\n", m.ck_file, m.ck_step));
     if (m.first_step) PetscCall(PetscPrintf(scene->comm, "  restarted at step %" PetscInt_FMT "\n", m.first_step));
     if (sys->njoints) {

@@ -17,7 +17,7 @@
 #include <private/transient.h>
 #include <petscviewerhdf5.h>
 
-#define CHECKPOINT_NMONITOR 25 /* the accumulators of PackMonitor */
+#define CHECKPOINT_NMONITOR 26 /* the accumulators of PackMonitor */
 
 /* the energy monitor's accumulators, in a fixed order; returns how many */
 static PetscInt PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMONITOR])
@@ -29,7 +29,7 @@ static PetscInt PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMON
   for (PetscInt c = 0; c < 3; c++) a[k++] = m->L0[c];
   a[k++] = m->Pscale, a[k++] = m->Lscale, a[k++] = m->max_dP, a[k++] = m->max_dL, a[k++] = m->max_orth;
   a[k++] = m->max_defect, a[k++] = m->max_gap, a[k++] = m->project_dH, a[k++] = (PetscReal)m->nprojections;
-  a[k++] = (PetscReal)m->last_written;
+  a[k++] = (PetscReal)m->last_written, a[k++] = (PetscReal)m->nretries;
   return k;
 }
 
@@ -42,18 +42,22 @@ static void UnpackMonitor(MonitorContext *m, const PetscReal a[CHECKPOINT_NMONIT
   for (PetscInt c = 0; c < 3; c++) m->L0[c] = a[k++];
   m->Pscale = a[k++], m->Lscale = a[k++], m->max_dP = a[k++], m->max_dL = a[k++], m->max_orth = a[k++];
   m->max_defect = a[k++], m->max_gap = a[k++], m->project_dH = a[k++], m->nprojections = (PetscInt)a[k++];
-  m->last_written = (PetscInt)a[k++];
+  m->last_written = (PetscInt)a[k++], m->nretries = (PetscInt)a[k++];
 }
 
 /* what the state vector means: the parts and joints by name and kind, the sizes, the scales; a restart checks that
    its own run has the same */
-static PetscErrorCode Fingerprint(MonitorContext *m, char parts[], size_t len, PetscReal units[4])
+static PetscErrorCode Fingerprint(MonitorContext *m, char **fingerprint, PetscReal units[4])
 {
-  PhlexSystem sys = m->sys;
-  size_t      n;
+  PhlexSystem  sys = m->sys;
+  const size_t len = (size_t)(sys->nparts + sys->njoints + 1) * (2 * PHLEX_NAME_LEN + 64);
+  char        *parts;
+  size_t       n;
 
   PetscFunctionBeginUser;
-  parts[0] = 0;
+  PetscCall(PetscMalloc1(len, &parts));
+  parts[0]     = 0;
+  *fingerprint = parts;
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PetscCall(PetscStrlen(parts, &n));
     PetscCall(PetscSNPrintf(parts + n, len - n, "%s%s:%s:%" PetscInt_FMT ":%" PetscInt_FMT, i ? " " : "", sys->parts[i]->name, sys->parts[i]->type, sys->parts[i]->Nu + sys->parts[i]->Ns + sys->parts[i]->Nv, sys->parts[i]->nq));
@@ -63,6 +67,35 @@ static PetscErrorCode Fingerprint(MonitorContext *m, char parts[], size_t len, P
     PetscCall(PetscSNPrintf(parts + n, len - n, " joint %s:%" PetscInt_FMT, sys->joints[k]->name, sys->joints[k]->nc));
   }
   units[0] = m->scene->units.length, units[1] = m->scene->units.density, units[2] = m->scene->units.modulus, units[3] = m->scene->units.mass;
+  PetscFunctionReturn(0);
+}
+
+/* the time integrator and its parameters, as text: a restart needs the same */
+static PetscErrorCode Scheme(TS ts, char scheme[], size_t len)
+{
+  TSType    type;
+  PetscBool theta, bdf, alpha;
+
+  PetscFunctionBeginUser;
+  PetscCall(TSGetType(ts, &type));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)ts, &theta, TSTHETA, TSCN, TSBEULER, ""));
+  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSBDF, &bdf));
+  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSALPHA, &alpha));
+  if (theta) {
+    PetscReal th;
+    PetscBool endpoint;
+    PetscCall(TSThetaGetTheta(ts, &th));
+    PetscCall(TSThetaGetEndpoint(ts, &endpoint));
+    PetscCall(PetscSNPrintf(scheme, len, "-ts_type %s, theta %.17g%s", type, (double)th, endpoint ? ", endpoint" : ""));
+  } else if (bdf) {
+    PetscInt order;
+    PetscCall(TSBDFGetOrder(ts, &order));
+    PetscCall(PetscSNPrintf(scheme, len, "-ts_type %s, order %" PetscInt_FMT, type, order));
+  } else if (alpha) {
+    PetscReal am, af, g;
+    PetscCall(TSAlphaGetParams(ts, &am, &af, &g));
+    PetscCall(PetscSNPrintf(scheme, len, "-ts_type %s, alpha_m %.17g, alpha_f %.17g, gamma %.17g", type, (double)am, (double)af, (double)g));
+  } else PetscCall(PetscSNPrintf(scheme, len, "-ts_type %s", type));
   PetscFunctionReturn(0);
 }
 
@@ -108,6 +141,19 @@ PetscErrorCode PhlexTransientCheckpointOptions(MPI_Comm comm, PhlexOutput out, M
   PetscCheck(m->ck_wall >= 0 && !PetscIsInfOrNanReal(m->ck_wall), comm, PETSC_ERR_USER_INPUT, "-checkpoint_wall_interval must be a finite number of seconds >= 0 (0: off), got %g", (double)m->ck_wall);
   PetscCheck(m->ck_file[0], comm, PETSC_ERR_USER_INPUT, "-checkpoint_file must not be empty");
   PetscCheck(!*restarting || restart[0], comm, PETSC_ERR_USER_INPUT, "-restart needs the checkpoint file to continue from");
+  if ((m->ck_interval > 0 || m->ck_wall > 0) && out) {
+    /* a checkpoint elsewhere than the output directory (created when the run writes): its directory must exist */
+    char        dir[PETSC_MAX_PATH_LEN];
+    const char *slash = strrchr(m->ck_file, '/');
+    PetscBool   same, ok;
+    if (slash) PetscCall(PetscSNPrintf(dir, sizeof(dir), "%.*s", (int)(slash - m->ck_file), m->ck_file));
+    else PetscCall(PetscStrcpy(dir, "."));
+    PetscCall(PetscStrcmp(dir, out->dir, &same));
+    if (!same) {
+      PetscCall(PetscTestDirectory(dir, 'w', &ok));
+      PetscCheck(ok, comm, PETSC_ERR_USER_INPUT, "-checkpoint_file '%s': the directory '%s' does not exist or is not writable", m->ck_file, dir);
+    }
+  }
   PetscFunctionReturn(0);
 }
 
@@ -144,29 +190,29 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
   PhlexSystem sys  = m->sys;
   PetscViewer v;
   Vec         P;
-  TSType      type;
   PetscInt    step, n;
   PetscReal   t, dt, mon[CHECKPOINT_NMONITOR], units[4];
   PetscMPIInt size;
-  char        tmp[PETSC_MAX_PATH_LEN], parts[4096];
+  char        tmp[PETSC_MAX_PATH_LEN], *parts, scheme[256];
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_Output, 0, 0, 0, 0));
   PetscCall(TSGetStepNumber(ts, &step));
   PetscCall(TSGetTime(ts, &t));
   PetscCall(TSGetTimeStep(ts, &dt));
-  PetscCall(TSGetType(ts, &type));
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(Fingerprint(m, parts, sizeof(parts), units));
+  PetscCall(Fingerprint(m, &parts, units));
+  PetscCall(Scheme(ts, scheme, sizeof(scheme)));
   PetscCall(PhlexCheckpointOpenWrite(comm, m->ck_file, tmp, &v));
   PetscCall(PhlexCheckpointWriteInt(v, "/", "phlex_checkpoint", 1));
   PetscCall(PhlexCheckpointWriteInt(v, "/run", "step", step));
   PetscCall(PhlexCheckpointWriteReals(v, "/run", "time", 1, &t));
   PetscCall(PhlexCheckpointWriteReals(v, "/run", "dt", 1, &dt));
-  PetscCall(PhlexCheckpointWriteReals(v, "/run", "theta", 1, &m->theta_value));
+  PetscCall(PhlexCheckpointWriteReals(v, "/run", "dt_nominal", 1, &m->dt_nominal));
+  PetscCall(PhlexCheckpointWriteString(v, "/run", "scheme", scheme));
   PetscCall(PhlexCheckpointWriteReals(v, "/run", "units", 4, units));
-  PetscCall(PhlexCheckpointWriteString(v, "/run", "ts_type", type));
   PetscCall(PhlexCheckpointWriteString(v, "/run", "parts", parts));
+  PetscCall(PetscFree(parts));
   PetscCall(PhlexCheckpointWriteInt(v, "/run", "nranks", size));
   {
     /* the layout of X over the ranks: a restart needs the same */
@@ -210,21 +256,31 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
 PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer v, const char file[], Vec X)
 {
   MPI_Comm    comm = m->scene->comm;
-  TSType      type;
-  PetscInt    step, nranks;
-  PetscReal   t, theta, units[4], ck_units[4], tmax;
+  PetscInt    step, nranks, fields;
+  PetscReal   t, units[4], ck_units[4], tmax;
   PetscMPIInt size;
   PetscBool   same;
-  char        parts[4096], ck_parts[4096], ck_type[64];
+  char       *parts, *ck_parts, scheme[256], ck_scheme[256];
+  size_t      len;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PhlexCheckpointReadInt(v, "/run", "nranks", &nranks));
   PetscCheck(nranks == size, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written by a run on %" PetscInt_FMT " processes: restart it on as many (mpiexec -n %" PetscInt_FMT "), not %d", file, nranks, nranks, (int)size);
-  PetscCall(Fingerprint(m, parts, sizeof(parts), units));
-  PetscCall(PhlexCheckpointReadString(v, "/run", "parts", ck_parts, sizeof(ck_parts)));
+  PetscCall(Fingerprint(m, &parts, units));
+  PetscCall(PetscStrlen(parts, &len));
+  PetscCall(PetscMalloc1(2 * len + 64, &ck_parts));
+  PetscCall(PhlexCheckpointReadString(v, "/run", "parts", ck_parts, 2 * len + 64));
   PetscCall(PetscStrcmp(parts, ck_parts, &same));
-  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written for another scene: its parts and joints (name:kind:field unknowns:discrete unknowns) are '%s', this scene's '%s'", file, ck_parts, parts);
+  if (!same) {
+    char msg[PETSC_MAX_PATH_LEN];
+    PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for another scene: its parts and joints (name:kind:field unknowns:discrete unknowns) are '%s', this scene's '%s'", file, ck_parts, parts));
+    PetscCall(PetscFree(parts));
+    PetscCall(PetscFree(ck_parts));
+    SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);
+  }
+  PetscCall(PetscFree(parts));
+  PetscCall(PetscFree(ck_parts));
   PetscCall(PhlexCheckpointReadReals(v, "/run", "units", 4, ck_units));
   for (PetscInt k = 0; k < 4; k++) PetscCheck(PetscAbsReal(units[k] - ck_units[k]) <= 1e-14 * PetscAbsReal(units[k]), comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with other reference scales (length %g m, density %g kg/m^3, modulus %g Pa, mass %g kg; this run %g, %g, %g, %g): use the same -scale_* options and materials", file, (double)ck_units[0], (double)ck_units[1], (double)ck_units[2], (double)ck_units[3], (double)units[0], (double)units[1], (double)units[2], (double)units[3]);
   {
@@ -242,13 +298,24 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
     PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPIU_BOOL, MPI_LAND, comm));
     PetscCheck(ok, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with another distribution of the meshes over the processes: restart with the same meshes, partitioner and number of processes", file);
   }
-  PetscCall(TSGetType(ts, &type));
-  PetscCall(PhlexCheckpointReadString(v, "/run", "ts_type", ck_type, sizeof(ck_type)));
-  PetscCall(PetscStrcmp(type, ck_type, &same));
-  PetscCall(PhlexCheckpointReadReals(v, "/run", "theta", 1, &theta));
-  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with -ts_type %s, this run has -ts_type %s: restart with the same scheme", file, ck_type, type);
-  PetscCheck(theta == m->theta_value, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with -ts_theta_theta %g, this run has %g: restart with the same scheme", file, (double)theta, (double)m->theta_value);
-  if (!m->theta) PetscCall(PetscPrintf(comm, "Restart: TS %s keeps a history of past steps that PETSc does not checkpoint: it starts again from the checkpoint's state (the first steps differ from an uninterrupted run by the scheme's local error)\n", type));
+  PetscCall(Scheme(ts, scheme, sizeof(scheme)));
+  PetscCall(PhlexCheckpointReadString(v, "/run", "scheme", ck_scheme, sizeof(ck_scheme)));
+  PetscCall(PetscStrcmp(scheme, ck_scheme, &same));
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written with the time integrator '%s', this run has '%s': restart with the same scheme", file, ck_scheme, scheme);
+  if (!m->theta) {
+    TSType type;
+    PetscCall(TSGetType(ts, &type));
+    PetscCall(PetscPrintf(comm, "Restart: TS %s keeps a history of past steps that PETSc does not checkpoint: it starts again from the checkpoint's state (the first steps differ from an uninterrupted run by the scheme's local error)\n", type));
+  }
+  /* fields written or not: the same as the run that wrote the checkpoint (its field segments continue) */
+  PetscCall(PhlexCheckpointReadInt(v, "/output", "nwriters", &fields));
+  {
+    PetscInt mine = 0;
+    for (PetscInt i = 0; i < m->sys->nparts; i++)
+      if (m->sys->parts[i]->nv) mine++;
+    if (!m->scene->output->fields) mine = 0;
+    PetscCheck(mine == fields, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written %s field output (-output_fields %d): restart with the same", file, fields ? "with" : "without", fields ? 1 : 0);
+  }
   PetscCall(PhlexCheckpointReadInt(v, "/run", "step", &step));
   PetscCall(PhlexCheckpointReadReals(v, "/run", "time", 1, &t));
   PetscCall(TSGetMaxTime(ts, &tmax));
@@ -293,9 +360,17 @@ PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, co
   UnpackMonitor(m, mon);
   PetscCall(TSSetTime(ts, t));
   PetscCall(TSSetStepNumber(ts, step));
-  PetscCall(TSSetTimeStep(ts, dt));
+  if (m->adaptive) PetscCall(TSSetTimeStep(ts, dt)); /* the controller's next step */
+  else {
+    /* fixed steps: -ts_dt (the checkpoint's current step may have been cut to land on its run's end) */
+    PetscReal nominal;
+    PetscCall(PhlexCheckpointReadReals(v, "/run", "dt_nominal", 1, &nominal));
+    PetscCall(TSGetTimeStep(ts, &dt));
+    if (PetscAbsReal(dt - nominal) > 1e-14 * nominal) PetscCall(PetscPrintf(comm, "Restart: time step %g s (-ts_dt), the run that wrote the checkpoint had %g s\n", (double)dt, (double)nominal));
+  }
   PetscCall(VecCopy(X, m->Xprev));
   m->first_step = step;
+  m->last_step  = step;
   m->ck_step    = step;
   PetscCall(PetscPrintf(comm, "Restart from %s: step %" PetscInt_FMT ", t = %g s, time step %g s\n", file, step, (double)t, (double)dt));
   PetscFunctionReturn(0);

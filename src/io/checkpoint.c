@@ -77,6 +77,15 @@ PetscErrorCode PhlexCheckpointCommit(MPI_Comm comm, const char tmp[], const char
   if (rank == 0) {
     err = SyncFile(tmp);
     if (!err && rename(tmp, path)) err = errno;
+    if (err) (void)remove(tmp);
+    else {
+      /* the rename itself on the disk: the directory's entry */
+      char        dir[PETSC_MAX_PATH_LEN];
+      const char *slash = strrchr(path, '/');
+      if (slash) snprintf(dir, sizeof(dir), "%.*s", (int)(slash - path), path);
+      else snprintf(dir, sizeof(dir), ".");
+      (void)SyncFile(dir);
+    }
   }
   PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));
   PetscCheck(!err, comm, PETSC_ERR_FILE_WRITE, "cannot write the checkpoint '%s' (option -checkpoint_file): %s", path, strerror(err));
@@ -96,6 +105,25 @@ PetscErrorCode PhlexCheckpointOpenRead(MPI_Comm comm, const char path[], PetscVi
   PetscFunctionBeginUser;
   PetscCall(PetscTestFile(path, 'r', &exists));
   PetscCheck(exists, comm, PETSC_ERR_FILE_OPEN, "cannot read the checkpoint '%s' (option -restart): no such file", path);
+  {
+    /* rank 0 tries it first, quietly: a file that is not HDF5, or a truncated one, gets a message, not HDF5's trace */
+    PetscMPIInt rank;
+    int         ok = 1;
+    PetscCallMPI(MPI_Comm_rank(comm, &rank));
+    if (rank == 0) {
+      H5E_auto2_t func;
+      void       *data;
+      hid_t       f;
+      H5Eget_auto2(H5E_DEFAULT, &func, &data);
+      H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+      f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+      if (f < 0) ok = 0;
+      else H5Fclose(f);
+      H5Eset_auto2(H5E_DEFAULT, func, data);
+    }
+    PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
+    PetscCheck(ok, comm, PETSC_ERR_FILE_UNEXPECTED, "cannot read the checkpoint '%s' (option -restart): not an HDF5 file, or a damaged one (truncated?)", path);
+  }
   PetscCall(PetscViewerHDF5Open(comm, path, FILE_MODE_READ, viewer));
   PetscCall(PetscViewerHDF5HasAttribute(*viewer, "/", "phlex_checkpoint", &has));
   PetscCheck(has, comm, PETSC_ERR_FILE_UNEXPECTED, "'%s' (option -restart) is an HDF5 file but not a phlex checkpoint", path);

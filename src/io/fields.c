@@ -56,7 +56,7 @@ static PetscErrorCode OpenSegment(PhlexFieldWriter w)
 static PetscErrorCode RestoreState(PhlexFieldWriter w)
 {
   PetscViewer v = w->out->restart;
-  char        group[PETSC_MAX_PATH_LEN], list[8 * PHLEX_NAME_LEN + 16], file[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
+  char        group[PETSC_MAX_PATH_LEN], list[8 * (PHLEX_NAME_LEN + 8)], file[PETSC_MAX_PATH_LEN], tmp[PETSC_MAX_PATH_LEN];
   PetscBool   has;
   PetscReal  *buf;
 
@@ -73,11 +73,14 @@ static PetscErrorCode RestoreState(PhlexFieldWriter w)
   for (PetscInt k = 0; k < w->nsteps; k++) w->snap_seg[k] = (PetscInt)buf[k];
   PetscCall(PetscFree(buf));
   PetscCall(PhlexCheckpointReadString(v, group, "vertex_fields", list, sizeof(list)));
-  for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) PetscCall(PetscStrncpy(w->vfields[w->nvfields++], tok, PHLEX_NAME_LEN));
+  for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
+    PetscCheck(w->nvfields < 8, w->out->comm, PETSC_ERR_FILE_UNEXPECTED, "the checkpoint's vertex fields of body %s are malformed", w->name);
+    PetscCall(PetscStrncpy(w->vfields[w->nvfields++], tok, PHLEX_NAME_LEN));
+  }
   PetscCall(PhlexCheckpointReadString(v, group, "cell_fields", list, sizeof(list)));
   for (char *tok = strtok(list, ","); tok; tok = strtok(NULL, ",")) {
     char *colon = strchr(tok, ':');
-    PetscCheck(colon, w->out->comm, PETSC_ERR_FILE_UNEXPECTED, "the checkpoint's cell fields of body %s are malformed", w->name);
+    PetscCheck(colon && w->ncfields < 8, w->out->comm, PETSC_ERR_FILE_UNEXPECTED, "the checkpoint's cell fields of body %s are malformed", w->name);
     *colon                    = 0;
     w->cfield_nc[w->ncfields] = atoi(colon + 1);
     PetscCall(PetscStrncpy(w->cfields[w->ncfields++], tok, PHLEX_NAME_LEN));
@@ -98,7 +101,7 @@ static PetscErrorCode RestoreState(PhlexFieldWriter w)
 @*/
 PetscErrorCode PhlexFieldWriterSaveState(PhlexFieldWriter w, PetscViewer v)
 {
-  char       group[PETSC_MAX_PATH_LEN], list[8 * PHLEX_NAME_LEN + 16] = "";
+  char       group[PETSC_MAX_PATH_LEN], list[8 * (PHLEX_NAME_LEN + 8)] = "";
   PetscReal *buf;
   size_t     len;
 

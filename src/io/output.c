@@ -229,7 +229,8 @@ PetscErrorCode PhlexOutputCommit(PhlexOutput out)
     PetscCall(PetscPrintf(out->comm, "\n"));
   }
   out->ncommitted += out->nfiles;
-  out->nfiles = 0;
+  out->nfiles   = 0;
+  out->keep_tmp = PETSC_FALSE; /* nothing temporary is left */
   PetscFunctionReturn(0);
 }
 
@@ -245,10 +246,10 @@ PetscErrorCode PhlexOutputAbort(PhlexOutput out)
   if (!out) return 0;
   MPI_Comm_rank(out->comm, &rank);
   Unlock(out);
-  if (rank == 0 && out->keep_tmp) {
+  if (rank == 0 && out->keep_tmp && out->nfiles) {
     /* a checkpoint continues them (-restart) */
     fprintf(stderr, "phlex: the partial series and fields in '%s' were kept for the checkpoint (continue with -restart)\n", out->dir);
-  } else if (rank == 0) {
+  } else if (rank == 0 && !out->keep_tmp) {
     for (PetscInt k = 0; k < out->nfiles; k++) (void)remove(out->tmp[k]);
     /* a directory this run made and left empty would look like a result: removed (rmdir fails if not empty) */
     if (out->made_dir && !out->ncommitted) (void)rmdir(out->dir);
@@ -276,6 +277,7 @@ PetscErrorCode PhlexOutputCSVOpen(PhlexOutput out, const char name[], const char
     PetscCall(PetscStrcmp(out->restart_csv[i], name, &same));
     if (same) k = i;
   }
+  if (k >= 0) out->restart_csv_used[k] = PETSC_TRUE;
   if (k >= 0) {
     PetscCheck(header, out->comm, PETSC_ERR_PLIB, "series '%s' continued by a restart must be opened with its header", name);
     /* a restarted run: the series up to the checkpoint (its header included), then this run's rows appended */
@@ -383,14 +385,17 @@ PetscErrorCode PhlexOutputSaveState(PhlexOutput out, PetscViewer viewer)
   PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
   for (PetscInt k = 0; k < out->nfiles; k++) {
     PetscReal length = 0;
+    int       err    = 0;
     if (!out->csv[k]) continue;
     PetscCall(PetscViewerFlush(out->csv[k]));
     if (rank == 0) {
       FILE *fp;
       PetscCall(PetscViewerASCIIGetPointer(out->csv[k], &fp));
-      PetscCheck(!fflush(fp) && !fsync(fileno(fp)), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write '%s': %s", out->tmp[k], strerror(errno));
+      if (fflush(fp) || fsync(fileno(fp))) err = errno ? errno : EIO;
       length = (PetscReal)ftell(fp);
     }
+    PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, out->comm));
+    PetscCheck(!err, out->comm, PETSC_ERR_FILE_WRITE, "cannot write '%s' to disk for the checkpoint: %s", out->tmp[k], strerror(err));
     PetscCallMPI(MPI_Bcast(&length, 1, MPIU_REAL, 0, out->comm));
     PetscCall(PetscSNPrintf(key, sizeof(key), "csv_%" PetscInt_FMT, ncsv));
     PetscCall(PhlexCheckpointWriteString(viewer, "/output", key, out->final[k] + strlen(out->dir) + 1));
@@ -399,11 +404,25 @@ PetscErrorCode PhlexOutputSaveState(PhlexOutput out, PetscViewer viewer)
     ncsv++;
   }
   PetscCall(PhlexCheckpointWriteInt(viewer, "/output", "ncsv", ncsv));
+  PetscCall(PhlexCheckpointWriteInt(viewer, "/output", "nwriters", out->nwriters));
   if (rank == 0 && !realpath(out->dir, dir)) PetscCall(PetscStrncpy(dir, out->dir, sizeof(dir)));
   PetscCallMPI(MPI_Bcast(dir, sizeof(dir), MPI_CHAR, 0, out->comm));
   PetscCall(PhlexCheckpointWriteString(viewer, "/output", "dir", dir));
   for (PetscInt w = 0; w < out->nwriters; w++) PetscCall(PhlexFieldWriterSaveState((PhlexFieldWriter)out->writers[w], viewer));
   out->keep_tmp = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputRestartCheckUsed - after a restarted run has opened its outputs: every series of the checkpoint was
+  continued (a series this run does not write means another scene or other outputs)
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputRestartCheckUsed(PhlexOutput out)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < out->nrestart_csv; k++) PetscCheck(out->restart_csv_used[k], out->comm, PETSC_ERR_USER_INPUT, "the checkpoint (option -restart) has the series '%s', which this run does not write: it was written for another scene or other outputs", out->restart_csv[k]);
   PetscFunctionReturn(0);
 }
 
@@ -428,7 +447,7 @@ PetscErrorCode PhlexOutputSetRestart(PhlexOutput out, PetscViewer viewer, const 
     else PetscCall(PetscStrcpy(out->restart_dir, "."));
   }
   PetscCall(PhlexCheckpointReadInt(viewer, "/output", "ncsv", &out->nrestart_csv));
-  PetscCall(PetscMalloc2(out->nrestart_csv, &out->restart_csv, out->nrestart_csv, &out->restart_csv_length));
+  PetscCall(PetscCalloc3(out->nrestart_csv, &out->restart_csv, out->nrestart_csv, &out->restart_csv_length, out->nrestart_csv, &out->restart_csv_used));
   for (PetscInt k = 0; k < out->nrestart_csv; k++) {
     PetscCall(PetscSNPrintf(key, sizeof(key), "csv_%" PetscInt_FMT, k));
     PetscCall(PhlexCheckpointReadString(viewer, "/output", key, out->restart_csv[k], sizeof(out->restart_csv[k])));
@@ -455,7 +474,7 @@ PetscErrorCode PhlexOutputDestroy(PhlexOutput *out)
   Unlock(*out);
   PetscCall(PetscFree3((*out)->tmp, (*out)->final, (*out)->csv));
   PetscCall(PetscFree((*out)->writers));
-  PetscCall(PetscFree2((*out)->restart_csv, (*out)->restart_csv_length));
+  PetscCall(PetscFree3((*out)->restart_csv, (*out)->restart_csv_length, (*out)->restart_csv_used));
   PetscCall(PetscFree(*out));
   PetscFunctionReturn(0);
 }

@@ -43,7 +43,8 @@ PetscErrorCode PhlexProgressStart(PhlexProgress *p)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&p->start));
-  p->last = p->start;
+  p->last  = p->start;
+  p->done0 = 0;
   PetscFunctionReturn(0);
 }
 
@@ -72,7 +73,8 @@ PetscErrorCode PhlexProgressStep(PhlexProgress *p, MPI_Comm comm, PetscInt step,
   if (now - p->last < progress_interval) PetscFunctionReturn(0);
   p->last = now;
   FormatDuration((PetscReal)(now - p->start), elapsed, sizeof(elapsed));
-  if (done > 0) FormatDuration((PetscReal)(now - p->start) * (1 - done) / done, left, sizeof(left));
+  /* the time left from the pace since this process started (a restart starts at done0) */
+  if (done > p->done0) FormatDuration((PetscReal)(now - p->start) * (1 - done) / (done - p->done0), left, sizeof(left));
   else PetscCall(PetscStrcpy(left, "?"));
   PetscCall(PetscPrintf(comm, "progress: step %" PetscInt_FMT ", t = %.6g s (%.0f%%), elapsed %s, left ~%s%s%s\n", step, (double)t, (double)(100 * done), elapsed, left, drift ? ", " : "", drift ? drift : ""));
   PetscFunctionReturn(0);
