@@ -18,7 +18,7 @@ CC        = $(shell pkg-config --variable=ccompiler petsc 2>/dev/null || echo mp
 CPPFLAGS  = -Iinclude $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 CFLAGS    ?= -O2 -g
 CFLAGS    += -std=c99 -Wall -Wextra -Wno-unused-parameter -MMD -MP
-LDLIBS    = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -llapack -lblas -lm
+LDLIBS    = $(shell pkg-config --libs $(PKGS) 2>/dev/null) -lmetis -llapack -lblas -lm
 
 SRC       := $(sort $(wildcard src/*.c src/*/*.c))
 OBJ       := $(patsubst src/%.c,build/%.o,$(SRC))

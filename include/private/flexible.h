@@ -247,6 +247,9 @@ PETSC_INTERN PetscErrorCode PhlexMeshLoad(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexMeshFindGroup(PhlexFlexible, const char[], PetscInt, const char[], PetscInt *);
 PETSC_INTERN PetscErrorCode PhlexMeshCheckGeometry(PhlexFlexible);
 
+/* partition_metis.c: PetscPartitioner "phlexmetis" */
+PETSC_INTERN PetscErrorCode PhlexPartitionerRegister(void);
+
 /* flexible_fe.c: spaces and constant operators */
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible, const PhlexUnits *);

@@ -298,6 +298,9 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
     if (dmdist) {
       PetscCall(DMDestroy(&dm));
       dm = dmdist;
+      /* the distributed DM does not inherit the prefix: without it -<prefix>dm_refine, -<prefix>dm_view ... would be
+         ignored in parallel */
+      PetscCall(DMSetOptionsPrefix(dm, body->prefix));
     }
   }
   PetscCall(DMSetFromOptions(dm)); /* -<prefix>dm_refine, -<prefix>dm_plex_check_all, ... */
