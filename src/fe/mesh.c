@@ -242,7 +242,7 @@ PetscErrorCode PhlexMeshFindGroup(PhlexFlexible body, const char name[], PetscIn
   Options Database Keys (body prefix):
 + -dm_refine <n>          - uniform refinements after distribution
 . -dm_plex_check_all      - DMPlex consistency checks
-- -petscpartitioner_type  - partitioner (PTScotch in parallel on Debian)
+- -petscpartitioner_type  - partitioner: phlexmetis (default), ptscotch
 
   Notes:
   Tetrahedra only. Hexahedra are refused: with discontinuous Q_{k-1} stress the stress space does not contain the
@@ -292,6 +292,9 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
   PetscCall(DMSetOptionsPrefix(dm, body->prefix));
   PetscCall(DMPlexGetPartitioner(dm, &part));
   PetscCall(PetscObjectSetOptionsPrefix((PetscObject)part, body->prefix));
+  /* METIS by default: as fast as PTScotch on the bar (BENCHMARKS.md), and the same partition at every run (PTScotch's
+     varies), so that parallel runs repeat bit for bit and a checkpoint's layout is found again at restart */
+  PetscCall(PetscPartitionerSetType(part, "phlexmetis"));
   PetscCall(PetscPartitionerSetFromOptions(part));
   if (size > 1) {
     PetscCall(DMPlexDistribute(dm, 0, NULL, &dmdist));
@@ -303,6 +306,9 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
       PetscCall(DMSetOptionsPrefix(dm, body->prefix));
     }
   }
+  /* distributed above: DMSetFromOptions would distribute it again (PETSc's default -dm_distribute), with the default
+     partitioner of the new DM, which changed the partition from run to run */
+  PetscCall(DMPlexDistributeSetDefault(dm, PETSC_FALSE));
   PetscCall(DMSetFromOptions(dm)); /* -<prefix>dm_refine, -<prefix>dm_plex_check_all, ... */
   /* extra uniform refinements requested by a convergence study */
   for (PetscInt r = 0; r < body->extra_refinements; r++) {
