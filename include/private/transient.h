@@ -13,6 +13,8 @@ typedef struct {
   PetscViewer energy_csv, monitor;
   PetscInt    interval, last_written;
   PetscBool   theta, endpoint;
+  PetscBool   history;     /* BDF, alpha: past steps kept inside TS (a changed state restarts them) */
+  PetscBool   orth_warned; /* the warning on rotations off SO(3) was given */
   PetscReal   theta_value;
   PetscReal  *qprev, *lambda; /* discrete unknowns of the previous step, multipliers (step averages) */
   PetscReal  *jpower;         /* power through each joint over the step, with the scheme's quadrature */

@@ -309,6 +309,13 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
   /* distributed above: DMSetFromOptions would distribute it again (PETSc's default -dm_distribute), with the default
      partitioner of the new DM, which changed the partition from run to run */
   PetscCall(DMPlexDistributeSetDefault(dm, PETSC_FALSE));
+  {
+    PetscBool again = PETSC_FALSE, overlap;
+    PetscCall(PetscOptionsGetBool(NULL, body->prefix, "-dm_distribute", &again, NULL));
+    PetscCall(PetscOptionsHasName(NULL, body->prefix, "-dm_distribute_overlap", &overlap));
+    PetscCheck(!overlap, body->comm, PETSC_ERR_USER_INPUT, "body %s: -%sdm_distribute_overlap: phlex needs non-overlapping parts (every cell on one process: the operators sum over the local cells)", body->name, body->prefix);
+    PetscCheck(!again, body->comm, PETSC_ERR_USER_INPUT, "body %s: -%sdm_distribute: phlex distributes the mesh itself (-%spetscpartitioner_type chooses how); a second distribution is not supported", body->name, body->prefix, body->prefix);
+  }
   PetscCall(DMSetFromOptions(dm)); /* -<prefix>dm_refine, -<prefix>dm_plex_check_all, ... */
   /* extra uniform refinements requested by a convergence study */
   for (PetscInt r = 0; r < body->extra_refinements; r++) {
@@ -316,6 +323,12 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
     PetscCall(DMRefine(dm, body->comm, &rdm));
     PetscCall(DMDestroy(&dm));
     dm = rdm;
+  }
+  {
+    /* overlapping cells would be assembled twice (the operators sum over the local cells) */
+    PetscInt overlap;
+    PetscCall(DMPlexGetOverlap(dm, &overlap));
+    PetscCheck(overlap == 0, body->comm, PETSC_ERR_USER_INPUT, "body %s: a distributed mesh with overlap %" PetscInt_FMT " (option -%sdm_distribute_overlap): phlex needs non-overlapping parts (every cell on one process)", body->name, overlap, body->prefix);
   }
   PetscCall(DMViewFromOptions(dm, NULL, "-dm_view"));
   body->dm = dm;

@@ -18,7 +18,7 @@ static PetscErrorCode PartitionerView_Metis(PetscPartitioner part, PetscViewer v
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
   if (ascii) {
     PetscCall(PetscViewerASCIIPushTab(viewer));
-    PetscCall(PetscViewerASCIIPrintf(viewer, "METIS k-way on one rank, seed %" PetscInt_FMT ", edge cut %" PetscInt_FMT "\n", ((PartitionerMetis *)part->data)->seed, part->edgeCut));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "METIS k-way on one rank, seed %" PetscInt_FMT "\n", ((PartitionerMetis *)part->data)->seed));
     PetscCall(PetscViewerASCIIPopTab(viewer));
   }
   PetscFunctionReturn(0);
@@ -65,7 +65,12 @@ static PetscErrorCode PartitionerPartition_Metis(PetscPartitioner part, PetscInt
     PetscCall(ISCreateGeneral(comm, 0, NULL, PETSC_OWN_POINTER, partition));
     PetscFunctionReturn(0);
   }
-  PetscCheck(holders == 1, comm, PETSC_ERR_SUP, "partitioner phlexmetis partitions a mesh held by one rank (as read from a file); the cells are on %" PetscInt_FMT " ranks: use -petscpartitioner_type ptscotch", holders);
+  if (holders != 1) {
+    const char *prefix;
+    PetscCall(PetscObjectGetOptionsPrefix((PetscObject)part, &prefix));
+    SETERRQ(comm, PETSC_ERR_SUP, "partitioner phlexmetis partitions a mesh held by one rank (as read from a file); the cells are on %" PetscInt_FMT " ranks: use -%spetscpartitioner_type ptscotch", holders, prefix ? prefix : "");
+  }
+  PetscCheck(total < PETSC_MAX_INT / 64 && (!numVertices || start[numVertices] < (PetscInt)2147483647), comm, PETSC_ERR_SUP, "partitioner phlexmetis: the cell graph is too large for METIS's 32-bit indices; use ptscotch");
   PetscCall(PetscMalloc1(numVertices, &assignment));
   if (numVertices && nparts > 1) {
     idx_t   nv = (idx_t)numVertices, ncon = 1, np = (idx_t)nparts, cut = 0, options[METIS_NOPTIONS];
