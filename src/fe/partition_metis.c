@@ -143,6 +143,8 @@ static PetscErrorCode PetscPartitionerCreate_PhlexMetis(PetscPartitioner part)
 PetscErrorCode PhlexPartitionerRegister(void)
 {
   PetscFunctionBeginUser;
+  /* the package first: its finalisation frees the list of types (a run that never makes a DMPlex would leak it) */
+  PetscCall(PetscPartitionerInitializePackage());
   PetscCall(PetscPartitionerRegister("phlexmetis", PetscPartitionerCreate_PhlexMetis));
   PetscFunctionReturn(0);
 }
