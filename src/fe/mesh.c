@@ -293,7 +293,7 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
   PetscCall(DMPlexGetPartitioner(dm, &part));
   PetscCall(PetscObjectSetOptionsPrefix((PetscObject)part, body->prefix));
   /* METIS by default: as fast as PTScotch on the bar (BENCHMARKS.md), and the same partition at every run (PTScotch's
-     varies), so that parallel runs repeat bit for bit and a checkpoint's layout is found again at restart */
+     varies), so that a checkpoint's layout is found again at restart */
   PetscCall(PetscPartitionerSetType(part, "phlexmetis"));
   PetscCall(PetscPartitionerSetFromOptions(part));
   if (size > 1) {
