@@ -36,7 +36,7 @@ typedef struct {
 
 /* log.c */
 PETSC_EXTERN PetscClassId  PHLEX_CLASSID;
-PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly;
+PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp;
 PETSC_EXTERN PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes;
 PETSC_EXTERN PetscErrorCode PhlexLogRegister(void);
 PETSC_EXTERN PetscErrorCode PhlexLogStagePush(const char[], PetscLogStage *);
@@ -72,6 +72,8 @@ PETSC_EXTERN PetscErrorCode PhlexHelpCaptureEnd(PetscInt *, char ***);
 /* options_check.c: misspelt options fail before the run */
 PETSC_EXTERN PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm, PetscErrorCode (*)(void *), void *);
 PETSC_EXTERN PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm);
+PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedFromFiles(const char *const[]);
+PETSC_EXTERN PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const[], PetscBool *);
 
 /* scene_file.c: the YAML syntax of the scene files, before PETSc reads them */
 PETSC_EXTERN int PhlexSceneFilesCheck(int, char **);

@@ -95,6 +95,7 @@ int main(int argc, char **argv)
   PetscCall(PhlexInterruptPush());
   PetscCall(PhlexLogRegister());
   PetscCall(PhlexPCRegister());
+  PetscCall(PhlexSNESRegister());
   PetscCall(PhlexPartitionerRegister());
   PetscCall(PhlexPartRegisterAll());
   ierr = Run(&scene);

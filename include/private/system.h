@@ -95,6 +95,11 @@ PETSC_INTERN PetscErrorCode PhlexBorderCreateShells(PhlexSystem);
 
 /* pcbordered.c */
 PETSC_INTERN PetscErrorCode PhlexPCRegister(void);
+PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
+/* snes_condensed.c: SNES phlexcondensed, the theta-method stage of fixed linear bodies by exact elimination */
+PETSC_INTERN PetscErrorCode PhlexSNESRegister(void);
+PETSC_INTERN PetscErrorCode PhlexSNESCondensedApplicable(PhlexSystem, TS, PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexSNESCondensedSetSystem(SNES, PhlexSystem, TS);
 
 /* assembly.c: consistent configuration and velocities, redundancy, drift */
 PETSC_INTERN PetscErrorCode PhlexAssemblyPlaceAttached(PhlexSystem, Vec);

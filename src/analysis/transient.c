@@ -466,7 +466,12 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
   char      drift[96] = "";
 
   PetscFunctionBeginUser;
-  if (step == m->first_step + 1) PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
+  if (step == m->first_step + 1) {
+    /* the preset's options of the solver path not taken */
+    const char *const generic[] = {"ksp_", "pc_", "fieldsplit_", NULL}, *const stage[] = {"condensed_", NULL};
+    PetscCall(PhlexOptionsSetUsedFromFiles(m->condensed ? generic : stage));
+    PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
+  }
   PetscCall(TSGetMaxTime(ts, &tmax));
   PetscCall(TSGetMaxSteps(ts, &smax));
   done = PetscMax(tmax < PETSC_MAX_REAL ? t / tmax : 0.0, smax < PETSC_MAX_INT ? (PetscReal)step / smax : 0.0);
@@ -663,6 +668,23 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
       PetscCall(PetscPrintf(scene->comm, "Generalized-alpha: SNES newtonls (basic line search) instead of ksponly, so that the scheme's rate is taken at the solution\n"));
     }
+  }
+  {
+    /* fixed linear bodies under the theta method: the stage by exact elimination (snes_condensed.c) when the preset
+       configures its solve (-condensed_ksp_type) and neither -snes_type nor a solver option of the whole system
+       (-ksp_*, -pc_*, -fieldsplit_*) on the command line asks for the generic path */
+    SNES              snes;
+    PetscBool         given, configured, generic, condensed, applicable;
+    const char *const whole[] = {"ksp_", "pc_", "fieldsplit_", NULL};
+    PetscCall(TSGetSNES(ts, &snes));
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_type", &given));
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-condensed_ksp_type", &configured));
+    PetscCall(PhlexOptionsCommandLineHasPrefix(whole, &generic));
+    PetscCall(PhlexSNESCondensedApplicable(sys, ts, &applicable));
+    if (!given && configured && !generic && applicable) PetscCall(SNESSetType(snes, "phlexcondensed"));
+    PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexcondensed", &condensed));
+    if (condensed) PetscCall(PhlexSNESCondensedSetSystem(snes, sys, ts));
+    m.condensed = condensed;
   }
   if (sys->nonlinear || sys->inexact_schur) {
     /* Newton (a preset's newtonls also on a linear spinning body: its tolerances are below the round-off floor,

@@ -558,6 +558,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->Sv        = b->Sv;
   ops->M         = b->Mvaij;
   ops->K         = b->Kaij;
+  ops->load      = b->floating ? NULL : b->load;
   PetscFunctionReturn(0);
 }
 

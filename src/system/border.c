@@ -277,6 +277,20 @@ static PetscErrorCode VelocityPmat(PhlexSystem sys)
 }
 
 /*@C
+  PhlexSystemVelocityOperator - the condensed velocity operators shift Mv + K/shift of all bodies (block diagonal, at
+  the shift of the last Jacobian); owned by the system
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem sys, Mat *Sv)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VelocityPmat(sys));
+  *Sv = sys->Sv;
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexSystemPmat - the preconditioning matrix of a set of fields, assembled when PCFIELDSPLIT asks for a split
   (layout.c): {velocity}: the condensed velocity operators shift Mv + K/shift (the exact Schur complement of the
   displacement and stress of a fixed body; of a floating one up to its node-wise inertial terms); {velocity,

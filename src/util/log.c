@@ -2,7 +2,7 @@
 #include <phlex.h>
 
 PetscClassId  PHLEX_CLASSID;
-PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly;
+PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp;
 PetscLogStage PHLEX_StageSetup = -1, PHLEX_StageTransient = -1, PHLEX_StageModes = -1;
 
 /*@C
@@ -17,6 +17,8 @@ PetscErrorCode PhlexLogRegister(void)
   PetscCall(PetscLogEventRegister("PhlexBodySetUp", PHLEX_CLASSID, &PHLEX_BodySetUp));
   PetscCall(PetscLogEventRegister("PhlexBodyAssem", PHLEX_CLASSID, &PHLEX_BodyAssemble));
   PetscCall(PetscLogEventRegister("PhlexSysIFunc", PHLEX_CLASSID, &PHLEX_SysIFunction));
+  PetscCall(PetscLogEventRegister("PhlexCondStage", PHLEX_CLASSID, &PHLEX_CondensedStage));
+  PetscCall(PetscLogEventRegister("PhlexCondSetUp", PHLEX_CLASSID, &PHLEX_CondensedSetUp));
   PetscCall(PetscLogEventRegister("PhlexSysIJac", PHLEX_CLASSID, &PHLEX_SysIJacobian));
   PetscCall(PetscLogEventRegister("PhlexMonEnergy", PHLEX_CLASSID, &PHLEX_MonitorEnergy));
   PetscCall(PetscLogEventRegister("PhlexModesSolve", PHLEX_CLASSID, &PHLEX_ModesSolve));

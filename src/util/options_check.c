@@ -164,6 +164,55 @@ PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm comm, PetscErrorCode (*reread)(v
 }
 
 /*@C
+  PhlexOptionsCommandLineHasPrefix - whether the command line gives an option that starts with one of the
+  NULL-terminated prefixes
+
+  Not Collective
+@*/
+PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const prefixes[], PetscBool *found)
+{
+  int    argc;
+  char **args;
+
+  PetscFunctionBeginUser;
+  *found = PETSC_FALSE;
+  PetscCall(PetscGetArgs(&argc, &args));
+  for (int i = 1; i < argc && !*found; i++)
+    for (PetscInt k = 0; prefixes[k] && !*found; k++)
+      if (args[i][0] == '-' && !strncasecmp(args[i] + 1, prefixes[k], strlen(prefixes[k]))) *found = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOptionsSetUsedFromFiles - marks as read the options that start with one of the NULL-terminated prefixes and came
+  from a scene or preset file, not from the command line: a preset configures two solver paths, and the one this run
+  does not take is not the user's mistake (the same options typed on the command line are still checked)
+
+  Not Collective
+@*/
+PetscErrorCode PhlexOptionsSetUsedFromFiles(const char *const prefixes[])
+{
+  PetscInt n;
+  char   **names, **values;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
+  for (PetscInt i = 0; i < n; i++) {
+    PetscBool match = PETSC_FALSE, given, set;
+    char      option[256];
+    /* (PETSc 3.18's PetscStrbeginswith looks for the last occurrence: "fieldsplit_0_fieldsplit_..." would not match) */
+    for (PetscInt k = 0; prefixes[k] && !match; k++) match = strncmp(names[i], prefixes[k], strlen(prefixes[k])) ? PETSC_FALSE : PETSC_TRUE;
+    if (!match) continue;
+    PetscCall(OnCommandLine(names[i], &given));
+    if (given) continue;
+    PetscCall(PetscSNPrintf(option, sizeof(option), "-%s", names[i]));
+    PetscCall(PetscOptionsHasName(NULL, NULL, option, &set)); /* a query marks the option as read */
+  }
+  PetscCall(PetscOptionsLeftRestore(NULL, &n, &names, &values));
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexOptionsWarnUnused - at the end of a run, a warning for every option that was never read
 
   Collective

@@ -1,0 +1,327 @@
+/* SNES "phlexcondensed": the stage of the theta method for scenes of fixed linear flexible bodies, computed from the
+   start of the step by exact elimination instead of a residual and a field-split Newton step.
+
+   A fixed body's equations (paper eq. (ph-mixed), the rows of FlexResidual in SI time t, non-dimensional fields) are
+       T u' = v,    T Ms Sigma' = G v,    T Mv v' = -G^T Sigma + b(t),
+   and TSTHETA's stage X = X0 + theta dt X' (shift a = 1 / (theta dt), s = a T) solves
+       s (u - u0) = v,   s Ms (Sigma - Sigma0) = G v,   s Mv (v - v0) + G^T Sigma = b(t0 + theta dt).
+   With B = Ms^{-1} G (formed once by a sparse product; it has G's pattern, Ms being block diagonal per cell) and the
+   predicted stress Sigma_p = Sigma0 + B v0 / s, eliminating u and Sigma and solving for the increment dv = v - v0:
+       (s Mv + K / s) dv = b - G^T Sigma_p,                                             (the condensed right-hand side)
+       Sigma = Sigma0 + B v / s,   u = u0 + v / s.
+   The factored operator s Mv + K / s is the exact preset's (each body's Sv). Measured on the cantilever (200 steps),
+   the right-hand side must be formed this way to keep the power balance at round-off (4e-13 J per step):
+     - solving for v instead of dv puts the solve's error on v itself (3e-11 J);
+     - b - G^T Sigma0 - K v0 / s with the element-assembled K, which differs from G^T Ms^{-1} G by about 1e-11
+       relative on smooth fields (1e-11 J), or even with the product G^T B (5e-12 J): the momentum rows must see
+       G^T of the very stress whose change the stress rows see.
+     - Sigma = Sigma0 + B v / s instead of Sigma_p + B dv / s, or B v0 carried over from the previous step's
+       B v_{n+1} (saving a product), each moved the tip velocities by 1e-12 to 2e-11 of their 0.35 m/s scale from a
+       fully converged solve; as written, 5e-15 to 3e-12 of it (the generic path: 2e-15 to 2e-12).
+   So a step costs two products with B, one with G^T and one solve, against a residual (G, G^T, Ms, Mv) and a
+   field-split Newton step (Ms^{-1} twice, G, G^T, copies of the five-times-larger stress field) on the generic path. The result is the same stage (the system is linear and both
+   solve it exactly); the energy balance of the midpoint rule holds to the solve's round-off.
+
+   Used when every part is a fixed flexible body with constant operators (no frame, joint, spin or stiffening) and
+   the integrator is the theta method without endpoint (the default implicit midpoint, backward Euler); the
+   transient analysis selects it unless -snes_type is given. The condensed solve is KSP "condensed_" (the presets set
+   it: options/solver/exact.opts). */
+#include <phlex_impl.h>
+#include <petsc/private/snesimpl.h>
+
+typedef struct {
+  PhlexSystem sys;
+  TS          ts;
+  KSP         ksp;   /* the condensed velocity operator s Mv + K / s (the bodies' Sv, block diagonal) */
+  Mat        *B;    /* per body: Ms^{-1} G */
+  Vec         r;     /* the condensed right-hand side */
+  Vec         bv, sp; /* stress field: B v0, then B dv; Sigma_p */
+  PetscReal   shift; /* non-dimensional shift of the operator last handed to the KSP (0: none) */
+} SNES_Condensed;
+
+/* why a scene or an integrator cannot use the condensed stage (empty: it can) */
+static PetscErrorCode Eligibility(PhlexSystem sys, TS ts, char why[], size_t len)
+{
+  PetscBool theta, beuler, endpoint = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  why[0] = 0;
+  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSTHETA, &theta));
+  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSBEULER, &beuler));
+  if (theta) PetscCall(TSThetaGetEndpoint(ts, &endpoint));
+  if (!sys->nfparts) PetscCall(PetscSNPrintf(why, len, "the scene has no flexible body"));
+  else if (sys->nq || sys->njoints) PetscCall(PetscSNPrintf(why, len, "the scene has rigid, lumped or floating parts or joints (discrete unknowns)"));
+  else if (sys->nonlinear || sys->state_dependent_fields || sys->inexact_schur) PetscCall(PetscSNPrintf(why, len, "a body is nonlinear or spinning (geometric stiffening, spin)"));
+  else if (!(theta || beuler) || endpoint) {
+    TSType type;
+    PetscCall(TSGetType(ts, &type));
+    PetscCall(PetscSNPrintf(why, len, "the integrator is %s%s; the condensed stage is that of the theta method without endpoint (-ts_type theta, the default implicit midpoint, or beuler)", type, endpoint ? " with endpoint (Crank-Nicolson)" : ""));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESCondensedApplicable - whether the scene and the integrator admit SNES phlexcondensed
+
+  Collective
+@*/
+PetscErrorCode PhlexSNESCondensedApplicable(PhlexSystem sys, TS ts, PetscBool *ok)
+{
+  char why[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(Eligibility(sys, ts, why, sizeof(why)));
+  *ok = why[0] ? PETSC_FALSE : PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESCondensedSetSystem - hands SNES phlexcondensed the scene's system and the TS whose stages it solves; an
+  error names what the scene or the integrator lacks
+
+  Collective
+@*/
+PetscErrorCode PhlexSNESCondensedSetSystem(SNES snes, PhlexSystem sys, TS ts)
+{
+  SNES_Condensed *c = (SNES_Condensed *)snes->data;
+  char            why[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(Eligibility(sys, ts, why, sizeof(why)));
+  PetscCheck(!why[0], sys->comm, PETSC_ERR_USER_INPUT, "-snes_type phlexcondensed cannot solve this scene's steps: %s; use -snes_type ksponly (linear) or newtonls", why);
+  c->sys = sys;
+  c->ts  = ts;
+  PetscFunctionReturn(0);
+}
+
+/* Ms^{-1} in Ms's pattern, from the inverses of its per-cell blocks */
+static PetscErrorCode InverseStressMass(PhlexSystem sys, Mat *Minv)
+{
+  PetscInt           nb, rstart, row, bmax = 1, ntot = 0, *idx;
+  const PetscInt    *bsz;
+  PetscScalar       *diag, *blk;
+  const PetscScalar *d;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetVariableBlockSizes(sys->Ms, &nb, &bsz));
+  for (PetscInt k = 0; k < nb; k++) {
+    bmax = PetscMax(bmax, bsz[k]);
+    ntot += bsz[k] * bsz[k];
+  }
+  PetscCall(PetscMalloc3(PetscMax(ntot, 1), &diag, bmax * bmax, &blk, bmax, &idx));
+  PetscCall(MatInvertVariableBlockDiagonal(sys->Ms, nb, bsz, diag));
+  PetscCall(MatDuplicate(sys->Ms, MAT_DO_NOT_COPY_VALUES, Minv));
+  PetscCall(MatGetOwnershipRange(sys->Ms, &rstart, NULL));
+  row = rstart;
+  d   = diag;
+  for (PetscInt k = 0; k < nb; k++) {
+    const PetscInt bs = bsz[k];
+    for (PetscInt i = 0; i < bs; i++) {
+      idx[i] = row + i;
+      for (PetscInt j = 0; j < bs; j++) blk[i * bs + j] = d[j * bs + i]; /* column-major to row-major */
+    }
+    PetscCall(MatSetValues(*Minv, bs, idx, bs, idx, blk, INSERT_VALUES));
+    row += bs;
+    d += bs * bs;
+  }
+  PetscCall(MatAssemblyBegin(*Minv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*Minv, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscFree3(diag, blk, idx));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESSetUp_Condensed(SNES snes)
+{
+  SNES_Condensed *c = (SNES_Condensed *)snes->data;
+  PhlexSystem     sys;
+  const char     *prefix;
+  Mat             Minv;
+
+  PetscFunctionBeginUser;
+  PetscCheck(c->sys, PetscObjectComm((PetscObject)snes), PETSC_ERR_ORDER, "SNES phlexcondensed: PhlexSNESCondensedSetSystem() was not called");
+  if (c->ksp) PetscFunctionReturn(0);
+  sys = c->sys;
+  PetscCall(PetscLogEventBegin(PHLEX_CondensedSetUp, 0, 0, 0, 0));
+  PetscCall(KSPCreate(sys->comm, &c->ksp));
+  PetscCall(PetscObjectIncrementTabLevel((PetscObject)c->ksp, (PetscObject)snes, 1));
+  PetscCall(SNESGetOptionsPrefix(snes, &prefix));
+  PetscCall(KSPSetOptionsPrefix(c->ksp, prefix));
+  PetscCall(KSPAppendOptionsPrefix(c->ksp, "condensed_"));
+  PetscCall(KSPSetFromOptions(c->ksp));
+  PetscCall(InverseStressMass(sys, &Minv));
+  PetscCall(PetscMalloc1(sys->nfparts, &c->B));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    Mat                 Mi;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCall(MatCreateSubMatrix(Minv, sys->fis[PHLEX_FIELD_STRESS][i], sys->fis[PHLEX_FIELD_STRESS][i], MAT_INITIAL_MATRIX, &Mi));
+    PetscCall(MatMatMult(Mi, ops.G, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &c->B[i]));
+    PetscCall(MatDestroy(&Mi));
+  }
+  PetscCall(MatDestroy(&Minv));
+  PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
+  PetscCall(VecDuplicate(c->sp, &c->bv));
+  PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* y = B v over the bodies (stress and velocity field vectors) */
+static PetscErrorCode MultB(PhlexSystem sys, Mat *B, Vec v, Vec y)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    Vec vi, yi;
+    PetscCall(VecGetSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+    PetscCall(VecGetSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
+    PetscCall(MatMult(B[i], vi, yi));
+    PetscCall(VecRestoreSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
+    PetscCall(VecRestoreSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESSolve_Condensed(SNES snes)
+{
+  SNES_Condensed    *c   = (SNES_Condensed *)snes->data;
+  PhlexSystem        sys = c->sys;
+  Vec                X   = snes->vec_sol, X0, u0, s0, v0, xu, xs, xv;
+  PetscReal          t, dt, theta, a, s, tstage;
+  PetscInt           its;
+  KSPConvergedReason kreason;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_CondensedStage, 0, 0, 0, 0));
+  snes->reason = SNES_CONVERGED_ITERATING;
+  snes->iter   = 0;
+  snes->norm   = 0.0;
+  PetscCall(TSGetSolution(c->ts, &X0));
+  PetscCall(TSGetTime(c->ts, &t));
+  PetscCall(TSGetTimeStep(c->ts, &dt));
+  PetscCall(TSThetaGetTheta(c->ts, &theta));
+  a      = 1.0 / (theta * dt);
+  s      = a * sys->units->time;
+  tstage = t + theta * dt;
+  if (PetscAbsReal(s - c->shift) > 1e-12 * s) {
+    /* a new step size: the parts rebuild their condensed operators (the KSP refactors) */
+    Mat Sv;
+    PetscCall(PhlexSystemIJacobian(c->ts, tstage, X0, NULL, a, sys->J, sys->J, sys));
+    PetscCall(PhlexSystemVelocityOperator(sys, &Sv));
+    PetscCall(KSPSetOperators(c->ksp, Sv, Sv));
+    c->shift = s;
+  }
+  /* the loads b at the stage time (those of a fixed body depend on t only) */
+  PetscCall(PhlexSystemEvaluate(sys, tstage, X0, NULL));
+  PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_DISPLACEMENT], &u0));
+  PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
+  PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
+  /* Sigma_p = Sigma0 + B v0 / s; per body r = b - G^T Sigma_p */
+  PetscCall(MultB(sys, c->B, v0, c->bv));
+  PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    Vec                 ri, si;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCall(VecGetSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
+    PetscCall(VecGetSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
+    PetscCall(MatMult(ops.Gt, si, ri));
+    PetscCall(VecAYPX(ri, -1.0, ops.load));
+    PetscCall(VecRestoreSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
+    PetscCall(VecRestoreSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
+  }
+  /* dv: the condensed solve, straight into the stage's velocity block; v = v0 + dv */
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+  PetscCall(KSPSolve(c->ksp, c->r, xv));
+  PetscCall(KSPGetIterationNumber(c->ksp, &its));
+  PetscCall(KSPGetConvergedReason(c->ksp, &kreason));
+  snes->linear_its += its;
+  /* Sigma = Sigma_p + B dv / s (not Sigma0 + B v / s: the momentum rows saw G^T Sigma_p); v = v0 + dv; u = u0 + v / s */
+  PetscCall(MultB(sys, c->B, xv, c->bv));
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
+  PetscCall(VecWAXPY(xs, 1.0 / s, c->bv, c->sp));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
+  PetscCall(VecAXPY(xv, 1.0, v0));
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &xu));
+  PetscCall(VecWAXPY(xu, 1.0 / s, xv, u0));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &xu));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+  PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_DISPLACEMENT], &u0));
+  PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
+  PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
+  snes->iter   = 1;
+  snes->reason = kreason < 0 ? SNES_DIVERGED_LINEAR_SOLVE : SNES_CONVERGED_ITS;
+  if (kreason < 0) snes->numLinearSolveFailures++;
+  PetscCall(PetscLogEventEnd(PHLEX_CondensedStage, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESReset_Condensed(SNES snes)
+{
+  SNES_Condensed *c = (SNES_Condensed *)snes->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPDestroy(&c->ksp));
+  if (c->B) {
+    for (PetscInt i = 0; i < c->sys->nfparts; i++) {
+      PetscCall(MatDestroy(&c->B[i]));
+    }
+    PetscCall(PetscFree(c->B));
+  }
+  PetscCall(VecDestroy(&c->r));
+  PetscCall(VecDestroy(&c->sp));
+  PetscCall(VecDestroy(&c->bv));
+  c->shift = 0.0;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESDestroy_Condensed(SNES snes)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SNESReset_Condensed(snes));
+  PetscCall(PetscFree(snes->data));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESView_Condensed(SNES snes, PetscViewer viewer)
+{
+  SNES_Condensed *c = (SNES_Condensed *)snes->data;
+  PetscBool       ascii;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
+  if (!ascii) PetscFunctionReturn(0);
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  theta-method stage by exact elimination of displacement and stress; condensed velocity solve:\n"));
+  if (c->ksp) {
+    PetscCall(PetscViewerASCIIPushTab(viewer));
+    PetscCall(KSPView(c->ksp, viewer));
+    PetscCall(PetscViewerASCIIPopTab(viewer));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESCreate_Condensed(SNES snes)
+{
+  SNES_Condensed *c;
+
+  PetscFunctionBeginUser;
+  snes->ops->setup            = SNESSetUp_Condensed;
+  snes->ops->solve            = SNESSolve_Condensed;
+  snes->ops->reset            = SNESReset_Condensed;
+  snes->ops->destroy          = SNESDestroy_Condensed;
+  snes->ops->view             = SNESView_Condensed;
+  snes->usesksp               = PETSC_FALSE; /* its own KSP, prefix condensed_ (the presets configure SNES's for the generic path) */
+  snes->usesnpc               = PETSC_FALSE;
+  snes->alwayscomputesfinalresidual = PETSC_FALSE;
+  PetscCall(PetscNew(&c));
+  snes->data = (void *)c;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESRegister - registers the SNES type "phlexcondensed"
+@*/
+PetscErrorCode PhlexSNESRegister(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SNESRegister("phlexcondensed", SNESCreate_Condensed));
+  PetscFunctionReturn(0);
+}
