@@ -72,7 +72,7 @@ PETSC_EXTERN PetscErrorCode PhlexHelpCaptureEnd(PetscInt *, char ***);
 /* options_check.c: misspelt options fail before the run */
 PETSC_EXTERN PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm, PetscErrorCode (*)(void *), void *);
 PETSC_EXTERN PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm);
-PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedFromFiles(const char *const[]);
+PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedFromFile(const char[], const char *const[]);
 PETSC_EXTERN PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const[], PetscBool *);
 
 /* scene_file.c: the YAML syntax of the scene files, before PETSc reads them */

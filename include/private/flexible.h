@@ -200,6 +200,7 @@ struct _p_PhlexFlexible {
   PetscInt *port_basis_col;   /* first column of each port's distribution in W (-1: not in W) */
   Vec       load, work;       /* velocity-space work vectors */
   Vec       ud, vd;           /* non-dimensional rates (floating) */
+  Vec       ewv, ews;         /* the energy's work vectors (velocity, stress), made at its first call */
   PetscReal (*port_ext)[6];   /* external port wrenches at the evaluated time (body frame) */
   PetscReal (*port_y)[6];     /* port outputs at the evaluated state */
   PetscReal (*port_ubar)[3];  /* full model: mean displacement of each port (the arm of its force beyond the drawn point) */

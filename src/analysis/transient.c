@@ -117,7 +117,7 @@ static PetscErrorCode PostStage(TS ts, PetscReal t, PetscInt index, Vec *Y)
     PetscCall(SNESGetConvergedReason(snes, &reason));
     if (reason < 0) {
       char why[64];
-      PetscCall(PetscSNPrintf(why, sizeof(why), "Newton did not converge (%s)", SNESConvergedReasons[reason]));
+      PetscCall(PetscSNPrintf(why, sizeof(why), "%s did not converge (%s)", m->condensed ? "the condensed solve" : "Newton", SNESConvergedReasons[reason]));
       /* TS gives up when a user's -ts_max_snes_failures is reached: then it is no retry */
       if (m->max_snes_failures > 0 && ++m->snes_failures >= m->max_snes_failures) PetscCall(PetscSNPrintf(m->last_retry, sizeof(m->last_retry), "%s", why));
       else PetscCall(ReportRetry(ts, m, why));
@@ -346,8 +346,8 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
   PetscCheck(!PetscIsInfOrNanReal(residual), m->scene->comm, PETSC_ERR_NOT_CONVERGED, "at step %" PetscInt_FMT " (t = %g s) the power balance of the step is not a number: the state (a multiplier, an input) holds NaN or Inf; reduce -ts_dt, or check the inputs' magnitudes; no result was written", step, (double)t);
   if (step > 0 && m->lossless_scheme && m->watch_balance > 0) {
     const PetscReal scale = PetscMax(m->Emax, PetscAbsReal(m->H0));
-    PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently; tighten -snes_rtol/-ksp_rtol or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
-               step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance);
+    PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently; tighten %s or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
+               step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance, m->condensed ? "-condensed_ksp_rtol" : "-snes_rtol/-ksp_rtol");
   }
   /* a scheme whose rotations are not re-orthonormalised (BDF, alpha): R^T R - I drifts with the scheme's error */
   if (m->history && !m->orth_warned && m->max_orth > 1e-2 && (m->watch_orth <= 0 || m->max_orth <= m->watch_orth)) {
@@ -376,9 +376,8 @@ static PetscErrorCode SolverPresetOption(MPI_Comm comm, char file[])
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys)
+static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys, char file[])
 {
-  char      file[PETSC_MAX_PATH_LEN];
   PetscBool exists;
   int       argc;
   char    **argv;
@@ -467,9 +466,13 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
 
   PetscFunctionBeginUser;
   if (step == m->first_step + 1) {
-    /* the preset's options of the solver path not taken */
+    /* the preset's own options of the solver path not taken (a preset configures both) */
     const char *const generic[] = {"ksp_", "pc_", "fieldsplit_", NULL}, *const stage[] = {"condensed_", NULL};
-    PetscCall(PhlexOptionsSetUsedFromFiles(m->condensed ? generic : stage));
+    PetscBool         typed;
+    PetscCall(PhlexOptionsSetUsedFromFile(m->preset, m->condensed ? generic : stage));
+    PetscCall(PhlexOptionsCommandLineHasPrefix(generic, &typed));
+    if (m->condensed && typed)
+      PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexcondensed (fixed linear bodies, theta method): its linear solve reads -condensed_ksp_* and -condensed_pc_*; -snes_type ksponly takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
     PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
   }
   PetscCall(TSGetMaxTime(ts, &tmax));
@@ -573,7 +576,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCheck(frames || o.orth_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_orthogonality_max needs a moving frame (a floating or rigid body)");
   }
   PetscCheck(sys->njoints || o.gap_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_joint_drift_max needs joints");
-  PetscCall(InsertSolverPreset(scene->comm, sys));
+  PetscCall(InsertSolverPreset(scene->comm, sys, m.preset));
   PetscCall(TSCreate(scene->comm, &ts));
   PetscCall(TSSetDM(ts, sys->dm));
   /* linear fields (KSP only); moving frames and joints make it nonlinear (Newton) */
@@ -626,6 +629,42 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(VecDestroy(&vrtol));
   }
   PetscCall(TSSetFromOptions(ts));
+  {
+    /* SNES phlexcondensed (the presets exact and iterative ask for it): the theta-method stage of fixed linear bodies by
+       exact elimination (snes_condensed.c). Where it does not apply the preset's field split takes over (SNES ksponly, or
+       Newton for a nonlinear scene), unless -snes_type phlexcondensed was typed on the command line: then an error
+       says why */
+    SNES              snes;
+    PetscBool         applicable, typed;
+    const char *const snestype[] = {"snes_type", NULL};
+    PetscCall(TSGetSNES(ts, &snes));
+    PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexcondensed", &m.condensed));
+    if (m.condensed) {
+      PetscCall(PhlexSNESCondensedApplicable(sys, ts, &applicable));
+      PetscCall(PhlexOptionsCommandLineHasPrefix(snestype, &typed));
+      if (applicable || typed) PetscCall(PhlexSNESCondensedSetSystem(snes, sys, ts));
+      else {
+        KSP ksp;
+        PetscCall(SNESSetType(snes, (sys->nonlinear || sys->inexact_schur) ? SNESNEWTONLS : SNESKSPONLY));
+        PetscCall(SNESGetKSP(snes, &ksp));
+        PetscCall(KSPSetFromOptions(ksp));
+        if (sys->nonlinear || sys->inexact_schur) {
+          SNESLineSearch ls;
+          PetscCall(SNESGetLineSearch(snes, &ls));
+          PetscCall(SNESLineSearchSetFromOptions(ls));
+        }
+        m.condensed = PETSC_FALSE;
+      }
+    }
+    if (m.condensed && PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
+      /* what the condensed solve will read (it is made at the first step) */
+      KSP ksp;
+      PetscCall(KSPCreate(scene->comm, &ksp));
+      PetscCall(KSPSetOptionsPrefix(ksp, "condensed_"));
+      PetscCall(KSPSetFromOptions(ksp));
+      PetscCall(KSPDestroy(&ksp));
+    }
+  }
   if (PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
     PetscCall(PetscViewerDestroy(&m.monitor));
     PetscCall(VecDestroy(&X));
@@ -668,23 +707,6 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
       PetscCall(PetscPrintf(scene->comm, "Generalized-alpha: SNES newtonls (basic line search) instead of ksponly, so that the scheme's rate is taken at the solution\n"));
     }
-  }
-  {
-    /* fixed linear bodies under the theta method: the stage by exact elimination (snes_condensed.c) when the preset
-       configures its solve (-condensed_ksp_type) and neither -snes_type nor a solver option of the whole system
-       (-ksp_*, -pc_*, -fieldsplit_*) on the command line asks for the generic path */
-    SNES              snes;
-    PetscBool         given, configured, generic, condensed, applicable;
-    const char *const whole[] = {"ksp_", "pc_", "fieldsplit_", NULL};
-    PetscCall(TSGetSNES(ts, &snes));
-    PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_type", &given));
-    PetscCall(PetscOptionsHasName(NULL, NULL, "-condensed_ksp_type", &configured));
-    PetscCall(PhlexOptionsCommandLineHasPrefix(whole, &generic));
-    PetscCall(PhlexSNESCondensedApplicable(sys, ts, &applicable));
-    if (!given && configured && !generic && applicable) PetscCall(SNESSetType(snes, "phlexcondensed"));
-    PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexcondensed", &condensed));
-    if (condensed) PetscCall(PhlexSNESCondensedSetSystem(snes, sys, ts));
-    m.condensed = condensed;
   }
   if (sys->nonlinear || sys->inexact_schur) {
     /* Newton (a preset's newtonls also on a linear spinning body: its tolerances are below the round-off floor,
@@ -786,7 +808,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     SETERRQ(scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s), the last try with a time step of %g s because: %s; allow more retries (%s, now %" PetscInt_FMT ") or a smaller step (-ts_adapt_dt_min), tighten the solvers, or check the inputs; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast, m.last_retry, snes ? "-ts_max_snes_failures" : "-ts_max_reject", snes ? m.max_snes_failures : maxrej);
   }
   PetscCheck(reason >= 0, scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s, time step %g s): %s; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast,
-             reason == TS_DIVERGED_NONLINEAR_SOLVE ? "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic: a failed step is then retried with a smaller one), or see why with -snes_converged_reason -ksp_converged_reason" : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
+             reason == TS_DIVERGED_NONLINEAR_SOLVE ? (m.condensed ? "the condensed solve (SNES phlexcondensed) did not converge: see why with -condensed_ksp_converged_reason, or try a smaller -ts_dt" : "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic: a failed step is then retried with a smaller one), or see why with -snes_converged_reason -ksp_converged_reason") : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
   /* the final state's checkpoint: the run can be continued further (-restart with a later -ts_max_time); written
      before the end-of-run snapshot below, which a longer run would not have */
   if (checkpointing) PetscCall(PhlexTransientCheckpointWrite(ts, &m, X));

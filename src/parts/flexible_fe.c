@@ -539,16 +539,17 @@ PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible b, Vec v, Vec s, PetscReal *kin
   PetscScalar e;
 
   PetscFunctionBeginUser;
-  PetscCall(VecDuplicate(v, &wv));
-  PetscCall(VecDuplicate(s, &ws));
+  /* kept: the monitor calls this every step, and a fresh stress-sized vector costs its page faults each time */
+  if (!b->ewv) PetscCall(VecDuplicate(v, &b->ewv));
+  if (!b->ews) PetscCall(VecDuplicate(s, &b->ews));
+  wv = b->ewv;
+  ws = b->ews;
   PetscCall(MatMult(b->Mv, v, wv));
   PetscCall(VecDot(wv, v, &e));
   *kinetic = 0.5 * PetscRealPart(e);
   PetscCall(MatMult(b->Ms, s, ws));
   PetscCall(VecDot(ws, s, &e));
   *strain = 0.5 * PetscRealPart(e);
-  PetscCall(VecDestroy(&wv));
-  PetscCall(VecDestroy(&ws));
   PetscFunctionReturn(0);
 }
 

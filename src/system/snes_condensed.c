@@ -23,9 +23,10 @@
    solve it exactly); the energy balance of the midpoint rule holds to the solve's round-off.
 
    Used when every part is a fixed flexible body with constant operators (no frame, joint, spin or stiffening) and
-   the integrator is the theta method without endpoint (the default implicit midpoint, backward Euler); the
-   transient analysis selects it unless -snes_type is given. The condensed solve is KSP "condensed_" (the presets set
-   it: options/solver/exact.opts). */
+   the integrator is the theta method without endpoint (the default implicit midpoint, backward Euler). The presets
+   exact and iterative ask for it (-snes_type phlexcondensed); where it does not apply the transient analysis takes
+   their field split instead, unless -snes_type phlexcondensed was typed on the command line (then an error says
+   why). The condensed solve is KSP "condensed_" (the presets configure it). */
 #include <phlex_impl.h>
 #include <petsc/private/snesimpl.h>
 
@@ -94,10 +95,10 @@ PetscErrorCode PhlexSNESCondensedSetSystem(SNES snes, PhlexSystem sys, TS ts)
   PetscFunctionReturn(0);
 }
 
-/* Ms^{-1} in Ms's pattern, from the inverses of its per-cell blocks */
+/* Ms^{-1}, block diagonal, from the inverses of Ms's per-cell blocks (its variable block sizes) */
 static PetscErrorCode InverseStressMass(PhlexSystem sys, Mat *Minv)
 {
-  PetscInt           nb, rstart, row, bmax = 1, ntot = 0, *idx;
+  PetscInt           nb, rstart, row, bmax = 1, ntot = 0, *idx, *nnz, m, r = 0;
   const PetscInt    *bsz;
   PetscScalar       *diag, *blk;
   const PetscScalar *d;
@@ -110,8 +111,18 @@ static PetscErrorCode InverseStressMass(PhlexSystem sys, Mat *Minv)
   }
   PetscCall(PetscMalloc3(PetscMax(ntot, 1), &diag, bmax * bmax, &blk, bmax, &idx));
   PetscCall(MatInvertVariableBlockDiagonal(sys->Ms, nb, bsz, diag));
-  PetscCall(MatDuplicate(sys->Ms, MAT_DO_NOT_COPY_VALUES, Minv));
-  PetscCall(MatGetOwnershipRange(sys->Ms, &rstart, NULL));
+  /* full blocks (Ms may have dropped zero entries; its inverse has none) */
+  PetscCall(MatGetLocalSize(sys->Ms, &m, NULL));
+  PetscCall(PetscMalloc1(PetscMax(m, 1), &nnz));
+  for (PetscInt k = 0; k < nb; k++)
+    for (PetscInt i = 0; i < bsz[k]; i++) nnz[r++] = bsz[k];
+  PetscCall(MatCreate(sys->comm, Minv));
+  PetscCall(MatSetSizes(*Minv, m, m, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetType(*Minv, MATAIJ));
+  PetscCall(MatSeqAIJSetPreallocation(*Minv, 0, nnz));
+  PetscCall(MatMPIAIJSetPreallocation(*Minv, 0, nnz, 0, NULL));
+  PetscCall(PetscFree(nnz));
+  PetscCall(MatGetOwnershipRange(*Minv, &rstart, NULL));
   row = rstart;
   d   = diag;
   for (PetscInt k = 0; k < nb; k++) {
@@ -147,6 +158,14 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
   PetscCall(SNESGetOptionsPrefix(snes, &prefix));
   PetscCall(KSPSetOptionsPrefix(c->ksp, prefix));
   PetscCall(KSPAppendOptionsPrefix(c->ksp, "condensed_"));
+  {
+    /* defaults for a run without preset: the operator is symmetric positive definite, and an inexact solve breaks the
+       power balance (the presets choose MUMPS or CG + GAMG) */
+    PC pc;
+    PetscCall(KSPSetType(c->ksp, KSPPREONLY));
+    PetscCall(KSPGetPC(c->ksp, &pc));
+    PetscCall(PCSetType(pc, PCCHOLESKY));
+  }
   PetscCall(KSPSetFromOptions(c->ksp));
   PetscCall(InverseStressMass(sys, &Minv));
   PetscCall(PetscMalloc1(sys->nfparts, &c->B));

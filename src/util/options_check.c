@@ -184,31 +184,39 @@ PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const prefixes[], Pe
 }
 
 /*@C
-  PhlexOptionsSetUsedFromFiles - marks as read the options that start with one of the NULL-terminated prefixes and came
-  from a scene or preset file, not from the command line: a preset configures two solver paths, and the one this run
-  does not take is not the user's mistake (the same options typed on the command line are still checked)
+  PhlexOptionsSetUsedFromFile - marks as read the options of an options file (a solver preset) that start with one of
+  the NULL-terminated prefixes and are not on the command line: a preset configures two solver paths, and the one this
+  run does not take is not the user's mistake (the same options from the command line, a scene or PETSC_OPTIONS are
+  still checked)
 
   Not Collective
 @*/
-PetscErrorCode PhlexOptionsSetUsedFromFiles(const char *const prefixes[])
+PetscErrorCode PhlexOptionsSetUsedFromFile(const char file[], const char *const prefixes[])
 {
-  PetscInt n;
-  char   **names, **values;
+  FILE *f;
+  char  line[1024];
 
   PetscFunctionBeginUser;
-  PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
-  for (PetscInt i = 0; i < n; i++) {
+  if (!file || !file[0]) PetscFunctionReturn(0);
+  f = fopen(file, "r");
+  if (!f) PetscFunctionReturn(0); /* read when the preset was inserted; nothing to mark */
+  while (fgets(line, sizeof(line), f)) {
+    char     *name = line, *end;
     PetscBool match = PETSC_FALSE, given, set;
-    char      option[256];
+    while (*name == ' ' || *name == '\t') name++;
+    if (name[0] != '-') continue;
+    name++;
+    for (end = name; *end && !isspace((unsigned char)*end) && *end != '#'; end++) {}
+    *end = 0;
     /* (PETSc 3.18's PetscStrbeginswith looks for the last occurrence: "fieldsplit_0_fieldsplit_..." would not match) */
-    for (PetscInt k = 0; prefixes[k] && !match; k++) match = strncmp(names[i], prefixes[k], strlen(prefixes[k])) ? PETSC_FALSE : PETSC_TRUE;
+    for (PetscInt k = 0; prefixes[k] && !match; k++) match = strncmp(name, prefixes[k], strlen(prefixes[k])) ? PETSC_FALSE : PETSC_TRUE;
     if (!match) continue;
-    PetscCall(OnCommandLine(names[i], &given));
+    PetscCall(OnCommandLine(name, &given));
     if (given) continue;
-    PetscCall(PetscSNPrintf(option, sizeof(option), "-%s", names[i]));
-    PetscCall(PetscOptionsHasName(NULL, NULL, option, &set)); /* a query marks the option as read */
+    name[-1] = '-';
+    PetscCall(PetscOptionsHasName(NULL, NULL, name - 1, &set)); /* a query marks the option as read */
   }
-  PetscCall(PetscOptionsLeftRestore(NULL, &n, &names, &values));
+  fclose(f);
   PetscFunctionReturn(0);
 }
 

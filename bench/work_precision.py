@@ -1,0 +1,181 @@
+#!/usr/bin/env python3
+"""Work-precision of phlex: error against wall time, per point its DOFs, ranks and peak memory.
+
+  transient  the tip-loaded cantilever (options/cantilever_tip_load.yaml) on one mesh, integrators x time steps; the
+             error is that of the tip port's velocity (vx vy vz wx wy wz) at the end time against a run of the
+             implicit midpoint rule with a step --ref-factor times smaller than the smallest, relative to its norm
+  modes      the free-free bar, P1 and P2 on a sequence of meshes; the error is the largest relative error of the
+             first 10 elastic frequencies against the finest P2 mesh
+
+Writes bench/results/work_precision_<case>.csv and, when matplotlib is installed, .png beside them.
+
+usage: bench/work_precision.py [--cases transient,modes] [--mesh meshes/bench/bar_h0.02.msh]
+                               [--meshes meshes/bar_h0.05.msh,meshes/bench/bar_h0.02.msh,meshes/bench/bar_h0.01.msh]
+                               [--np 1] [--phlex bin/phlex]
+"""
+import argparse
+import csv
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+RESULTS = os.path.join(ROOT, "bench", "results")
+
+# integrator: phlex options (the preset is the scene's default one)
+SCHEMES = {
+    "midpoint": [],
+    "cn": ["-ts_type", "cn"],
+    "bdf2": ["-ts_type", "bdf", "-ts_bdf_order", "2", "-ts_adapt_type", "none"],
+    "alpha0.8": ["-ts_type", "alpha", "-ts_alpha_radius", "0.8"],
+}
+
+
+def run(cmd):
+    """cmd under /usr/bin/time -v: (output, wall seconds, peak RSS GiB)"""
+    with tempfile.NamedTemporaryFile("r", suffix=".time") as tf:
+        p = subprocess.run(["/usr/bin/time", "-v", "-o", tf.name] + cmd, cwd=ROOT, stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, text=True)
+        t = tf.read()
+    if p.returncode != 0:
+        sys.exit("failed (%d): %s\n%s" % (p.returncode, " ".join(cmd), p.stdout[-3000:]))
+    m = re.search(r"Elapsed \(wall clock\) time.*: (?:(\d+):)?(\d+):([\d.]+)", t)
+    wall = int(m.group(1) or 0) * 3600 + int(m.group(2)) * 60 + float(m.group(3))
+    rss = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", t).group(1)) / 2**20
+    return p.stdout, wall, rss
+
+
+def launcher(np_):
+    return ["mpiexec", "-n", str(np_)] if np_ > 1 else []
+
+
+def last_row(path):
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return rows[-1]
+
+
+def transient(a, out):
+    tend = a.tend
+    dts = [float(x) for x in a.dts.split(",")]
+    outdir = tempfile.mkdtemp(prefix="phlex_wp_")
+
+    def one(scheme, dt):
+        cmd = launcher(a.np) + [a.phlex, "-options_file", "options/cantilever_tip_load.yaml", "-body0_dm_plex_filename",
+                                a.mesh, "-ts_dt", repr(dt), "-ts_max_time", repr(tend), "-ts_max_steps", "100000000",
+                                "-output_fields", "0", "-output_dir", outdir, "-progress", "0"] + SCHEMES[scheme]
+        log, wall, rss = run(cmd)
+        dofs = int(re.search(r"velocity P\d \((\d+) dofs\)", log).group(1))
+        r = last_row(os.path.join(outdir, "cantilever_ports.csv"))
+        assert abs(float(r["time"]) - tend) < 1e-9 * tend, "the run did not end at %g" % tend
+        y = [float(r[k]) for k in ("tip_vx", "tip_vy", "tip_vz", "tip_wx", "tip_wy", "tip_wz")]
+        return y, wall, rss, dofs
+
+    dtref = min(dts) / a.ref_factor
+    yref, wall, rss, dofs = one("midpoint", dtref)
+    print("reference: midpoint, dt %g, %.1f s" % (dtref, wall), flush=True)
+    nref = math.sqrt(sum(v * v for v in yref))
+    rows = []
+    for scheme in SCHEMES:
+        for dt in dts:
+            y, wall, rss, dofs = one(scheme, dt)
+            err = math.sqrt(sum((u - v) ** 2 for u, v in zip(y, yref))) / nref
+            rows.append(dict(scheme=scheme, dt=dt, steps=round(tend / dt), error=err, wall_s=wall, peak_rss_gib=rss,
+                             dofs=dofs, ranks=a.np, mesh=a.mesh))
+            print("%-9s dt %-8g error %.3e  %.1f s" % (scheme, dt, err, wall), flush=True)
+    write(out, rows)
+    return rows
+
+
+def modes(a, out):
+    outdir = tempfile.mkdtemp(prefix="phlex_wp_")
+    meshes = a.meshes.split(",")
+
+    def one(mesh, degree):
+        cmd = launcher(a.np) + [a.phlex, "-analysis", "modes", "-body0_dm_plex_filename", mesh,
+                                "-body0_youngs_modulus", "2.1e11", "-body0_poissons_ratio", "0.3", "-body0_density",
+                                "7800", "-body0_petscspace_degree", str(degree), "-modes_nev", "10",
+                                "-modes_eps_tol", a.tol, "-output_dir", outdir, "-output_fields", "0", "-progress", "0"]
+        log, wall, rss = run(cmd)
+        dofs = int(re.search(r"velocity P\d \((\d+) dofs\)", log).group(1))
+        with open(os.path.join(outdir, "modes.csv")) as f:
+            rows = [r for r in csv.DictReader(f)]
+        elastic = [float(r["frequency_hz"]) for r in rows if r["rigid"] == "0"]
+        return elastic[:10], wall, rss, dofs
+
+    ref, _, _, _ = one(meshes[-1], 2)
+    rows = []
+    for degree in (1, 2):
+        for mesh in meshes:
+            f, wall, rss, dofs = one(mesh, degree)
+            err = max(abs(x - y) / y for x, y in zip(f, ref))
+            rows.append(dict(degree=degree, mesh=mesh, error=err, wall_s=wall, peak_rss_gib=rss, dofs=dofs,
+                             ranks=a.np, tol=a.tol))
+            print("P%d %-32s %8d DOFs error %.3e  %.1f s" % (degree, mesh, dofs, err, wall), flush=True)
+    write(out, rows)
+    return rows
+
+
+def write(path, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    print("wrote", os.path.relpath(path, ROOT))
+
+
+def plot(path, rows, group, title):
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        print("matplotlib not installed: no", os.path.relpath(path, ROOT))
+        return
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for g in sorted({r[group] for r in rows}, key=str):
+        pts = [(r["wall_s"], r["error"]) for r in rows if r[group] == g and r["error"] > 0]
+        if pts:
+            ax.loglog(*zip(*pts), "o-", label="%s %s" % (group, g))
+    ax.set_xlabel("wall time [s]")
+    ax.set_ylabel("relative error")
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    print("wrote", os.path.relpath(path, ROOT))
+
+
+def main():
+    p = argparse.ArgumentParser()
+    p.add_argument("--cases", default="transient,modes")
+    p.add_argument("--phlex", default="bin/phlex")
+    p.add_argument("--np", type=int, default=1)
+    p.add_argument("--mesh", default="meshes/bench/bar_h0.02.msh")
+    p.add_argument("--dts", default="4.8e-4,2.4e-4,1.2e-4,6e-5")
+    p.add_argument("--tend", type=float, default=0.00576)
+    p.add_argument("--ref-factor", type=float, default=8.0)
+    p.add_argument("--meshes", default="meshes/bar_h0.05.msh,meshes/bench/bar_h0.02.msh,meshes/bench/bar_h0.01.msh")
+    p.add_argument("--tol", default="1e-10")
+    a = p.parse_args()
+    os.makedirs(RESULTS, exist_ok=True)
+    if a.np > 1:
+        os.environ.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    for case in a.cases.split(","):
+        base = os.path.join(RESULTS, "work_precision_%s" % case)
+        if case == "transient":
+            rows = transient(a, base + ".csv")
+            plot(base + ".png", rows, "scheme", "cantilever tip velocity at t = %g s, %d DOFs" % (a.tend, rows[0]["dofs"]))
+        elif case == "modes":
+            rows = modes(a, base + ".csv")
+            plot(base + ".png", rows, "degree", "free-free bar, first 10 elastic frequencies")
+        else:
+            sys.exit("unknown case %s" % case)
+
+
+if __name__ == "__main__":
+    main()
