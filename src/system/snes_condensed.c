@@ -8,19 +8,19 @@
    With B = Ms^{-1} G (formed once by a sparse product; it has G's pattern, Ms being block diagonal per cell) and the
    predicted stress Sigma_p = Sigma0 + B v0 / s, eliminating u and Sigma and solving for the increment dv = v - v0:
        (s Mv + K / s) dv = b - G^T Sigma_p,                                             (the condensed right-hand side)
-       Sigma = Sigma0 + B v / s,   u = u0 + v / s.
-   The factored operator s Mv + K / s is the exact preset's (each body's Sv). Measured on the cantilever (200 steps),
-   the right-hand side must be formed this way to keep the power balance at round-off (4e-13 J per step):
+       Sigma = Sigma_p + B dv / s  (= Sigma0 + B v / s),   u = u0 + v / s.
+   The factored operator s Mv + K / s is the exact preset's (each body's Sv, its K assembled by the elements); as on
+   the generic path, its difference from G^T Ms^{-1} G (about 1e-11 relative on smooth fields) enters the increment
+   only. Measured on the cantilever, the formulas must be taken as written to keep the power balance at round-off
+   (4e-13 J per step over 200 steps) and the tip velocities at 5e-15 to 3e-12 of their 0.35 m/s scale from a fully
+   converged solve (the generic path: 2e-15 to 2e-12):
      - solving for v instead of dv puts the solve's error on v itself (3e-11 J);
-     - b - G^T Sigma0 - K v0 / s with the element-assembled K, which differs from G^T Ms^{-1} G by about 1e-11
-       relative on smooth fields (1e-11 J), or even with the product G^T B (5e-12 J): the momentum rows must see
-       G^T of the very stress whose change the stress rows see.
-     - Sigma = Sigma0 + B v / s instead of Sigma_p + B dv / s, or B v0 carried over from the previous step's
-       B v_{n+1} (saving a product), each moved the tip velocities by 1e-12 to 2e-11 of their 0.35 m/s scale from a
-       fully converged solve; as written, 5e-15 to 3e-12 of it (the generic path: 2e-15 to 2e-12).
-   So a step costs two products with B, one with G^T and one solve, against a residual (G, G^T, Ms, Mv) and a
-   field-split Newton step (Ms^{-1} twice, G, G^T, copies of the five-times-larger stress field) on the generic path. The result is the same stage (the system is linear and both
-   solve it exactly); the energy balance of the midpoint rule holds to the solve's round-off.
+     - b - G^T Sigma0 - K v0 / s, with the element-assembled K (1e-11 J) or with the product G^T B (5e-12 J): the
+       momentum rows must see G^T of the very stress whose change the stress rows see;
+     - Sigma0 + B v / s computed as such, or B v0 carried over from the previous step's B v_{n+1} (saving a
+       product): the tip velocities moved by 1e-12 to 2e-11 of their scale.
+   A step costs one solve, two products with B and one with G^T, against a residual (G, G^T, Ms, Mv) and a
+   field-split Newton step (Ms^{-1} twice, G, G^T, copies of the five-times-larger stress field) on the generic path.
 
    Used when every part is a fixed flexible body with constant operators (no frame, joint, spin or stiffening) and
    the integrator is the theta method without endpoint (the default implicit midpoint, backward Euler). The presets
