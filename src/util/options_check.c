@@ -163,6 +163,16 @@ PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm comm, PetscErrorCode (*reread)(v
   PetscFunctionReturn(0);
 }
 
+/* the option name (without '-') starts with one of the NULL-terminated prefixes, case-insensitively as PETSc compares
+   option names (PETSc 3.18's PetscStrbeginswith looks for the last occurrence: "fieldsplit_0_fieldsplit_..." would
+   not match "fieldsplit_") */
+static PetscBool HasPrefix(const char name[], const char *const prefixes[])
+{
+  for (PetscInt k = 0; prefixes[k]; k++)
+    if (!strncasecmp(name, prefixes[k], strlen(prefixes[k]))) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
 /*@C
   PhlexOptionsCommandLineHasPrefix - whether the command line gives an option that starts with one of the
   NULL-terminated prefixes
@@ -178,8 +188,7 @@ PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const prefixes[], Pe
   *found = PETSC_FALSE;
   PetscCall(PetscGetArgs(&argc, &args));
   for (int i = 1; i < argc && !*found; i++)
-    for (PetscInt k = 0; prefixes[k] && !*found; k++)
-      if (args[i][0] == '-' && !strncasecmp(args[i] + 1, prefixes[k], strlen(prefixes[k]))) *found = PETSC_TRUE;
+    if (args[i][0] == '-' && HasPrefix(args[i] + 1, prefixes)) *found = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
 
@@ -202,15 +211,13 @@ PetscErrorCode PhlexOptionsSetUsedFromFile(const char file[], const char *const 
   if (!f) PetscFunctionReturn(0); /* read when the preset was inserted; nothing to mark */
   while (fgets(line, sizeof(line), f)) {
     char     *name = line, *end;
-    PetscBool match = PETSC_FALSE, given, set;
+    PetscBool given, set;
     while (*name == ' ' || *name == '\t') name++;
     if (name[0] != '-') continue;
     name++;
     for (end = name; *end && !isspace((unsigned char)*end) && *end != '#'; end++) {}
     *end = 0;
-    /* (PETSc 3.18's PetscStrbeginswith looks for the last occurrence: "fieldsplit_0_fieldsplit_..." would not match) */
-    for (PetscInt k = 0; prefixes[k] && !match; k++) match = strncmp(name, prefixes[k], strlen(prefixes[k])) ? PETSC_FALSE : PETSC_TRUE;
-    if (!match) continue;
+    if (!HasPrefix(name, prefixes)) continue;
     PetscCall(OnCommandLine(name, &given));
     if (given) continue;
     name[-1] = '-';
