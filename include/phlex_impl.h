@@ -160,6 +160,7 @@ PETSC_INTERN PetscErrorCode PhlexProgressEPSMonitor(EPS, PetscInt, PetscInt, Pet
 
 /* flexible_modes.c: the eigensolver of the modal analysis with its defaults (also read by -help) */
 PETSC_INTERN PetscErrorCode PhlexModesEPSCreate(MPI_Comm, EPS *, PetscReal *, PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexEPSRegister(void);
 
 /* scene.c */
 PETSC_INTERN PetscErrorCode PhlexSceneFindPart(PhlexScene, const char[], PhlexPart *);
