@@ -7,12 +7,15 @@
 
      V = [X, Op X, Op^2 X, ...]   (B-orthonormal; the block X of bs vectors random, or the user's initial space)
 
-   with one product with B and one solve with bs right-hand sides (KSPMatSolve, MatMatSolve of the factor) per block, keeping the block Arnoldi relation
+   with one solve with bs right-hand sides (KSPMatSolve: MatMatSolve of the factor) and one product with B per
+   block, keeping the block Arnoldi relation
 
      Op V[:, 0:j] = V[:, 0:j+bs] H[0:j+bs, 0:j]
 
    from the orthogonalization coefficients (block classical Gram-Schmidt twice against V, Cholesky QR inside the
-   block, a shifted Cholesky QR where the block is numerically rank deficient). The Ritz pairs (theta, y) of the
+   block, a shifted Cholesky QR where the block is numerically rank deficient). B V is kept beside V and carried
+   through the same recurrences: it gives the next right-hand sides and the B-inner products without more products
+   with B (Krylov-Schur: about three per vector with its B inner product). The Ritz pairs (theta, y) of the
    symmetric part of H[0:j, 0:j] give the eigenpairs lambda = sigma + 1/theta, and the Arnoldi relation gives their
    residuals in the transformed problem without another product:
 
@@ -25,7 +28,8 @@
 
    Works with ST sinvert (the operator's KSP decides the solve: -st_ksp_type, -st_pc_factor_mat_solver_type), for
    Hermitian problems (HEP, GHEP) and the eigenvalues nearest the target, with deflation spaces (EPSSetDeflationSpace)
-   and initial spaces. Options: -eps_phlexblock_block_size <bs> (default: nev, at most 8), -eps_ncv (default
+   and initial spaces. The converged eigenvalues are the Rayleigh quotients of their vectors (one more block solve).
+   Options: -eps_phlexblock_block_size <bs> (default: nev, at most 8), -eps_ncv (default
    the larger of 2 nev + 3 bs and nev + 15; at least nev + 3 bs), -eps_max_it (restart cycles,
    as Krylov-Schur's iterations; the monitors are called once a cycle). */
 #include <phlex_impl.h>
@@ -45,6 +49,7 @@ typedef struct {
   PetscReal   *cn2;        /* bs: squared norms of the coefficients a projection removed */
   PetscReal   *lock, *lockerr; /* ncv: theta and error estimate of the locked eigenpairs */
   PetscInt     nBexact;    /* products with B beyond one per block (monitoring) */
+  PetscBool    refine;     /* the converged eigenvalues from the Rayleigh quotients of their vectors */
 } EPS_PhlexBlock;
 
 /* the loss of norm beyond which the projected B Z is recomputed rather than taken from the recurrence: the
@@ -446,11 +451,11 @@ static PetscErrorCode FirstBlock(EPS eps)
 }
 
 /* theta = (Op x)^T B x / x^T B x for the n converged Ritz vectors in V[:, 0:n] (one product with B, one solve with n
-   right-hand sides). The Ritz values of H are accurate only to round-off of its norm, the largest |theta|: with the
-   rigid modes of a free body (theta = 1/|sigma|) in the basis, the elastic frequencies of the free bar (P2, 2889
-   DOFs, tolerance 1e-12) came out 5e-10 apart between block sizes 4 and 8, where two Krylov-Schur runs (ncv 32
-   and 40; it locks the converged rigid modes) differ by 3e-11. The Rayleigh quotient of each vector is accurate
-   relative to its own theta: block sizes 4 and 8 and 2 ranks then agree to 13 digits. */
+   right-hand sides). The Ritz values of H are accurate only to round-off of its norm, the largest active |theta|:
+   before the rigid modes of a free body (theta = 1/|sigma|) are locked at a restart, the elastic ones are off by up
+   to 5e-10 (free bar, P2, 2889 DOFs); after, block sizes 2, 4 and 8 agree to 5e-11, as two Krylov-Schur runs (ncv
+   32 and 40) do to 3e-11. The Rayleigh quotient of each vector is accurate relative to its own theta: block sizes
+   4 and 8 and 2 ranks then agree to 13 digits. -eps_phlexblock_rayleigh_quotient 0 skips it. */
 static PetscErrorCode RefineRitzValues(EPS eps, PetscInt n)
 {
   BV           X = NULL, BX = NULL;
@@ -576,7 +581,7 @@ static PetscErrorCode EPSSolve_PhlexBlock(EPS eps)
   }
   /* the converged Ritz vectors into the first columns of V (eigenvalues of the transformed problem in eigr) */
   PetscCall(Rotate(eps, j0, Y, nconv, PETSC_FALSE));
-  PetscCall(RefineRitzValues(eps, nconv));
+  if (ctx->refine) PetscCall(RefineRitzValues(eps, nconv));
   eps->nconv = nconv;
   PetscCall(BVSetMatrix(eps->V, B, indef));
   PetscCall(MatDestroy(&B));
@@ -621,6 +626,7 @@ static PetscErrorCode EPSSetFromOptions_PhlexBlock(EPS eps, PetscOptionItems *Pe
     PetscCheck(bs >= 1, PetscObjectComm((PetscObject)eps), PETSC_ERR_USER_INPUT, "-%seps_phlexblock_block_size must be >= 1, got %" PetscInt_FMT, prefix ? prefix : "", bs);
     ctx->bs = bs;
   }
+  PetscCall(PetscOptionsBool("-eps_phlexblock_rayleigh_quotient", "Converged eigenvalues from the Rayleigh quotients of their vectors (one more block solve; accurate to 13 digits where the Ritz values agree to about 11)", "EPSPhlexBlock", ctx->refine, &ctx->refine, NULL));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
 }
@@ -670,6 +676,7 @@ static PetscErrorCode EPSCreate_PhlexBlock(EPS eps)
 
   PetscFunctionBegin;
   PetscCall(PetscNew(&ctx));
+  ctx->refine              = PETSC_TRUE;
   eps->data                = (void *)ctx;
   eps->categ               = EPS_CATEGORY_KRYLOV;
   eps->useds               = PETSC_FALSE;
