@@ -23,8 +23,11 @@ def main() -> int:
     args = parser.parse_args()
     phlex_args = [a for a in args.phlex_args if a != "--"]
     sig = getattr(signal, "SIG" + args.signal)
+    # the default SIGINT disposition for phlex: a test suite started in the background by a non-interactive shell
+    # ignores SIGINT, phlex then keeps it ignored (by design), and the run would go on to its end
     proc = subprocess.Popen(["bin/phlex"] + phlex_args + ["-output_dir", args.outdir, "-progress_interval", "0"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     for line in proc.stdout:
         if line.startswith("progress:"):
             proc.send_signal(sig)
