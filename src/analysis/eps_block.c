@@ -29,15 +29,17 @@
    Works with ST sinvert (the operator's KSP decides the solve: -st_ksp_type, -st_pc_factor_mat_solver_type), for
    Hermitian problems (HEP, GHEP) and the eigenvalues nearest the target, with deflation spaces (EPSSetDeflationSpace)
    and initial spaces. The converged eigenvalues are the Rayleigh quotients of their vectors (one more block solve).
-   Options: -eps_phlexblock_block_size <bs> (default: nev, at most 8), -eps_ncv (default
-   the larger of 2 nev + 3 bs and nev + 15; at least nev + 3 bs), -eps_max_it (restart cycles,
-   as Krylov-Schur's iterations; the monitors are called once a cycle). */
+   Options: -eps_phlexblock_block_size <bs> (default: nev, at most 8), -eps_ncv (default the larger of 2 nev + 3 bs
+   and nev + 15; at least nev + 3 bs, so that nev must stay 3 below the problem's dimension), -eps_max_it (restart
+   cycles; after the first, a cycle is one block step: the default is Krylov-Schur's, times the blocks of half a
+   basis), -eps_phlexblock_rayleigh_quotient. Real scalars only; -eps_true_residual is not supported. */
 #include <phlex_impl.h>
 #include <slepc/private/epsimpl.h>
 #include <petscblaslapack.h>
 
 typedef struct {
-  PetscInt     bs;         /* block size (0: default) */
+  PetscInt     bsopt;      /* the block size asked for (-eps_phlexblock_block_size; 0: default) */
+  PetscInt     bs;         /* the block size of the current set-up */
   PetscScalar *H;          /* ncv x ncv, column major: the block Arnoldi coefficients */
   BV           BV;         /* B V, column by column (kept through the recurrences, no product with B) */
   BV           W, Z, BZ;   /* one block: the right-hand sides, the block being orthonormalized and B times it */
@@ -108,6 +110,7 @@ static PetscErrorCode EPSSetUp_PhlexBlock(EPS eps)
   const char     *prefix;
 
   PetscFunctionBegin;
+  PetscCheck(!PetscDefined(USE_COMPLEX), PetscObjectComm((PetscObject)eps), PETSC_ERR_SUP, "EPS phlexblock is written for real scalars");
   PetscCall(EPSGetOptionsPrefix(eps, &prefix));
   if (!prefix) prefix = "";
   EPSCheckHermitianDefinite(eps);
@@ -117,11 +120,12 @@ static PetscErrorCode EPSSetUp_PhlexBlock(EPS eps)
   PetscCheck(eps->which == EPS_TARGET_MAGNITUDE || eps->which == EPS_TARGET_REAL, PetscObjectComm((PetscObject)eps), PETSC_ERR_SUP, "EPS phlexblock computes the eigenvalues nearest the target (-%seps_target_magnitude); -%seps_type another solver for other parts of the spectrum", prefix, prefix);
   EPSCheckUnsupported(eps, EPS_FEATURE_ARBITRARY | EPS_FEATURE_REGION | EPS_FEATURE_EXTRACTION | EPS_FEATURE_TWOSIDED);
   EPSCheckIgnored(eps, EPS_FEATURE_BALANCE);
+  PetscCheck(!eps->trueres, PetscObjectComm((PetscObject)eps), PETSC_ERR_SUP, "EPS phlexblock estimates the residuals from its Arnoldi relation: -%seps_true_residual is not supported", prefix);
   if (eps->nev < 1) eps->nev = 1;
   /* default block size 8: from 6 to 13 the 2.2e5-DOF free-free bar (26 pairs, BENCHMARKS.md) costs the same, more
      vectors in all balancing the cheaper solve per vector of a larger block */
-  bs   = ctx->bs > 0 ? ctx->bs : PetscMin(eps->nev, 8);
-  room = eps->n - eps->nds; /* dimension of the space searched */
+  bs   = ctx->bsopt > 0 ? ctx->bsopt : PetscMin(eps->nev, 8);
+  room = eps->n - PetscAbs(eps->nds); /* dimension of the space searched (a deflation space not yet inserted: nds < 0) */
   PetscCheck(room > eps->nev, PetscObjectComm((PetscObject)eps), PETSC_ERR_USER_INPUT, "EPS phlexblock: %" PetscInt_FMT " eigenpairs asked of a problem of dimension %" PetscInt_FMT, eps->nev, room);
   /* small problems: a basis of nev + 3 bs vectors must fit */
   if (eps->nev + 3 * bs > room) bs = PetscMax(1, (room - eps->nev) / 3);
@@ -131,7 +135,9 @@ static PetscErrorCode EPSSetUp_PhlexBlock(EPS eps)
   PetscCheck(eps->ncv >= eps->nev + 3 * bs, PetscObjectComm((PetscObject)eps), PETSC_ERR_USER_INPUT, "EPS phlexblock: -%seps_ncv %" PetscInt_FMT " is too small for %" PetscInt_FMT " eigenpairs and block size %" PetscInt_FMT " (at least eigenpairs + 3 x block size = %" PetscInt_FMT ")", prefix, eps->ncv, eps->nev, bs, eps->nev + 3 * bs);
   ctx->bs  = bs;
   eps->mpd = eps->ncv;
-  if (eps->max_it == PETSC_DEFAULT || eps->max_it == PETSC_DECIDE) eps->max_it = 100;
+  /* after the first cycle a cycle is one block step: Krylov-Schur's default restarts, times the blocks of half a
+     basis (the vectors one of its restarts adds) */
+  if (eps->max_it == PETSC_DEFAULT || eps->max_it == PETSC_DECIDE) eps->max_it = PetscMax(100, 2 * eps->n / eps->ncv) * ((eps->ncv + 2 * bs - 1) / (2 * bs));
   PetscCall(EPSAllocateSolution(eps, 0));
   PetscCall(EPS_SetInnerProduct(eps));
   PetscCall(SetMatMultMethod(eps, eps->V));
@@ -167,7 +173,8 @@ static PetscErrorCode ApplyB(EPS eps, BV X, BV BX)
 }
 
 /* Z = Op W = (A - sigma B)^{-1} B W: one product with B, one solve with bs right-hand sides (KSPMatSolve: MatMatSolve
-   of the factor; SLEPc 3.18's sinvert has no STApplyMat); BW is B W when known (NULL: computed into Z first) */
+   of the factor; SLEPc 3.18's sinvert has no STApplyMat); BW is B W when known (NULL: B W is computed and
+   overwrites W) */
 static PetscErrorCode ApplyOp(EPS eps, BV W, BV BW, BV Z)
 {
   Mat X, Y;
@@ -408,7 +415,8 @@ static PetscErrorCode RayleighRitz(EPS eps, PetscInt nlock, PetscInt j, PetscRea
   PetscFunctionReturn(0);
 }
 
-/* V[:, 0:k] = V[:, 0:j] Y[:, 0:k] and, on a restart, the last block V[:, j:j+bs] to V[:, k:k+bs], with B V alongside */
+/* V[:, 0:k] = V[:, 0:j] Y[:, 0:k] and, on a restart, the last block V[:, j:j+bs] to V[:, k:k+bs], with B V alongside
+   (on a restart only: after the final rotation B V is stale, and RefineRitzValues overwrites it) */
 static PetscErrorCode Rotate(EPS eps, PetscInt j, const PetscScalar *Y, PetscInt k, PetscBool restart)
 {
   EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
@@ -444,6 +452,7 @@ static PetscErrorCode FirstBlock(EPS eps)
   const PetscInt  bs  = ctx->bs;
 
   PetscFunctionBegin;
+  if (eps->nini > bs) PetscCall(PetscInfo(eps, "the first %" PetscInt_FMT " of %" PetscInt_FMT " initial vectors start the search (the block size)\n", bs, eps->nini));
   for (PetscInt k = eps->nini; k < bs; k++) PetscCall(BVSetRandomColumn(eps->V, k));
   PetscCall(BVSetActiveColumns(eps->V, 0, bs));
   if (eps->isgeneralized) {
@@ -510,7 +519,10 @@ static PetscErrorCode EPSSolve_PhlexBlock(EPS eps)
   PetscCall(PetscObjectReference((PetscObject)B));
   PetscCall(BVSetMatrix(eps->V, NULL, PETSC_FALSE));
   ctx->nBexact = 0;
-  /* the deflation space and B times it, as BVs of their own for the block products */
+  /* the deflation space and B times it, as BVs of their own for the block products (none left from a solve that
+     failed) */
+  PetscCall(BVDestroy(&ctx->C));
+  PetscCall(BVDestroy(&ctx->BC));
   if (eps->nds) {
     PetscCall(WorkBV(eps, eps->nds, &ctx->C));
     PetscCall(WorkBV(eps, eps->nds, &ctx->BC));
@@ -539,7 +551,10 @@ static PetscErrorCode EPSSolve_PhlexBlock(EPS eps)
       eps->eigi[i] = 0.0;
       if (i < nlock) eps->errest[i] = ctx->lockerr[i];
       else {
-        PetscCall((*eps->converged)(eps, theta[i], 0.0, res[i], &eps->errest[i], eps->convergedctx));
+        PetscScalar re = theta[i], im = 0.0;
+        /* as EPSKrylovConvergence: the eigenvalue of the problem for the norm-relative test */
+        if (eps->conv == EPS_CONV_NORM) PetscCall(STBackTransform(eps->st, 1, &re, &im));
+        PetscCall((*eps->converged)(eps, re, im, res[i], &eps->errest[i], eps->convergedctx));
         if (nconv == i && eps->errest[i] < eps->tol) nconv++;
       }
     }
@@ -562,11 +577,12 @@ static PetscErrorCode EPSSolve_PhlexBlock(EPS eps)
       const PetscInt keep = ncv - 2 * bs;
       PetscScalar   *Hn;
       PetscCall(Rotate(eps, j0, Y, keep, PETSC_TRUE));
-      for (PetscInt i = nlock; i < nconv; i++) {
+      /* (nconv < nev <= keep with the default stopping test; a user's test may go on past nev) */
+      for (PetscInt i = nlock; i < PetscMin(nconv, keep); i++) {
         ctx->lock[i]    = theta[i];
         ctx->lockerr[i] = eps->errest[i];
       }
-      nlock = nconv;
+      nlock = PetscMin(nconv, keep);
       PetscCall(PetscCalloc1(ld * ld, &Hn));
       for (PetscInt i = 0; i < keep; i++) Hn[i + i * ld] = theta[i];
       for (PetscInt r = 0; r < bs; r++)
@@ -603,7 +619,8 @@ static PetscErrorCode EPSBackTransform_PhlexBlock(EPS eps)
   PetscFunctionReturn(0);
 }
 
-/* the Ritz vectors are the eigenvectors (B-orthonormal); purification on request, as Krylov-Schur */
+/* the Ritz vectors are the eigenvectors (B-orthonormal); purification on request (SLEPc's, one solve per vector;
+   the modal analyses turn it off) */
 static PetscErrorCode EPSComputeVectors_PhlexBlock(EPS eps)
 {
   PetscFunctionBegin;
@@ -617,7 +634,7 @@ static PetscErrorCode EPSComputeVectors_PhlexBlock(EPS eps)
 static PetscErrorCode EPSSetFromOptions_PhlexBlock(EPS eps, PetscOptionItems *PetscOptionsObject)
 {
   EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
-  PetscInt        bs  = ctx->bs;
+  PetscInt        bs  = ctx->bsopt;
   PetscBool       flg;
 
   PetscFunctionBegin;
@@ -627,7 +644,7 @@ static PetscErrorCode EPSSetFromOptions_PhlexBlock(EPS eps, PetscOptionItems *Pe
     const char *prefix;
     PetscCall(EPSGetOptionsPrefix(eps, &prefix));
     PetscCheck(bs >= 1, PetscObjectComm((PetscObject)eps), PETSC_ERR_USER_INPUT, "-%seps_phlexblock_block_size must be >= 1, got %" PetscInt_FMT, prefix ? prefix : "", bs);
-    ctx->bs = bs;
+    ctx->bsopt = bs;
   }
   PetscCall(PetscOptionsBool("-eps_phlexblock_rayleigh_quotient", "Converged eigenvalues from the Rayleigh quotients of their vectors (one more block solve; accurate to 13 digits where the Ritz values agree to about 11)", "EPSPhlexBlock", ctx->refine, &ctx->refine, NULL));
   PetscOptionsHeadEnd();
@@ -669,6 +686,7 @@ static PetscErrorCode EPSReset_PhlexBlock(EPS eps)
 static PetscErrorCode EPSDestroy_PhlexBlock(EPS eps)
 {
   PetscFunctionBegin;
+  PetscCall(EPSReset_PhlexBlock(eps)); /* EPSSetType calls only destroy */
   PetscCall(PetscFree(eps->data));
   PetscFunctionReturn(0);
 }

@@ -106,8 +106,9 @@ static PetscErrorCode FloatingPencil(PhlexFlexible b, Mat *A, Mat *B, IS is[2])
 }
 
 /*@C
-  PhlexModesEPSCreate - the eigensolver of a body's modes with phlex's defaults (Krylov-Schur, shift-and-invert,
-  Cholesky by MUMPS, tolerance 1e-12, no purification), options prefix modes_, and the target frequency asked for;
+  PhlexModesEPSCreate - the eigensolver of a body's modes with phlex's defaults (block Krylov-Schur phlexblock,
+  shift-and-invert, Cholesky by MUMPS, tolerance 1e-12, no purification), options prefix modes_, and the target
+  frequency asked for;
   the operators, dimensions and target are the caller's. The modal analysis also creates one without operators to
   read (and check) every eigensolver option before the first solve.
 
@@ -173,7 +174,7 @@ PetscErrorCode PhlexModesEPSCreate(MPI_Comm comm, EPS *eps, PetscReal *ftarget, 
   Options Database Keys:
 + -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)
 . -modes_target_frequency <Hz>    - look for modes nearest this frequency (default: lowest)
-- -modes_eps_*, -modes_st_*       - any SLEPc EPS/ST option; defaults: Krylov-Schur, shift-and-invert, Cholesky (MUMPS)
+- -modes_eps_*, -modes_st_*       - any SLEPc EPS/ST option; defaults: phlexblock (block Krylov-Schur), shift-and-invert, Cholesky (MUMPS)
 @*/
 PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
 {
