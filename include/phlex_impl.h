@@ -160,6 +160,9 @@ PETSC_INTERN PetscErrorCode PhlexProgressEPSMonitor(EPS, PetscInt, PetscInt, Pet
 
 /* flexible_modes.c: the eigensolver of the modal analysis with its defaults (also read by -help) */
 PETSC_INTERN PetscErrorCode PhlexModesEPSCreate(MPI_Comm, EPS *, PetscReal *, PetscBool *);
+
+/* eps_block.c: EPS "phlexblock", block shift-and-invert Krylov-Schur (the modal analyses' default) */
+#define EPSPHLEXBLOCK "phlexblock"
 PETSC_INTERN PetscErrorCode PhlexEPSRegister(void);
 
 /* scene.c */

@@ -658,7 +658,7 @@ static PetscErrorCode EPSView_PhlexBlock(EPS eps, PetscViewer viewer)
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
-  if (ascii) PetscCall(PetscViewerASCIIPrintf(viewer, "  block shift-and-invert Krylov-Schur, block size %" PetscInt_FMT "\n", ctx->bs));
+  if (ascii) PetscCall(PetscViewerASCIIPrintf(viewer, "  block shift-and-invert Krylov-Schur, block size %" PetscInt_FMT ", eigenvalues from %s\n", ctx->bs, ctx->refine ? "Rayleigh quotients" : "Ritz values"));
   PetscFunctionReturn(0);
 }
 
@@ -722,6 +722,6 @@ static PetscErrorCode EPSCreate_PhlexBlock(EPS eps)
 PetscErrorCode PhlexEPSRegister(void)
 {
   PetscFunctionBegin;
-  PetscCall(EPSRegister("phlexblock", EPSCreate_PhlexBlock));
+  PetscCall(EPSRegister(EPSPHLEXBLOCK, EPSCreate_PhlexBlock));
   PetscFunctionReturn(0);
 }

@@ -127,7 +127,7 @@ PetscErrorCode PhlexModesEPSCreate(MPI_Comm comm, EPS *eps, PetscReal *ftarget, 
   PetscCall(EPSCreate(comm, eps));
   PetscCall(EPSSetOptionsPrefix(*eps, "modes_"));
   PetscCall(EPSSetProblemType(*eps, EPS_GHEP));
-  PetscCall(EPSSetType(*eps, "phlexblock"));
+  PetscCall(EPSSetType(*eps, EPSPHLEXBLOCK));
   PetscCall(EPSSetWhichEigenpairs(*eps, EPS_TARGET_MAGNITUDE));
   PetscCall(EPSSetTolerances(*eps, 1e-12, PETSC_DEFAULT));
   /* B (the velocity mass, or the body's whole kinetic-energy matrix when floating) is positive definite, so the
