@@ -36,7 +36,7 @@ typedef struct {
 
 /* log.c */
 PETSC_EXTERN PetscClassId  PHLEX_CLASSID;
-PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp;
+PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult;
 PETSC_EXTERN PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes;
 PETSC_EXTERN PetscErrorCode PhlexLogRegister(void);
 PETSC_EXTERN PetscErrorCode PhlexLogStagePush(const char[], PetscLogStage *);
@@ -73,6 +73,7 @@ PETSC_EXTERN PetscErrorCode PhlexHelpCaptureEnd(PetscInt *, char ***);
 PETSC_EXTERN PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm, PetscErrorCode (*)(void *), void *);
 PETSC_EXTERN PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm);
 PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedFromFile(const char[], const char *const[]);
+PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedOverridden(const char[]);
 PETSC_EXTERN PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const[], PetscBool *);
 
 /* scene_file.c: the YAML syntax of the scene files, before PETSc reads them */

@@ -96,6 +96,7 @@ int main(int argc, char **argv)
   PetscCall(PhlexLogRegister());
   PetscCall(PhlexPCRegister());
   PetscCall(PhlexSNESRegister());
+  PetscCall(PhlexSNESReducedRegister());
   PetscCall(PhlexEPSRegister());
   PetscCall(PhlexPartitionerRegister());
   PetscCall(PhlexPartRegisterAll());

@@ -250,7 +250,8 @@ def column_errors(ref: CsvTable, out: CsvTable, name: str) -> Tuple[float, int]:
 
 
 def compare_csv(expected: str, got: str, tol: Tol, columns: Optional[Sequence[str]] = None,
-                label: str = "csv", max_diffs: int = MAX_DIFFS) -> CsvResult:
+                label: str = "csv", max_diffs: int = MAX_DIFFS,
+                column_atol: Optional[Dict[str, float]] = None) -> CsvResult:
     """Compare produced CSV text (got) with reference CSV text (expected).
 
     Only the reference's columns (or the given subset) are compared; extra
@@ -275,7 +276,7 @@ def compare_csv(expected: str, got: str, tol: Tol, columns: Optional[Sequence[st
     if len(ref.rows) != len(out.rows):
         diffs.append(Diff(f"{label}: expected {len(ref.rows)} rows, got {len(out.rows)}"))
     common = [n for n in wanted if n in ref.header and n in out.header]
-    diffs.extend(compare_cells(ref, out, common, tol, label, max_diffs - len(diffs)))
+    diffs.extend(compare_cells(ref, out, common, tol, label, max_diffs - len(diffs), column_atol))
     for name in common:
         worst, row = column_errors(ref, out, name)
         notes.append(f"{label}: column {name}: max rel err {worst:.3g}"
@@ -284,10 +285,12 @@ def compare_csv(expected: str, got: str, tol: Tol, columns: Optional[Sequence[st
 
 
 def compare_cells(ref: CsvTable, out: CsvTable, names: Sequence[str], tol: Tol,
-                  label: str, limit: int) -> List[Diff]:
-    """Compare the named columns cell by cell over the common rows."""
+                  label: str, limit: int, column_atol: Optional[Dict[str, float]] = None) -> List[Diff]:
+    """Compare the named columns cell by cell over the common rows (a column of column_atol with its own
+    absolute tolerance)."""
     diffs: List[Diff] = []
     indices = [(n, ref.header.index(n), out.header.index(n)) for n in names]
+    tols = {n: Tol(tol.rtol, column_atol[n], tol.ztol) if column_atol and n in column_atol else tol for n in names}
     for row, (rrow, orow) in enumerate(zip(ref.rows, out.rows), start=1):
         for name, ri, oi in indices:
             if len(diffs) >= limit:
@@ -301,7 +304,7 @@ def compare_cells(ref: CsvTable, out: CsvTable, names: Sequence[str], tol: Tol,
                                       f"{ocell if ocell is not None else '(missing cell)'}"))
                 continue
             rtok, otok = parse_cell(rcell), parse_cell(ocell)
-            if not tokens_match(rtok, otok, tol):
+            if not tokens_match(rtok, otok, tols[name]):
                 diffs.append(Diff(f"{label} column {name} row {row}: expected {shorten(rcell, 40)} "
                                   f"got {shorten(ocell, 40)}{error_note(rtok, otok)}"))
     return diffs
@@ -313,7 +316,7 @@ def compare_cells(ref: CsvTable, out: CsvTable, names: Sequence[str], tol: Tol,
 
 KNOWN_KEYS = {
     "description", "args", "nsize", "requires", "filter", "output", "csv", "columns",
-    "rtol", "atol", "ztol", "csv_rtol", "csv_atol", "csv_ztol", "timeout", "exit",
+    "rtol", "atol", "ztol", "csv_rtol", "csv_atol", "csv_ztol", "csv_column_atol", "timeout", "exit",
     "stderr", "files_absent", "files_present", "ref_source",
 }
 
@@ -363,6 +366,23 @@ class Spec(NamedTuple):
     files_absent: List[str]
     files_present: List[str]
     ref_source: Optional[str] = None  # how the reference CSVs were made (not phlex): --update leaves them alone
+    column_atol: Optional[Dict[str, float]] = None  # CSV columns with their own absolute tolerance
+
+
+def parse_column_atol(text: str) -> Dict[str, float]:
+    """``name=value`` pairs (whitespace separated): CSV columns with their own absolute tolerance."""
+    out: Dict[str, float] = {}
+    for item in text.split():
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise SpecError(f"csv_column_atol: expected name=value, got {item!r}")
+        try:
+            out[name] = float(value)
+        except ValueError:
+            raise SpecError(f"csv_column_atol: {name}: not a number: {value!r}") from None
+        if out[name] < 0:
+            raise SpecError(f"csv_column_atol: {name}: must be >= 0, got {value}")
+    return out
 
 
 def read_spec_lines(text: str) -> Dict[str, str]:
@@ -495,6 +515,7 @@ def parse_spec(name: str, text: str) -> Spec:
         files_absent=values.get("files_absent", "").split(),
         files_present=values.get("files_present", "").split(),
         ref_source=values.get("ref_source") or None,
+        column_atol=parse_column_atol(values.get("csv_column_atol", "")) or None,
     )
 
 
@@ -791,7 +812,7 @@ def check_csvs(spec: Spec, cfg: Config, absdir: str, chk: Checker) -> None:
         if expected is None:
             chk.fail(f"missing reference {rel(rpath)} (create it with --update)")
             continue
-        result = compare_csv(expected, got, spec.csv_tol, spec.columns, label=produced)
+        result = compare_csv(expected, got, spec.csv_tol, spec.columns, label=produced, column_atol=spec.column_atol)
         chk.extend("", result.diffs)
         if cfg.verbose:
             chk.notes.extend(result.notes)

@@ -42,10 +42,14 @@ typedef struct {
   PetscInt r, R, v, w;
 } PhlexFrameIndex;
 
-/* A part's view of a global vector: its field blocks and its discrete unknowns (an array valid on every rank). */
+/* A part's view of a global vector: its field blocks and its discrete unknowns (an array valid on every rank).
+   p, when set (state vectors handed to residual by SNES phlexreduced), is the stress resultant G^T Sigma in velocity
+   space: the displacement and the stress are eliminated by the caller, and residual writes the velocity and discrete
+   rows only, with p in place of G^T s. */
 typedef struct {
   Vec        u, s, v;
   PetscReal *q;
+  Vec        p;
 } PhlexPartVec;
 
 /* Matrices of a part's field blocks, referenced by the system's Jacobian (owned and updated by the part). */
@@ -54,6 +58,7 @@ typedef struct {
   Mat      Ms;       /* compliance mass, block diagonal per cell */
   PetscInt stress_bs; /* stress unknowns per cell (block size of Ms) */
   Mat      Jvv, Jvu; /* velocity rows: d/dv (shift Mv [+ node-wise terms]) and d/du (node-wise terms, or NULL) */
+  Mat      Jvc;      /* Jvv + Jvu / shift: the velocity rows' own block once u = u0 + v / shift is eliminated (one product) */
   Mat      Sv;       /* preconditioner: condensed velocity operator shift Mv + K/shift (AIJ, rigid modes attached) */
   Mat      M, K;     /* the velocity mass Mv and the condensed stiffness K = G^T Ms^{-1} G (AIJ; the linearised analysis) */
   Mat      Jsu;      /* stress rows: d(G(u) v)/du (geometric stiffening), or NULL */

@@ -59,6 +59,7 @@ struct _p_PhlexSystem {
   Mat       J, Jaij;
   PetscBool use_aij;
   Mat       Juu, Juv, Ms, Jss, Jsv, Jvs, Jvv, Jvu, Jsu, Bvq, Cqu, Cqv, Dq;
+  Mat       Jvc; /* Jvv + Jvu / shift (block diagonal over the bodies): the velocity block with the displacement eliminated */
   PetscBool state_dependent_fields, inexact_schur; /* a body with geometric stiffening: G(u) and its blocks change with the state */
 
   Mat       Sv, Pvq, Ssv, Abd, Cpre;
@@ -67,12 +68,18 @@ struct _p_PhlexSystem {
   Vec       *xu, *xv; /* work: per field part */
   Vec        Xwork;    /* work: a whole state (the joints' mid-step geometry) */
   PetscReal  fprev;    /* Newton: the previous residual norm (round-off floor test) */
+  /* the state the parts and joints were last evaluated at (a Jacobian right after a residual at the same state
+     skips the evaluation): the vectors' ids and object states, and the time */
+  PetscObjectId    eval_id[2];
+  PetscObjectState eval_state[2];
+  PetscReal        eval_t;
 };
 
 PETSC_INTERN PetscErrorCode PhlexSystemCreate(PhlexScene, PhlexSystem *);
 PETSC_INTERN PetscErrorCode PhlexSystemDestroy(PhlexSystem *);
 PETSC_INTERN PetscErrorCode PhlexSystemCreateForScene(PhlexScene, PhlexSystem *, Vec *);
 PETSC_INTERN PetscErrorCode PhlexSystemIFunction(TS, PetscReal, Vec, Vec, Vec, void *);
+PETSC_INTERN PetscErrorCode PhlexSystemReducedResidual(PhlexSystem, PetscReal, Vec, Vec, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemIJacobian(TS, PetscReal, Vec, Vec, PetscReal, Mat, Mat, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemGather(PhlexSystem, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexSystemScatter(PhlexSystem, const PetscReal *, Vec);
@@ -89,6 +96,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, PetscInt, Mat *);
+PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);
 
 /* border.c: the shells of the border blocks and the callbacks of PC phlexbordered */
 PETSC_INTERN PetscErrorCode PhlexBorderCreateShells(PhlexSystem);
@@ -100,6 +108,12 @@ PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSNESRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESCondensedApplicable(PhlexSystem, TS, PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexSNESCondensedSetSystem(SNES, PhlexSystem, TS);
+PETSC_INTERN PetscErrorCode PhlexSystemCreateStressMaps(PhlexSystem, Mat **);
+PETSC_INTERN PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem, Mat *, Vec, Vec);
+/* snes_reduced.c: SNES phlexreduced, Newton on the velocities and discrete unknowns of a theta-method stage */
+PETSC_INTERN PetscErrorCode PhlexSNESReducedRegister(void);
+PETSC_INTERN PetscErrorCode PhlexSNESReducedApplicable(PhlexSystem, TS, PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexSNESReducedSetSystem(SNES, PhlexSystem, TS);
 
 /* assembly.c: consistent configuration and velocities, redundancy, drift */
 PETSC_INTERN PetscErrorCode PhlexAssemblyPlaceAttached(PhlexSystem, Vec);

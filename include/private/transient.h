@@ -31,6 +31,7 @@ typedef struct {
   /* adaptive steps: a step that breaks a watchdog, or whose Newton fails, is retried with a smaller step */
   PetscBool   adaptive;
   PetscBool   condensed; /* SNES phlexcondensed solves the stages (the preset's field split is not used) */
+  PetscBool   reduced;   /* SNES phlexreduced solves the stages (Newton on velocities and discrete unknowns; the preset's field split is not used) */
   char        preset[PETSC_MAX_PATH_LEN]; /* the solver preset file ("": none) */
   PetscInt    nretries, snes_failures, max_snes_failures; /* retries over the run; Newton failures of this step, the user's bound (-1: none) */
   char        last_retry[256]; /* why the step being taken was retried (cleared when a step is accepted) */

@@ -347,7 +347,7 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
   if (step > 0 && m->lossless_scheme && m->watch_balance > 0) {
     const PetscReal scale = PetscMax(m->Emax, PetscAbsReal(m->H0));
     PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently; tighten %s or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
-               step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance, m->condensed ? "-condensed_ksp_rtol" : "-snes_rtol/-ksp_rtol");
+               step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance, m->condensed ? "-condensed_ksp_rtol" : (m->reduced ? "-snes_rtol/-reduced_ksp_rtol" : "-snes_rtol/-ksp_rtol"));
   }
   /* a scheme whose rotations are not re-orthonormalised (BDF, alpha): R^T R - I drifts with the scheme's error */
   if (m->history && !m->orth_warned && m->max_orth > 1e-2 && (m->watch_orth <= 0 || m->max_orth <= m->watch_orth)) {
@@ -467,12 +467,15 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
   PetscFunctionBeginUser;
   if (step == m->first_step + 1) {
     /* the preset's own options of the solver path not taken (a preset configures both) */
-    const char *const generic[] = {"ksp_", "pc_", "fieldsplit_", NULL}, *const stage[] = {"condensed_", NULL};
+    const char *const generic[] = {"ksp_", "pc_", "fieldsplit_", NULL}, *const stage[] = {"condensed_", "reduced_", "snes_phlexreduced_", NULL};
     PetscBool         typed;
-    PetscCall(PhlexOptionsSetUsedFromFile(m->preset, m->condensed ? generic : stage));
+    PetscCall(PhlexOptionsSetUsedFromFile(m->preset, (m->condensed || m->reduced) ? generic : stage));
+    PetscCall(PhlexOptionsSetUsedOverridden(m->preset));
     PetscCall(PhlexOptionsCommandLineHasPrefix(generic, &typed));
     if (m->condensed && typed)
       PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexcondensed (fixed linear bodies, theta method): its linear solve reads -condensed_ksp_* and -condensed_pc_*; -snes_type ksponly takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
+    if (m->reduced && typed)
+      PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexreduced (Newton on the velocities and discrete unknowns, theta method): its linear solve reads -reduced_ksp_*, -reduced_pc_* and -reduced_bordered_*; -snes_type newtonls takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_* (the consistent start of a scene with joints reads them too)\n"));
     PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
   }
   PetscCall(TSGetMaxTime(ts, &tmax));
@@ -656,11 +659,29 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
         m.condensed = PETSC_FALSE;
       }
     }
-    if (m.condensed && PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
-      /* what the condensed solve will read (it is made at the first step) */
+    /* SNES phlexreduced (the preset bordered asks for it): Newton on the velocities and the discrete unknowns of scenes
+       with frames and joints, displacement and stress eliminated exactly (snes_reduced.c); the same fall-back */
+    PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &m.reduced));
+    if (m.reduced) {
+      PetscCall(PhlexSNESReducedApplicable(sys, ts, &applicable));
+      PetscCall(PhlexOptionsCommandLineHasPrefix(snestype, &typed));
+      if (applicable || typed) PetscCall(PhlexSNESReducedSetSystem(snes, sys, ts));
+      else {
+        KSP            ksp;
+        SNESLineSearch ls;
+        PetscCall(SNESSetType(snes, SNESNEWTONLS));
+        PetscCall(SNESGetKSP(snes, &ksp));
+        PetscCall(KSPSetFromOptions(ksp));
+        PetscCall(SNESGetLineSearch(snes, &ls));
+        PetscCall(SNESLineSearchSetFromOptions(ls));
+        m.reduced = PETSC_FALSE;
+      }
+    }
+    if ((m.condensed || m.reduced) && PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
+      /* what the stage's own solve will read (it is made at the first step) */
       KSP ksp;
       PetscCall(KSPCreate(scene->comm, &ksp));
-      PetscCall(KSPSetOptionsPrefix(ksp, "condensed_"));
+      PetscCall(KSPSetOptionsPrefix(ksp, m.condensed ? "condensed_" : "reduced_"));
       PetscCall(KSPSetFromOptions(ksp));
       PetscCall(KSPDestroy(&ksp));
     }
@@ -808,7 +829,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     SETERRQ(scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s), the last try with a time step of %g s because: %s; allow more retries (%s, now %" PetscInt_FMT ") or a smaller step (-ts_adapt_dt_min), tighten the solvers, or check the inputs; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast, m.last_retry, snes ? "-ts_max_snes_failures" : "-ts_max_reject", snes ? m.max_snes_failures : maxrej);
   }
   PetscCheck(reason >= 0, scene->comm, PETSC_ERR_NOT_CONVERGED, "transient analysis: step %" PetscInt_FMT " from t = %g s failed (%s, time step %g s): %s; no result was written", nsteps + 1, (double)tfinal, TSConvergedReasons[reason], (double)dtlast,
-             reason == TS_DIVERGED_NONLINEAR_SOLVE ? (m.condensed ? "the condensed solve (SNES phlexcondensed) did not converge: see why with -condensed_ksp_converged_reason, or try a smaller -ts_dt" : "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic: a failed step is then retried with a smaller one), or see why with -snes_converged_reason -ksp_converged_reason") : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
+             reason == TS_DIVERGED_NONLINEAR_SOLVE ? (m.condensed ? "the condensed solve (SNES phlexcondensed) did not converge: see why with -condensed_ksp_converged_reason, or try a smaller -ts_dt" : m.reduced ? "Newton (SNES phlexreduced) did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic: a failed step is then retried with a smaller one), or see why with -snes_converged_reason -reduced_ksp_converged_reason" : "Newton did not converge: try a smaller -ts_dt, adaptive steps (-ts_adapt_type basic: a failed step is then retried with a smaller one), or see why with -snes_converged_reason -ksp_converged_reason") : "too many rejected steps: loosen -ts_rtol/-ts_atol or allow a smaller -ts_adapt_dt_min");
   /* the final state's checkpoint: the run can be continued further (-restart with a later -ts_max_time); written
      before the end-of-run snapshot below, which a longer run would not have */
   if (checkpointing) PetscCall(PhlexTransientCheckpointWrite(ts, &m, X));

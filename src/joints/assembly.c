@@ -425,6 +425,22 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
   }
   PetscCall(SNESSetFromOptions(snes));
+  {
+    /* the presets' stage solvers (phlexcondensed, phlexreduced) solve theta-method stages of a TS: this short step
+       takes Newton with the preset's field split */
+    PetscBool stage;
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &stage, "phlexcondensed", "phlexreduced", ""));
+    if (stage) {
+      KSP            ksp;
+      SNESLineSearch ls;
+      PetscCall(SNESSetType(snes, SNESNEWTONLS));
+      PetscCall(SNESGetKSP(snes, &ksp));
+      PetscCall(KSPSetFromOptions(ksp));
+      PetscCall(SNESGetLineSearch(snes, &ls));
+      PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
+      PetscCall(SNESLineSearchSetFromOptions(ls));
+    }
+  }
   PetscCall(SNESSetConvergenceTest(snes, PhlexSystemSNESConverged, sys, NULL));
 
   PetscCall(Energy(sys, t0, X, &H0, &K0));

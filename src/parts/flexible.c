@@ -379,6 +379,7 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(MatDestroy(&b->Kaij));
   PetscCall(MatDestroy(&b->Jvv));
   PetscCall(MatDestroy(&b->Jvu));
+  PetscCall(MatDestroy(&b->Jvc));
   PetscCall(MatDestroy(&b->Sv));
   PetscCall(MatDestroy(&b->W));
   PetscCall(PetscFree4(b->Bc, b->Cu, b->Cv, b->Cpre));

@@ -351,7 +351,8 @@ static PetscErrorCode FlexEvaluate(PhlexPart part, PetscReal t, const PhlexPartV
       PetscCall(VecAXPBY(b->ud, T, 0.0, Xdot->u));
       PetscCall(VecAXPBY(b->vd, T, 0.0, Xdot->v));
     }
-    PetscCall(PhlexFrameEvaluate(&b->frame, X->u, X->v, Xdot ? b->ud : NULL, Xdot ? b->vd : NULL, X->q, qd, &b->fs));
+    /* a reduced state (X->p) has T u' = v exactly: the frame takes v as u' and saves a product with Mv */
+    PetscCall(PhlexFrameEvaluate(&b->frame, X->u, X->v, Xdot ? (X->p ? X->v : b->ud) : NULL, Xdot ? b->vd : NULL, X->q, qd, &b->fs));
   }
   PetscCall(ExternalLoads(part, t, X));
   PetscCall(PortOutputs(part, X, PETSC_FALSE));
@@ -367,22 +368,30 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
 
   PetscFunctionBeginUser;
   PetscCall(AddJointLoads(part));
+  PetscCheck(!(X->p && b->stiffening), b->comm, PETSC_ERR_PLIB, "body %s: geometric stiffening has no reduced residual", b->name);
   if (b->stiffening) {
     /* the Green-Lagrange coupling G(u) in both rows (flexible_stiffening.c) */
     PetscCall(PhlexFlexibleCouplingUpdate(b, X->u));
     G = b->Gres;
   }
-  /* F_u = T u' - v */
-  PetscCall(VecAXPBYPCZ(F->u, T, -1.0, 0.0, Xdot->u, X->v));
-  /* F_Sigma = G v - T Ms Sigma' */
-  PetscCall(MatMult(b->Ms, Xdot->s, F->s));
-  PetscCall(VecScale(F->s, -T));
-  PetscCall(MatMultAdd(G, X->v, F->s, F->s));
-  /* F_v = T Mv v' + G^T Sigma - b */
-  PetscCall(MatMultTranspose(G, X->s, F->v));
-  PetscCall(VecScale(F->v, 1.0 / T));
-  PetscCall(MatMultAdd(b->Mv, Xdot->v, F->v, F->v));
-  PetscCall(VecScale(F->v, T));
+  if (!X->p) {
+    /* F_u = T u' - v */
+    PetscCall(VecAXPBYPCZ(F->u, T, -1.0, 0.0, Xdot->u, X->v));
+    /* F_Sigma = G v - T Ms Sigma' */
+    PetscCall(MatMult(b->Ms, Xdot->s, F->s));
+    PetscCall(VecScale(F->s, -T));
+    PetscCall(MatMultAdd(G, X->v, F->s, F->s));
+  }
+  /* F_v = T Mv v' + G^T Sigma - b (reduced: the caller's G^T Sigma, displacement and stress rows not written); a
+     moving frame has Mv (T v') already */
+  if (X->p) PetscCall(VecCopy(X->p, F->v));
+  else PetscCall(MatMultTranspose(G, X->s, F->v));
+  if (b->floating) PetscCall(VecAXPY(F->v, 1.0, b->fs.Mvd));
+  else {
+    PetscCall(VecScale(F->v, 1.0 / T));
+    PetscCall(MatMultAdd(b->Mv, Xdot->v, F->v, F->v));
+    PetscCall(VecScale(F->v, T));
+  }
   if (!b->floating) {
     PetscCall(VecAXPY(F->v, -1.0, b->load));
     if (b->spinning) {
@@ -472,6 +481,19 @@ static PetscErrorCode MatMult_Avv(Mat A, Vec x, Vec y)
   PetscFunctionReturn(0);
 }
 
+/* (shift + Bvv + Bvu / shift) Mv x: the velocity block with u = u0 + v / shift eliminated, one product with Mv */
+static PetscErrorCode MatMult_Avc(Mat A, Vec x, Vec y)
+{
+  PhlexFlexible b;
+  PetscReal     B[9];
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &b));
+  for (PetscInt k = 0; k < 9; k++) B[k] = b->Bvv[k] + b->Bvu[k] / b->shift;
+  PetscCall(NodeMassMult(b, b->shift, B, x, y));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatMult_Avu(Mat A, Vec x, Vec y)
 {
   PhlexFlexible b;
@@ -511,6 +533,8 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       PetscCall(MatShellSetOperation(b->Jvv, MATOP_MULT, (void (*)(void))MatMult_Avv));
       PetscCall(MatCreateShell(b->comm, n, n, N, N, b, &b->Jvu));
       PetscCall(MatShellSetOperation(b->Jvu, MATOP_MULT, (void (*)(void))MatMult_Avu));
+      PetscCall(MatCreateShell(b->comm, n, n, N, N, b, &b->Jvc));
+      PetscCall(MatShellSetOperation(b->Jvc, MATOP_MULT, (void (*)(void))MatMult_Avc));
       PetscCall(VecDuplicate(b->load, &b->ud));
       PetscCall(VecDuplicate(b->load, &b->vd));
       PetscCall(PetscCalloc4(PetscMax(n * part->nq, 1), &b->Bc, PetscMax(n * part->nq, 1), &b->Cu, PetscMax(n * part->nq, 1), &b->Cv, PetscMax(n * part->nq, 1), &b->Cpre));
@@ -555,6 +579,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->stress_bs = b->nb_s;
   ops->Jvv       = b->Jvv;
   ops->Jvu       = b->Jvu;
+  ops->Jvc       = b->floating ? b->Jvc : (b->Jvu ? NULL : b->Jvv); /* a fixed body with a Jvu (spin, stiffening): none */
   ops->Sv        = b->Sv;
   ops->M         = b->Mvaij;
   ops->K         = b->Kaij;
@@ -668,6 +693,7 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   for (PetscInt i = 0; i < n * nq; i++) b->Cpre[i] = b->Cv[i] + b->Cu[i] / shift;
   PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvv));
   PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvu));
+  PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvc));
   PetscCall(PetscLogEventEnd(PHLEX_FloatJacobian, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }

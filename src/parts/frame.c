@@ -130,7 +130,8 @@ PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, 
   if (full) PetscCall(MatMult(fr->Mv, u, f->Mu));
   else PetscCall(VecSet(f->Mu, 0.0));
   PetscCall(MatMult(fr->Mv, v, f->Mvv));
-  if (full && ud) PetscCall(MatMult(fr->Mv, ud, f->Mud));
+  if (full && ud == v) PetscCall(VecCopy(f->Mvv, f->Mud)); /* u' = v exactly (the caller eliminated u): one product fewer */
+  else if (full && ud) PetscCall(MatMult(fr->Mv, ud, f->Mud));
   else PetscCall(VecSet(f->Mud, 0.0));
   if (vd) PetscCall(MatMult(fr->Mv, vd, f->Mvd));
   else PetscCall(VecSet(f->Mvd, 0.0));

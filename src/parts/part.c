@@ -199,7 +199,7 @@ PetscErrorCode PhlexPartFindPort(PhlexPart p, const char name[], PetscInt *port)
 PetscErrorCode PhlexPartGetVec(PhlexPart p, Vec X, PetscReal *q, PhlexPartVec *pv)
 {
   PetscFunctionBeginUser;
-  pv->u = pv->s = pv->v = NULL;
+  pv->u = pv->s = pv->v = pv->p = NULL;
   if (p->isu) {
     PetscCall(VecGetSubVector(X, p->isu, &pv->u));
     PetscCall(VecGetSubVector(X, p->iss, &pv->s));

@@ -141,12 +141,56 @@ static PetscErrorCode InverseStressMass(PhlexSystem sys, Mat *Minv)
   PetscFunctionReturn(0);
 }
 
+/*@C
+  PhlexSystemCreateStressMaps - per body B = Ms^{-1} G (G's pattern: Ms is block diagonal per cell), the map from a
+  velocity increment to the stress increment of a theta-method stage (Sigma = Sigma0 + B v / s); freed by the caller
+  (MatDestroy each, PetscFree the array)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemCreateStressMaps(PhlexSystem sys, Mat **B)
+{
+  Mat Minv;
+
+  PetscFunctionBeginUser;
+  PetscCall(InverseStressMass(sys, &Minv));
+  PetscCall(PetscMalloc1(sys->nfparts, B));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    Mat                 Mi;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCall(MatCreateSubMatrix(Minv, sys->fis[PHLEX_FIELD_STRESS][i], sys->fis[PHLEX_FIELD_STRESS][i], MAT_INITIAL_MATRIX, &Mi));
+    PetscCall(MatMatMult(Mi, ops.G, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &(*B)[i]));
+    PetscCall(MatDestroy(&Mi));
+  }
+  PetscCall(MatDestroy(&Minv));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemStressMapsMult - y = B v over the bodies (v a velocity field vector, y a stress field vector)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem sys, Mat *B, Vec v, Vec y)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    Vec vi, yi;
+    PetscCall(VecGetSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+    PetscCall(VecGetSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
+    PetscCall(MatMult(B[i], vi, yi));
+    PetscCall(VecRestoreSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
+    PetscCall(VecRestoreSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+  }
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode SNESSetUp_Condensed(SNES snes)
 {
   SNES_Condensed *c = (SNES_Condensed *)snes->data;
   PhlexSystem     sys;
   const char     *prefix;
-  Mat             Minv;
 
   PetscFunctionBeginUser;
   PetscCheck(c->sys, PetscObjectComm((PetscObject)snes), PETSC_ERR_ORDER, "SNES phlexcondensed: PhlexSNESCondensedSetSystem() was not called");
@@ -167,35 +211,10 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
     PetscCall(PCSetType(pc, PCCHOLESKY));
   }
   PetscCall(KSPSetFromOptions(c->ksp));
-  PetscCall(InverseStressMass(sys, &Minv));
-  PetscCall(PetscMalloc1(sys->nfparts, &c->B));
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexFieldOperators ops;
-    Mat                 Mi;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    PetscCall(MatCreateSubMatrix(Minv, sys->fis[PHLEX_FIELD_STRESS][i], sys->fis[PHLEX_FIELD_STRESS][i], MAT_INITIAL_MATRIX, &Mi));
-    PetscCall(MatMatMult(Mi, ops.G, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &c->B[i]));
-    PetscCall(MatDestroy(&Mi));
-  }
-  PetscCall(MatDestroy(&Minv));
+  PetscCall(PhlexSystemCreateStressMaps(sys, &c->B));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
   PetscCall(VecDuplicate(c->sp, &c->bv));
   PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
-  PetscFunctionReturn(0);
-}
-
-/* y = B v over the bodies (stress and velocity field vectors) */
-static PetscErrorCode MultB(PhlexSystem sys, Mat *B, Vec v, Vec y)
-{
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    Vec vi, yi;
-    PetscCall(VecGetSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
-    PetscCall(VecGetSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
-    PetscCall(MatMult(B[i], vi, yi));
-    PetscCall(VecRestoreSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
-    PetscCall(VecRestoreSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
-  }
   PetscFunctionReturn(0);
 }
 
@@ -234,7 +253,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
   /* Sigma_p = Sigma0 + B v0 / s; per body r = b - G^T Sigma_p */
-  PetscCall(MultB(sys, c->B, v0, c->bv));
+  PetscCall(PhlexSystemStressMapsMult(sys, c->B, v0, c->bv));
   PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
@@ -254,7 +273,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
   PetscCall(KSPGetConvergedReason(c->ksp, &kreason));
   snes->linear_its += its;
   /* Sigma = Sigma_p + B dv / s (not Sigma0 + B v / s: the momentum rows saw G^T Sigma_p); v = v0 + dv; u = u0 + v / s */
-  PetscCall(MultB(sys, c->B, xv, c->bv));
+  PetscCall(PhlexSystemStressMapsMult(sys, c->B, xv, c->bv));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(VecWAXPY(xs, 1.0 / s, c->bv, c->sp));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));

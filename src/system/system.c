@@ -20,8 +20,6 @@
 
 const char *const PhlexFieldNames[] = {"displacement", "stress", "velocity", "discrete"};
 
-PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);
-
 static PetscErrorCode IdentityMatrix(MPI_Comm comm, PetscInt n, PetscReal value, Mat *A)
 {
   Vec d;
@@ -138,6 +136,7 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&sys));
+  sys->eval_id[0] = 0;
   PetscCallMPI(MPI_Comm_rank(scene->comm, &rank));
   sys->scene   = scene;
   sys->comm    = scene->comm;
@@ -258,6 +257,8 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvu;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_DISPLACEMENT, &sys->Jvu));
+    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvc;
+    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvc));
     /* geometric stiffening: the stress rows depend on u, and the field blocks change with the state */
     for (PetscInt i = 0; i < sys->nfparts; i++) {
       m[i] = ops[i].Jsu;
@@ -433,17 +434,20 @@ PetscErrorCode PhlexSystemPartVecRestore(PhlexSystem sys, PhlexPart p, Vec X, Ph
 }
 
 /* evaluate every part at (t, X, X') (X' NULL: rest), then the joints, which set the port wrenches */
-static PetscErrorCode EvaluateAll(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot, PhlexPartVec *pX, PhlexPartVec *pXd)
+static PetscErrorCode EvaluateAll(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot, Vec P, PhlexPartVec *pX, PhlexPartVec *pXd)
 {
   PetscFunctionBeginUser;
+  sys->eval_id[0] = 0; /* no record while the parts are being evaluated */
   PetscCall(PhlexSystemGather(sys, X, sys->q));
   if (Xdot) PetscCall(PhlexSystemGather(sys, Xdot, sys->qd));
-  for (PetscInt i = 0; i < sys->nparts; i++) {
+  for (PetscInt i = 0, f = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
     for (PetscInt k = 0; k < p->nports; k++)
       for (PetscInt c = 0; c < 6; c++) p->wrench[k][c] = 0.0;
     PetscCall(PhlexPartGetVec(p, X, sys->q, &pX[i]));
     if (Xdot) PetscCall(PhlexPartGetVec(p, Xdot, sys->qd, &pXd[i]));
+    if (P && p->nv) PetscCall(VecGetSubVector(P, sys->fis[PHLEX_FIELD_VELOCITY][f], &pX[i].p));
+    if (p->nv) f++;
     PetscCall((*p->ops.evaluate)(p, t, &pX[i], Xdot ? &pXd[i] : NULL));
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
@@ -453,10 +457,43 @@ static PetscErrorCode EvaluateAll(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot,
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode RestoreAll(PhlexSystem sys, Vec X, Vec Xdot, PhlexPartVec *pX, PhlexPartVec *pXd)
+/* the record of the state the parts were evaluated at (Xdot NULL: none kept, rest is not recorded) */
+static PetscErrorCode EvaluationRecord(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot)
 {
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nparts; i++) {
+  sys->eval_id[0] = 0;
+  if (!Xdot) PetscFunctionReturn(0);
+  PetscCall(PetscObjectGetId((PetscObject)X, &sys->eval_id[0]));
+  PetscCall(PetscObjectGetId((PetscObject)Xdot, &sys->eval_id[1]));
+  PetscCall(PetscObjectStateGet((PetscObject)X, &sys->eval_state[0]));
+  PetscCall(PetscObjectStateGet((PetscObject)Xdot, &sys->eval_state[1]));
+  sys->eval_t = t;
+  PetscFunctionReturn(0);
+}
+
+/* whether the parts are evaluated at (t, X, X') (unchanged since a residual there) */
+static PetscErrorCode EvaluatedAt(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot, PetscBool *same)
+{
+  PetscObjectId    id[2];
+  PetscObjectState st[2];
+
+  PetscFunctionBeginUser;
+  *same = PETSC_FALSE;
+  if (!Xdot || !sys->eval_id[0] || t != sys->eval_t) PetscFunctionReturn(0);
+  PetscCall(PetscObjectGetId((PetscObject)X, &id[0]));
+  PetscCall(PetscObjectGetId((PetscObject)Xdot, &id[1]));
+  PetscCall(PetscObjectStateGet((PetscObject)X, &st[0]));
+  PetscCall(PetscObjectStateGet((PetscObject)Xdot, &st[1]));
+  *same = (PetscBool)(id[0] == sys->eval_id[0] && id[1] == sys->eval_id[1] && st[0] == sys->eval_state[0] && st[1] == sys->eval_state[1]);
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode RestoreAll(PhlexSystem sys, Vec X, Vec Xdot, Vec P, PhlexPartVec *pX, PhlexPartVec *pXd)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0, f = 0; i < sys->nparts; i++) {
+    if (P && sys->parts[i]->nv) PetscCall(VecRestoreSubVector(P, sys->fis[PHLEX_FIELD_VELOCITY][f], &pX[i].p));
+    if (sys->parts[i]->nv) f++;
     PetscCall(PhlexPartRestoreVec(sys->parts[i], X, &pX[i]));
     if (Xdot) PetscCall(PhlexPartRestoreVec(sys->parts[i], Xdot, &pXd[i]));
   }
@@ -475,26 +512,22 @@ PetscErrorCode PhlexSystemEvaluate(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot
 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc2(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd));
-  PetscCall(EvaluateAll(sys, t, X, Xdot, pX, pXd));
-  PetscCall(RestoreAll(sys, X, Xdot, pX, pXd));
+  PetscCall(EvaluateAll(sys, t, X, Xdot, NULL, pX, pXd));
+  PetscCall(RestoreAll(sys, X, Xdot, NULL, pX, pXd));
   PetscCall(PetscFree2(pX, pXd));
   PetscFunctionReturn(0);
 }
 
-/*@C
-  PhlexSystemIFunction - F(t, X, X') of the scene (TS IFunction; t and X' in SI time)
-
-  Collective
-@*/
-PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, void *ctx)
+/* F(t, X, X'); with P (a velocity field: each body's G^T Sigma) the displacement and stress are eliminated by the
+   caller and only the velocity and discrete rows are written */
+static PetscErrorCode Residual(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot, Vec P, Vec F)
 {
-  PhlexSystem   sys = (PhlexSystem)ctx;
   PhlexPartVec *pX, *pXd, *pF;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_SysIFunction, 0, 0, 0, 0));
   PetscCall(PetscMalloc3(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd, PetscMax(sys->nparts, 1), &pF));
-  PetscCall(EvaluateAll(sys, t, X, Xdot, pX, pXd));
+  PetscCall(EvaluateAll(sys, t, X, Xdot, P, pX, pXd));
   for (PetscInt k = 0; k < sys->nq; k++) sys->fq[k] = 0.0;
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
@@ -506,9 +539,36 @@ PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, 
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointResidual(sys->joints[k], t, sys->fq));
   PetscCall(PetscLogEventEnd(PHLEX_JointResidual, 0, 0, 0, 0));
   PetscCall(PhlexSystemScatter(sys, sys->fq, F));
-  PetscCall(RestoreAll(sys, X, Xdot, pX, pXd));
+  PetscCall(RestoreAll(sys, X, Xdot, P, pX, pXd));
+  PetscCall(EvaluationRecord(sys, t, X, Xdot));
   PetscCall(PetscFree3(pX, pXd, pF));
   PetscCall(PetscLogEventEnd(PHLEX_SysIFunction, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemIFunction - F(t, X, X') of the scene (TS IFunction; t and X' in SI time)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemIFunction(TS ts, PetscReal t, Vec X, Vec Xdot, Vec F, void *ctx)
+{
+  PetscFunctionBeginUser;
+  PetscCall(Residual((PhlexSystem)ctx, t, X, Xdot, NULL, F));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemReducedResidual - the velocity and discrete rows of F(t, X, X') with the displacement and the stress
+  eliminated by the caller: P holds each body's stress resultant G^T Sigma (velocity field numbering); the stress block
+  of X is not read, the displacement and stress rows of F are not written
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemReducedResidual(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot, Vec P, Vec F)
+{
+  PetscFunctionBeginUser;
+  PetscCall(Residual(sys, t, X, Xdot, P, F));
   PetscFunctionReturn(0);
 }
 
@@ -563,14 +623,26 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
     }
   }
   PetscCall(PetscMalloc2(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd));
-  PetscCall(EvaluateAll(sys, t, X, Xdot, pX, pXd));
+  {
+    /* a Jacobian right after a residual at the same state (Newton) finds the parts evaluated there */
+    PetscBool same;
+    PetscCall(EvaluatedAt(sys, t, X, Xdot, &same));
+    if (same) {
+      PetscCall(PhlexSystemGather(sys, X, sys->q));
+      PetscCall(PhlexSystemGather(sys, Xdot, sys->qd));
+      for (PetscInt i = 0; i < sys->nparts; i++) {
+        PetscCall(PhlexPartGetVec(sys->parts[i], X, sys->q, &pX[i]));
+        PetscCall(PhlexPartGetVec(sys->parts[i], Xdot, sys->qd, &pXd[i]));
+      }
+    } else PetscCall(EvaluateAll(sys, t, X, Xdot, NULL, pX, pXd));
+  }
   for (PetscInt k = 0; k < sys->nq * sys->nq; k++) sys->D[k] = 0.0;
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
     PetscCall((*p->ops.jacobian)(p, s, &pX[i], sys->D + p->qoff * sys->nq + p->qoff, sys->nq));
   }
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointJacobian(sys->joints[k], s, sys->D, sys->nq));
-  PetscCall(RestoreAll(sys, X, Xdot, pX, pXd));
+  PetscCall(RestoreAll(sys, X, Xdot, NULL, pX, pXd));
   PetscCall(PetscFree2(pX, pXd));
   if (sys->nq) {
     PetscScalar *da;
@@ -603,6 +675,7 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
   }
   if (sys->Jvv && sys->nfparts > 1) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvv));
   if (sys->Jvu && sys->nfparts > 1) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvu));
+  if (sys->Jvc && sys->nfparts > 1) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvc));
   if (sys->state_dependent_fields && sys->nfparts > 1) {
     PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jsv));
     PetscCall(PetscObjectStateIncrease((PetscObject)sys->Jvs));
@@ -680,7 +753,7 @@ PetscErrorCode PhlexSystemJointSides(PhlexSystem sys, PhlexJoint j, Vec X, Petsc
   PetscFunctionBeginUser;
   for (PetscInt s = 0; s < 2; s++) {
     PhlexPart p = j->side[s].part;
-    pv[s].u = pv[s].s = pv[s].v = NULL;
+    pv[s].u = pv[s].s = pv[s].v = pv[s].p = NULL;
     pv[s].q                     = NULL;
     if (PhlexPartIsGround(p)) continue;
     if (s == 1 && p == j->side[0].part) {
@@ -724,6 +797,7 @@ PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem sys, Vec X, PetscReal dt)
     for (PetscInt s = 0; s < 2; s++)
       if (sys->joints[k]->side[s].part->nv) flexible = PETSC_TRUE;
   if (!flexible) PetscFunctionReturn(0);
+  sys->eval_id[0] = 0; /* the joints' geometry changes */
   if (!sys->Xwork) PetscCall(VecDuplicate(X, &sys->Xwork));
   Xm = sys->Xwork;
   PetscCall(VecCopy(X, Xm));
@@ -796,6 +870,7 @@ PetscErrorCode PhlexSystemDestroy(PhlexSystem *system)
   PetscCall(MatDestroy(&sys->Jvs));
   PetscCall(MatDestroy(&sys->Jvv));
   PetscCall(MatDestroy(&sys->Jvu));
+  PetscCall(MatDestroy(&sys->Jvc));
   PetscCall(MatDestroy(&sys->Jsu));
   PetscCall(MatDestroy(&sys->Bvq));
   PetscCall(MatDestroy(&sys->Cqu));

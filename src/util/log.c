@@ -2,7 +2,7 @@
 #include <phlex.h>
 
 PetscClassId  PHLEX_CLASSID;
-PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp;
+PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult;
 PetscLogStage PHLEX_StageSetup = -1, PHLEX_StageTransient = -1, PHLEX_StageModes = -1;
 
 /*@C
@@ -19,6 +19,9 @@ PetscErrorCode PhlexLogRegister(void)
   PetscCall(PetscLogEventRegister("PhlexSysIFunc", PHLEX_CLASSID, &PHLEX_SysIFunction));
   PetscCall(PetscLogEventRegister("PhlexCondStage", PHLEX_CLASSID, &PHLEX_CondensedStage));
   PetscCall(PetscLogEventRegister("PhlexCondSetUp", PHLEX_CLASSID, &PHLEX_CondensedSetUp));
+  PetscCall(PetscLogEventRegister("PhlexRedStage", PHLEX_CLASSID, &PHLEX_ReducedStage));
+  PetscCall(PetscLogEventRegister("PhlexRedSetUp", PHLEX_CLASSID, &PHLEX_ReducedSetUp));
+  PetscCall(PetscLogEventRegister("PhlexRedJacMult", PHLEX_CLASSID, &PHLEX_ReducedJacobianMult));
   PetscCall(PetscLogEventRegister("PhlexSysIJac", PHLEX_CLASSID, &PHLEX_SysIJacobian));
   PetscCall(PetscLogEventRegister("PhlexMonEnergy", PHLEX_CLASSID, &PHLEX_MonitorEnergy));
   PetscCall(PetscLogEventRegister("PhlexModesSolve", PHLEX_CLASSID, &PHLEX_ModesSolve));

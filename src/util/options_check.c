@@ -228,6 +228,60 @@ PetscErrorCode PhlexOptionsSetUsedFromFile(const char file[], const char *const 
 }
 
 /*@C
+  PhlexOptionsSetUsedOverridden - marks as read a solver preset's factorization settings (-<prefix>pc_factor_*) of a
+  preconditioner whose type (-<prefix>pc_type) the command line, a scene or another options file changed: with PC
+  redundant or an iterative solver in place of the preset's Cholesky, the preset's factorization package is not
+  the user's mistake
+
+  Not Collective
+@*/
+PetscErrorCode PhlexOptionsSetUsedOverridden(const char file[])
+{
+  FILE *f;
+  char  line[1024];
+
+  PetscFunctionBeginUser;
+  if (!file || !file[0]) PetscFunctionReturn(0);
+  f = fopen(file, "r");
+  if (!f) PetscFunctionReturn(0);
+  while (fgets(line, sizeof(line), f)) {
+    char     *name = line, *end, *value, *suffix, option[256], now[256];
+    PetscBool set;
+    while (*name == ' ' || *name == '\t') name++;
+    if (name[0] != '-') continue;
+    for (end = name; *end && !isspace((unsigned char)*end) && *end != '#'; end++) {}
+    if (!*end) continue;
+    *end = 0;
+    for (value = end + 1; *value == ' ' || *value == '\t'; value++) {}
+    for (end = value; *end && !isspace((unsigned char)*end) && *end != '#'; end++) {}
+    *end   = 0;
+    suffix = strstr(name, "pc_type");
+    if (!suffix || strcmp(suffix, "pc_type") || !value[0]) continue;
+    PetscCall(PetscOptionsGetString(NULL, NULL, name, now, sizeof(now), &set));
+    if (!set || !strcasecmp(now, value)) continue;
+    /* the type was changed: the preset's -<prefix>pc_factor_* of this prefix are the other solver's */
+    *suffix = 0;
+    {
+      FILE *g = fopen(file, "r");
+      char  other[1024];
+      if (!g) continue;
+      PetscCall(PetscSNPrintf(option, sizeof(option), "%spc_factor_", name));
+      while (fgets(other, sizeof(other), g)) {
+        char *o = other, *oe;
+        while (*o == ' ' || *o == '\t') o++;
+        if (strncasecmp(o, option, strlen(option))) continue;
+        for (oe = o; *oe && !isspace((unsigned char)*oe) && *oe != '#'; oe++) {}
+        *oe = 0;
+        PetscCall(PetscOptionsHasName(NULL, NULL, o, &set)); /* a query marks the option as read */
+      }
+      fclose(g);
+    }
+  }
+  fclose(f);
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexOptionsWarnUnused - at the end of a run, a warning for every option that was never read
 
   Collective

@@ -1,0 +1,466 @@
+/* SNES "phlexreduced": the stage of the theta method for scenes with discrete unknowns (floating flexible bodies,
+   mechanisms: frames, joints, rigid bodies, lumped masses) by Newton on the velocities and discrete unknowns only,
+   the displacement and the stress eliminated exactly.
+
+   Each flexible body's field rows (paper eq. (ph-mixed); frame.c for a moving frame) are, in non-dimensional time,
+       T u' = v,    T Ms Sigma' = G v,    F_v(u, v, v', q, q') + G^T Sigma = 0,
+   and the stage X = X0 + theta dt X' (shift a = 1 / (theta dt), s = a T) satisfies the first two exactly for any v
+   when
+       u = u0 + v / s,    Sigma = Sigma_p + B (v - v0) / s,    Sigma_p = Sigma0 + B v0 / s,    B = Ms^{-1} G,
+   so Newton runs on the rows of v and of the discrete unknowns q (frames, impulses) alone, with
+       G^T Sigma = G^T Sigma_p + K (v - v0) / s
+   (K the element-assembled condensed stiffness, as SNES phlexcondensed's solve uses it; it differs from G^T B by
+   about 1e-11 relative on smooth fields, and only the increment sees it). The Jacobian of these rows is
+       [ Jvv + Jvu / s + K / s    Bvq ]      Jvv, Jvu  the velocity rows' own blocks (shift Mv + node-wise inertia),
+       [ Cqv + Cqu / s            D   ]      Bvq, Cq*  the borders (frames, joints' port maps), D the discrete block,
+   applied as a shell, and its preconditioner is PC phlexbordered on [[shift Mv + K/shift, B], [C, D]]: the factored
+   condensed operators (once per step size), the border bases solved once, a small dense Schur complement per Newton
+   step (pcbordered.c).
+
+   A Newton iteration costs one residual (products with Mv and K: velocity sized, no pass over the stress field) and
+   a few Krylov iterations, each one product with the shell and one sparse solve per body; a step adds three passes
+   over the stress field: B v0 and G^T Sigma_p before Newton, B (v - v0) after it. The generic path (Newton on the
+   whole state with a Schur field split) pays two products with G, one with G^T and one with Ms per residual, and
+   several per Krylov iteration.
+
+   Used when the scene has discrete unknowns and flexible bodies with constant operators (no geometric stiffening,
+   no prescribed spin) and the integrator is the theta method without endpoint (the default implicit midpoint,
+   backward Euler). The preset bordered.opts asks for it (-snes_type phlexreduced); where it does not apply the
+   transient analysis takes the preset's field split, unless -snes_type phlexreduced was typed on the command line
+   (then an error says why). The linear solve is KSP "reduced_" (the preset configures it). */
+#include <phlex_impl.h>
+#include <petsc/private/snesimpl.h>
+
+typedef struct {
+  PhlexSystem sys;
+  TS          ts;
+  KSP         ksp;      /* reduced_: Krylov on Jred, PC phlexbordered on the system's {velocity, discrete} operator */
+  Mat         Jred;     /* shell: the Jacobian of the velocity and discrete rows, u and Sigma eliminated */
+  Mat         K;        /* the bodies' condensed stiffnesses (block diagonal, velocity field numbering) */
+  Mat        *B;        /* per body Ms^{-1} G */
+  Vec         Xd, F;    /* whole state: rate, residual */
+  Vec         sp, bv;   /* stress field: Sigma_p, B v */
+  Vec         P, Pp, dv, wv; /* velocity field: G^T Sigma at the iterate and at Sigma_p, v - v0, work */
+  Vec         Z, Dz;    /* {velocity, discrete}: residual, Newton correction */
+  Vec         wq;       /* {discrete}: work */
+  IS          isv, isq; /* the blocks of the {velocity, discrete} vectors */
+  PetscReal   shift;    /* non-dimensional shift of the Jacobian (0: none yet) */
+  PetscReal   vrtol;    /* the velocity rows' convergence, relative to their residual at the initial guess */
+} SNES_Reduced;
+
+/* why a scene or an integrator cannot use the reduced Newton (empty: it can) */
+static PetscErrorCode Eligibility(PhlexSystem sys, TS ts, char why[], size_t len)
+{
+  PetscBool theta, beuler, endpoint = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  why[0] = 0;
+  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSTHETA, &theta));
+  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSBEULER, &beuler));
+  if (theta) PetscCall(TSThetaGetEndpoint(ts, &endpoint));
+  if (!sys->nfparts) PetscCall(PetscSNPrintf(why, len, "the scene has no flexible body"));
+  else if (!sys->nq) PetscCall(PetscSNPrintf(why, len, "the scene has no discrete unknowns (no frame, joint, rigid or lumped part: SNES phlexcondensed solves fixed bodies)"));
+  else if (sys->state_dependent_fields || sys->inexact_schur) PetscCall(PetscSNPrintf(why, len, "a body's field operators change with the state (geometric stiffening, spin)"));
+  else if (!(theta || beuler) || endpoint) {
+    TSType type;
+    PetscCall(TSGetType(ts, &type));
+    PetscCall(PetscSNPrintf(why, len, "the integrator is %s%s; the reduced stage is that of the theta method without endpoint (-ts_type theta, the default implicit midpoint, or beuler)", type, endpoint ? " with endpoint (Crank-Nicolson)" : ""));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESReducedApplicable - whether the scene and the integrator admit SNES phlexreduced
+
+  Collective
+@*/
+PetscErrorCode PhlexSNESReducedApplicable(PhlexSystem sys, TS ts, PetscBool *ok)
+{
+  char why[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(Eligibility(sys, ts, why, sizeof(why)));
+  *ok = why[0] ? PETSC_FALSE : PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESReducedSetSystem - hands SNES phlexreduced the scene's system and the TS whose stages it solves; an error
+  names what the scene or the integrator lacks
+
+  Collective
+@*/
+PetscErrorCode PhlexSNESReducedSetSystem(SNES snes, PhlexSystem sys, TS ts)
+{
+  SNES_Reduced *c = (SNES_Reduced *)snes->data;
+  char          why[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(Eligibility(sys, ts, why, sizeof(why)));
+  PetscCheck(!why[0], sys->comm, PETSC_ERR_USER_INPUT, "-snes_type phlexreduced cannot solve this scene's steps: %s; use -snes_type newtonls", why);
+  c->sys = sys;
+  c->ts  = ts;
+  PetscFunctionReturn(0);
+}
+
+/* y = Jred x: velocity rows (Jvv + Jvu / s) xv + K xv / s + Bvq xq, discrete rows (Cqv + Cqu / s) xv + D xq */
+static PetscErrorCode MatMult_Reduced(Mat A, Vec x, Vec y)
+{
+  SNES_Reduced *c;
+  PhlexSystem   sys;
+  Vec           xv, xq, yv, yq;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_ReducedJacobianMult, A, 0, 0, 0));
+  PetscCall(MatShellGetContext(A, &c));
+  sys = c->sys;
+  PetscCall(VecGetSubVector(x, c->isv, &xv));
+  PetscCall(VecGetSubVector(x, c->isq, &xq));
+  PetscCall(VecGetSubVector(y, c->isv, &yv));
+  PetscCall(VecGetSubVector(y, c->isq, &yq));
+  PetscCall(MatMult(c->K, xv, yv));
+  PetscCall(VecScale(yv, 1.0 / c->shift));
+  PetscCall(MatMultAdd(sys->Jvc, xv, yv, yv));
+  PetscCall(MatMult(sys->Bvq, xq, c->wv));
+  PetscCall(VecAXPY(yv, 1.0, c->wv));
+  PetscCall(MatMult(sys->Cpre, xv, yq)); /* Cv^T + Cu^T / shift, the joints' rows included */
+  PetscCall(MatMultAdd(sys->Dq, xq, yq, yq));
+  PetscCall(VecRestoreSubVector(y, c->isq, &yq));
+  PetscCall(VecRestoreSubVector(y, c->isv, &yv));
+  PetscCall(VecRestoreSubVector(x, c->isq, &xq));
+  PetscCall(VecRestoreSubVector(x, c->isv, &xv));
+  PetscCall(PetscLogEventEnd(PHLEX_ReducedJacobianMult, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESSetUp_Reduced(SNES snes)
+{
+  SNES_Reduced *c = (SNES_Reduced *)snes->data;
+  PhlexSystem   sys;
+  const char   *prefix;
+  PC            pc;
+
+  PetscFunctionBeginUser;
+  PetscCheck(c->sys, PetscObjectComm((PetscObject)snes), PETSC_ERR_ORDER, "SNES phlexreduced: PhlexSNESReducedSetSystem() was not called");
+  if (c->ksp) PetscFunctionReturn(0);
+  sys = c->sys;
+  PetscCheck(sys->Jvc, sys->comm, PETSC_ERR_PLIB, "SNES phlexreduced: a body has no velocity block with the displacement eliminated");
+  PetscCall(PetscLogEventBegin(PHLEX_ReducedSetUp, 0, 0, 0, 0));
+  PetscCall(KSPCreate(sys->comm, &c->ksp));
+  PetscCall(PetscObjectIncrementTabLevel((PetscObject)c->ksp, (PetscObject)snes, 1));
+  PetscCall(SNESGetOptionsPrefix(snes, &prefix));
+  PetscCall(KSPSetOptionsPrefix(c->ksp, prefix));
+  PetscCall(KSPAppendOptionsPrefix(c->ksp, "reduced_"));
+  /* defaults for a run without preset (the preset bordered.opts gives the same): the preconditioner is exact but for
+     the state-dependent inertia terms, so a few iterations of a Krylov method that accepts it converge */
+  PetscCall(KSPSetType(c->ksp, KSPFGMRES));
+  PetscCall(KSPSetTolerances(c->ksp, 1e-12, 0.0, PETSC_DEFAULT, 200));
+  PetscCall(KSPGetPC(c->ksp, &pc));
+  PetscCall(PCSetType(pc, "phlexbordered"));
+  PetscCall(KSPSetFromOptions(c->ksp));
+  PetscCall(PhlexSystemCreateStressMaps(sys, &c->B));
+  {
+    /* K = G^T B per body: the stress rows' elimination as the final Sigma = Sigma_p + B (v - v0) / s sees it (the
+       element-assembled condensed stiffness differs from it by about 1e-11 relative, which the velocity rows, held
+       to 1e-10 of their scale, would see) */
+    Mat *Kb;
+    PetscCall(PetscMalloc1(sys->nfparts, &Kb));
+    for (PetscInt i = 0; i < sys->nfparts; i++) {
+      PhlexFieldOperators ops;
+      PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+      PetscCall(MatTransposeMatMult(ops.G, c->B[i], MAT_INITIAL_MATRIX, PETSC_DEFAULT, &Kb[i]));
+    }
+    PetscCall(PhlexSystemBlockDiagonal(sys, Kb, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &c->K));
+    for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(MatDestroy(&Kb[i]));
+    PetscCall(PetscFree(Kb));
+  }
+  PetscCall(VecDuplicate(snes->vec_sol, &c->Xd));
+  PetscCall(VecDuplicate(snes->vec_sol, &c->F));
+  PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->P)); /* stress columns, velocity rows */
+  PetscCall(VecDuplicate(c->sp, &c->bv));
+  PetscCall(VecDuplicate(c->P, &c->Pp));
+  PetscCall(VecDuplicate(c->P, &c->dv));
+  PetscCall(VecDuplicate(c->P, &c->wv));
+  PetscCall(PetscLogEventEnd(PHLEX_ReducedSetUp, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* the {velocity, discrete} operator of PC phlexbordered and the shell on its layout (once the first Jacobian has set
+   the shift: the preconditioning matrix needs it) */
+static PetscErrorCode SetUpOperators(SNES_Reduced *c)
+{
+  PhlexSystem sys = c->sys;
+  Mat         Pvq;
+  PetscInt    fields[2] = {sys->field[PHLEX_FIELD_VELOCITY], sys->field[PHLEX_FIELD_DISCRETE]}, m, M;
+  IS          rows[2];
+
+  PetscFunctionBeginUser;
+  if (c->Jred) PetscFunctionReturn(0);
+  PetscCall(PhlexSystemPmat(sys, 2, fields, &Pvq));
+  PetscCall(MatNestGetISs(Pvq, rows, NULL));
+  PetscCall(PetscObjectReference((PetscObject)rows[0]));
+  PetscCall(PetscObjectReference((PetscObject)rows[1]));
+  c->isv = rows[0];
+  c->isq = rows[1];
+  PetscCall(MatGetLocalSize(Pvq, &m, NULL));
+  PetscCall(MatGetSize(Pvq, &M, NULL));
+  PetscCall(MatCreateShell(sys->comm, m, m, M, M, c, &c->Jred));
+  PetscCall(MatShellSetOperation(c->Jred, MATOP_MULT, (void (*)(void))MatMult_Reduced));
+  PetscCall(PetscObjectSetName((PetscObject)c->Jred, "reduced Jacobian"));
+  PetscCall(MatCreateVecs(Pvq, &c->Z, &c->Dz));
+  PetscCall(MatCreateVecs(sys->Dq, &c->wq, NULL));
+  PetscCall(KSPSetOperators(c->ksp, c->Jred, Pvq));
+  PetscFunctionReturn(0);
+}
+
+/* Z = [F_v; F_q] of the whole-state residual F (both blocks contiguous on every rank, in that order) */
+static PetscErrorCode GatherReduced(SNES_Reduced *c, Vec F, Vec Z)
+{
+  PhlexSystem sys = c->sys;
+  Vec         fv, fq, zv, zq;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetSubVector(F, sys->is[PHLEX_FIELD_VELOCITY], &fv));
+  PetscCall(VecGetSubVector(F, sys->is[PHLEX_FIELD_DISCRETE], &fq));
+  PetscCall(VecGetSubVector(Z, c->isv, &zv));
+  PetscCall(VecGetSubVector(Z, c->isq, &zq));
+  PetscCall(VecCopy(fv, zv));
+  PetscCall(VecCopy(fq, zq));
+  PetscCall(VecRestoreSubVector(Z, c->isq, &zq));
+  PetscCall(VecRestoreSubVector(Z, c->isv, &zv));
+  PetscCall(VecRestoreSubVector(F, sys->is[PHLEX_FIELD_DISCRETE], &fq));
+  PetscCall(VecRestoreSubVector(F, sys->is[PHLEX_FIELD_VELOCITY], &fv));
+  PetscFunctionReturn(0);
+}
+
+/* X_v -= Dz_v, X_q -= Dz_q, X_u = u0 + X_v / s */
+static PetscErrorCode Update(SNES_Reduced *c, Vec X, Vec X0, PetscReal s)
+{
+  PhlexSystem sys = c->sys;
+  Vec         xv, xq, xu, u0, dv, dq;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetSubVector(c->Dz, c->isv, &dv));
+  PetscCall(VecGetSubVector(c->Dz, c->isq, &dq));
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISCRETE], &xq));
+  PetscCall(VecAXPY(xv, -1.0, dv));
+  PetscCall(VecAXPY(xq, -1.0, dq));
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &xu));
+  PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_DISPLACEMENT], &u0));
+  PetscCall(VecWAXPY(xu, 1.0 / s, xv, u0));
+  PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_DISPLACEMENT], &u0));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &xu));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_DISCRETE], &xq));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+  PetscCall(VecRestoreSubVector(c->Dz, c->isq, &dq));
+  PetscCall(VecRestoreSubVector(c->Dz, c->isv, &dv));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESSolve_Reduced(SNES snes)
+{
+  SNES_Reduced      *c   = (SNES_Reduced *)snes->data;
+  PhlexSystem        sys = c->sys;
+  Vec                X   = snes->vec_sol, X0, s0, v0, xs, xv, xu, u0;
+  PetscReal          t, dt, theta, a, s, tstage, fnorm, xnorm, snorm = 0.0, fv, fv0, fvprev = 0.0;
+  PetscInt           its = 0;
+  KSPConvergedReason kreason;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscLogEventBegin(PHLEX_ReducedStage, 0, 0, 0, 0));
+  snes->reason = SNES_CONVERGED_ITERATING;
+  snes->iter   = 0;
+  snes->norm   = 0.0;
+  PetscCall(TSGetSolution(c->ts, &X0));
+  PetscCall(TSGetTime(c->ts, &t));
+  PetscCall(TSGetTimeStep(c->ts, &dt));
+  PetscCall(TSThetaGetTheta(c->ts, &theta));
+  a      = 1.0 / (theta * dt);
+  s      = a * sys->units->time;
+  tstage = t + theta * dt;
+  c->shift = s;
+
+  /* Sigma_p = Sigma0 + B v0 / s and its resultant G^T Sigma_p; the stage's stress block holds Sigma_p during Newton
+     (the residual does not read it; the norm of the state does) */
+  PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
+  PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
+  PetscCall(PhlexSystemStressMapsMult(sys, c->B, v0, c->bv));
+  PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
+  PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
+  PetscCall(MatMultTranspose(sys->Jsv, c->sp, c->Pp)); /* G^T, block diagonal over the bodies */
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
+  PetscCall(VecCopy(c->sp, xs));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
+  /* the initial guess's displacement consistent with its velocity */
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &xu));
+  PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_DISPLACEMENT], &u0));
+  PetscCall(VecWAXPY(xu, 1.0 / s, xv, u0));
+  PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_DISPLACEMENT], &u0));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &xu));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+
+  fv0 = -1.0;
+  for (;;) {
+    /* the residual at the iterate: X' = a (X - X0), G^T Sigma = G^T Sigma_p + K (v - v0) / s */
+    PetscCall(VecWAXPY(c->Xd, -1.0, X0, X));
+    PetscCall(VecScale(c->Xd, a));
+    PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+    PetscCall(VecWAXPY(c->dv, -1.0, v0, xv));
+    PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
+    PetscCall(MatMult(c->K, c->dv, c->P));
+    PetscCall(VecAYPX(c->P, 1.0 / s, c->Pp));
+    PetscCall(PhlexSystemReducedResidual(sys, tstage, X, c->Xd, c->P, c->F));
+    if (!c->Jred) {
+      /* the first Jacobian sets the shift the preconditioning matrix needs */
+      PetscCall(PhlexSystemIJacobian(c->ts, tstage, X, c->Xd, a, sys->J, sys->J, sys));
+      PetscCall(SetUpOperators(c));
+    }
+    PetscCall(GatherReduced(c, c->F, c->Z));
+    PetscCall(VecNorm(c->Z, NORM_2, &fnorm));
+    {
+      Vec zv;
+      PetscCall(VecGetSubVector(c->Z, c->isv, &zv));
+      PetscCall(VecNorm(zv, NORM_2, &fv));
+      PetscCall(VecRestoreSubVector(c->Z, c->isv, &zv));
+      if (fv0 < 0) fv0 = fv;
+    }
+    PetscCall(PetscInfo(snes, "Newton iteration %" PetscInt_FMT ": residual %g, of its velocity rows %g (%g of their initial value)\n", snes->iter, (double)fnorm, (double)fv, (double)(fv0 > 0 ? fv / fv0 : 0.0)));
+    PetscCall(VecNorm(X, NORM_2, &xnorm));
+    if (PetscIsInfOrNanReal(fnorm)) {
+      snes->reason = SNES_DIVERGED_FNORM_NAN;
+      break;
+    }
+    snes->norm  = fnorm;
+    snes->xnorm = xnorm;
+    snes->ynorm = snorm;
+    PetscCall(SNESLogConvergenceHistory(snes, fnorm, snes->iter ? its : 0));
+    PetscCall(SNESMonitor(snes, snes->iter, fnorm));
+    PetscUseTypeMethod(snes, converged, snes->iter, xnorm, snorm, fnorm, &snes->reason, snes->cnvP);
+    /* the velocity rows are orders of magnitude smaller than the discrete ones (mass-matrix entries, elastic
+       velocities): the norm of the whole residual does not see them, so they are also held to their own scale */
+    if (snes->reason > 0 && fv > c->vrtol * fv0 && !(snes->iter > 0 && fv > 0.5 * fvprev)) snes->reason = SNES_CONVERGED_ITERATING;
+    if (!snes->reason && snes->iter >= snes->max_its) snes->reason = SNES_DIVERGED_MAX_IT;
+    fvprev = fv;
+    if (snes->reason) break;
+    /* the Newton step: Jred dz = Z */
+    PetscCall(PhlexSystemIJacobian(c->ts, tstage, X, c->Xd, a, sys->J, sys->J, sys));
+    PetscCall(KSPSolve(c->ksp, c->Z, c->Dz));
+    PetscCall(KSPGetIterationNumber(c->ksp, &its));
+    PetscCall(KSPGetConvergedReason(c->ksp, &kreason));
+    snes->linear_its += its;
+    if (kreason < 0) {
+      snes->numLinearSolveFailures++;
+      snes->reason = SNES_DIVERGED_LINEAR_SOLVE;
+      break;
+    }
+    PetscCall(VecNorm(c->Dz, NORM_2, &snorm));
+    PetscCall(Update(c, X, X0, s));
+    snes->iter++;
+  }
+  PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
+  /* Sigma = Sigma_p + B (v - v0) / s: the stress whose resultant the momentum rows saw (through K) */
+  PetscCall(PhlexSystemStressMapsMult(sys, c->B, c->dv, c->bv));
+  PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
+  PetscCall(VecWAXPY(xs, 1.0 / s, c->bv, c->sp));
+  PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
+  PetscCall(PetscLogEventEnd(PHLEX_ReducedStage, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESReset_Reduced(SNES snes)
+{
+  SNES_Reduced *c = (SNES_Reduced *)snes->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPDestroy(&c->ksp));
+  PetscCall(MatDestroy(&c->Jred));
+  PetscCall(MatDestroy(&c->K));
+  if (c->B) {
+    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->B[i]));
+    PetscCall(PetscFree(c->B));
+  }
+  PetscCall(VecDestroy(&c->Xd));
+  PetscCall(VecDestroy(&c->F));
+  PetscCall(VecDestroy(&c->sp));
+  PetscCall(VecDestroy(&c->bv));
+  PetscCall(VecDestroy(&c->P));
+  PetscCall(VecDestroy(&c->Pp));
+  PetscCall(VecDestroy(&c->dv));
+  PetscCall(VecDestroy(&c->wv));
+  PetscCall(VecDestroy(&c->Z));
+  PetscCall(VecDestroy(&c->Dz));
+  PetscCall(VecDestroy(&c->wq));
+  PetscCall(ISDestroy(&c->isv));
+  PetscCall(ISDestroy(&c->isq));
+  c->shift = 0.0;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESDestroy_Reduced(SNES snes)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SNESReset_Reduced(snes));
+  PetscCall(PetscFree(snes->data));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESSetFromOptions_Reduced(SNES snes, PetscOptionItems *PetscOptionsObject)
+{
+  SNES_Reduced *c = (SNES_Reduced *)snes->data;
+
+  PetscFunctionBeginUser;
+  PetscOptionsHeadBegin(PetscOptionsObject, "SNES phlexreduced options");
+  PetscCall(PetscOptionsReal("-snes_phlexreduced_velocity_rtol", "Newton converges when also the velocity rows' residual is below this share of its value at the initial guess", "SNESPHLEXREDUCED", c->vrtol, &c->vrtol, NULL));
+  PetscOptionsHeadEnd();
+  PetscCheck(c->vrtol > 0 && c->vrtol < 1, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT, "-snes_phlexreduced_velocity_rtol must be in (0, 1), got %g", (double)c->vrtol);
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESView_Reduced(SNES snes, PetscViewer viewer)
+{
+  SNES_Reduced *c = (SNES_Reduced *)snes->data;
+  PetscBool     ascii;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
+  if (!ascii) PetscFunctionReturn(0);
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  Newton on the velocities and discrete unknowns of a theta-method stage, displacement and stress eliminated exactly; linear solve:\n"));
+  if (c->ksp) {
+    PetscCall(PetscViewerASCIIPushTab(viewer));
+    PetscCall(KSPView(c->ksp, viewer));
+    PetscCall(PetscViewerASCIIPopTab(viewer));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode SNESCreate_Reduced(SNES snes)
+{
+  SNES_Reduced *c;
+
+  PetscFunctionBeginUser;
+  snes->ops->setup                  = SNESSetUp_Reduced;
+  snes->ops->solve                  = SNESSolve_Reduced;
+  snes->ops->reset                  = SNESReset_Reduced;
+  snes->ops->destroy                = SNESDestroy_Reduced;
+  snes->ops->view                   = SNESView_Reduced;
+  snes->ops->setfromoptions         = SNESSetFromOptions_Reduced;
+  snes->usesksp                     = PETSC_FALSE; /* its own KSP, prefix reduced_ (the preset configures SNES's for the generic path) */
+  snes->usesnpc                     = PETSC_FALSE;
+  snes->alwayscomputesfinalresidual = PETSC_FALSE;
+  PetscCall(PetscNew(&c));
+  c->vrtol   = 1e-10;
+  snes->data = (void *)c;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESReducedRegister - registers the SNES type "phlexreduced"
+@*/
+PetscErrorCode PhlexSNESReducedRegister(void)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SNESRegister("phlexreduced", SNESCreate_Reduced));
+  PetscFunctionReturn(0);
+}
