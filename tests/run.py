@@ -795,6 +795,8 @@ def check_stdout(spec: Spec, cfg: Config, filtered: str, chk: Checker) -> None:
 
 def check_csvs(spec: Spec, cfg: Config, absdir: str, chk: Checker) -> None:
     """Compare (or, with --update, copy over) each produced CSV with its reference."""
+    seen_columns: set = set()
+    compared = False
     for produced, reference in spec.csv:
         ppath, rpath = os.path.join(absdir, produced), os.path.join(cfg.ref, reference)
         got = read_text(ppath)
@@ -812,10 +814,16 @@ def check_csvs(spec: Spec, cfg: Config, absdir: str, chk: Checker) -> None:
         if expected is None:
             chk.fail(f"missing reference {rel(rpath)} (create it with --update)")
             continue
+        seen_columns.update(parse_csv(expected).header)
+        compared = True
         result = compare_csv(expected, got, spec.csv_tol, spec.columns, label=produced, column_atol=spec.column_atol)
         chk.extend("", result.diffs)
         if cfg.verbose:
             chk.notes.extend(result.notes)
+    unknown = sorted(set(spec.column_atol or {}) - seen_columns)
+    if compared and unknown:
+        chk.fail(f"csv_column_atol names column{'s' if len(unknown) > 1 else ''} in no compared reference: "
+                 f"{', '.join(unknown)}")
 
 
 def check_files(spec: Spec, absdir: str, chk: Checker) -> None:

@@ -468,8 +468,9 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
   if (step == m->first_step + 1) {
     /* the preset's own options of the solver path not taken (a preset configures both) */
     const char *const generic[] = {"ksp_", "pc_", "fieldsplit_", NULL}, *const stage[] = {"condensed_", "reduced_", "snes_phlexreduced_", NULL};
+    const char *const newton[]  = {"ksp_", "pc_", "fieldsplit_", "snes_linesearch_", NULL}; /* phlexreduced takes full steps */
     PetscBool         typed;
-    PetscCall(PhlexOptionsSetUsedFromFile(m->preset, (m->condensed || m->reduced) ? generic : stage));
+    PetscCall(PhlexOptionsSetUsedFromFile(m->preset, m->reduced ? newton : (m->condensed ? generic : stage)));
     PetscCall(PhlexOptionsSetUsedOverridden(m->preset));
     PetscCall(PhlexOptionsCommandLineHasPrefix(generic, &typed));
     if (m->condensed && typed)
@@ -667,8 +668,12 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(PhlexOptionsCommandLineHasPrefix(snestype, &typed));
       if (applicable || typed) PetscCall(PhlexSNESReducedSetSystem(snes, sys, ts));
       else {
-        KSP            ksp;
-        SNESLineSearch ls;
+        KSP               ksp;
+        SNESLineSearch    ls;
+        const char *const own[] = {"snes_phlexreduced_", NULL};
+        PetscBool         given;
+        PetscCall(PhlexOptionsCommandLineHasPrefix(own, &given));
+        PetscCheck(!given, scene->comm, PETSC_ERR_USER_INPUT, "-snes_phlexreduced_* options have no effect on this run: its steps are solved by Newton with the field split (SNES newtonls), since the reduced Newton does not apply (a body with geometric stiffening or spin, or an integrator other than the theta method without endpoint)");
         PetscCall(SNESSetType(snes, SNESNEWTONLS));
         PetscCall(SNESGetKSP(snes, &ksp));
         PetscCall(KSPSetFromOptions(ksp));
@@ -684,6 +689,12 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       PetscCall(KSPSetOptionsPrefix(ksp, m.condensed ? "condensed_" : "reduced_"));
       PetscCall(KSPSetFromOptions(ksp));
       PetscCall(KSPDestroy(&ksp));
+      if (m.reduced && sys->njoints) {
+        /* the consistent start of a scene with joints takes Newton with the preset's field split */
+        PetscCall(KSPCreate(scene->comm, &ksp));
+        PetscCall(KSPSetFromOptions(ksp));
+        PetscCall(KSPDestroy(&ksp));
+      }
     }
   }
   if (PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {

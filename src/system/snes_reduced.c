@@ -9,8 +9,9 @@
        u = u0 + v / s,    Sigma = Sigma_p + B (v - v0) / s,    Sigma_p = Sigma0 + B v0 / s,    B = Ms^{-1} G,
    so Newton runs on the rows of v and of the discrete unknowns q (frames, impulses) alone, with
        G^T Sigma = G^T Sigma_p + K (v - v0) / s
-   (K the element-assembled condensed stiffness, as SNES phlexcondensed's solve uses it; it differs from G^T B by
-   about 1e-11 relative on smooth fields, and only the increment sees it). The Jacobian of these rows is
+   (K = G^T B, formed once by a sparse product, so that the residual's stress term is that of the final Sigma; the
+   element-assembled condensed stiffness differs from it by about 1e-11 relative, which the velocity rows, held to
+   1e-10 of their scale, would see). The Jacobian of these rows is
        [ Jvv + Jvu / s + K / s    Bvq ]      Jvv, Jvu  the velocity rows' own blocks (shift Mv + node-wise inertia),
        [ Cqv + Cqu / s            D   ]      Bvq, Cq*  the borders (frames, joints' port maps), D the discrete block,
    applied as a shell, and its preconditioner is PC phlexbordered on [[shift Mv + K/shift, B], [C, D]]: the factored

@@ -227,11 +227,37 @@ PetscErrorCode PhlexOptionsSetUsedFromFile(const char file[], const char *const 
   PetscFunctionReturn(0);
 }
 
+/* the value of an option as the database holds it, without marking it as read (PetscOptionsGetString would): found
+   in the text of PetscOptionsGetAll; "" if absent */
+static PetscErrorCode CurrentValue(const char name[], char value[], size_t len)
+{
+  char  *all, *tok, *end;
+  size_t n;
+
+  PetscFunctionBeginUser;
+  value[0] = 0;
+  PetscCall(PetscStrlen(name, &n));
+  PetscCall(PetscOptionsGetAll(NULL, &all));
+  for (tok = all; *tok; tok = end) {
+    while (*tok == ' ') tok++;
+    for (end = tok; *end && *end != ' '; end++) {}
+    if (tok[0] == '-' && (size_t)(end - tok - 1) == n && !strncasecmp(tok + 1, name, n)) {
+      char *v = end, *ve;
+      while (*v == ' ') v++;
+      for (ve = v; *ve && *ve != ' '; ve++) {}
+      if (*v != '-' || isdigit((unsigned char)v[1])) PetscCall(PetscStrncpy(value, v, PetscMin(len, (size_t)(ve - v) + 1)));
+      else value[0] = 0;
+    }
+  }
+  PetscCall(PetscFree(all));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexOptionsSetUsedOverridden - marks as read a solver preset's factorization settings (-<prefix>pc_factor_*) of a
-  preconditioner whose type (-<prefix>pc_type) the command line, a scene or another options file changed: with PC
-  redundant or an iterative solver in place of the preset's Cholesky, the preset's factorization package is not
-  the user's mistake
+  preconditioner whose type (-<prefix>pc_type) a scene or another options file changed: with PC redundant or an
+  iterative solver in place of the preset's Cholesky, the preset's factorization package is not the user's mistake.
+  Neither the type itself nor any option typed on the command line is marked: those are still checked.
 
   Not Collective
 @*/
@@ -246,7 +272,7 @@ PetscErrorCode PhlexOptionsSetUsedOverridden(const char file[])
   if (!f) PetscFunctionReturn(0);
   while (fgets(line, sizeof(line), f)) {
     char     *name = line, *end, *value, *suffix, option[256], now[256];
-    PetscBool set;
+    PetscBool set, given;
     while (*name == ' ' || *name == '\t') name++;
     if (name[0] != '-') continue;
     for (end = name; *end && !isspace((unsigned char)*end) && *end != '#'; end++) {}
@@ -257,8 +283,8 @@ PetscErrorCode PhlexOptionsSetUsedOverridden(const char file[])
     *end   = 0;
     suffix = strstr(name, "pc_type");
     if (!suffix || strcmp(suffix, "pc_type") || !value[0]) continue;
-    PetscCall(PetscOptionsGetString(NULL, NULL, name, now, sizeof(now), &set));
-    if (!set || !strcasecmp(now, value)) continue;
+    PetscCall(CurrentValue(name + 1, now, sizeof(now)));
+    if (!now[0] || !strcasecmp(now, value)) continue;
     /* the type was changed: the preset's -<prefix>pc_factor_* of this prefix are the other solver's */
     *suffix = 0;
     {
@@ -272,6 +298,8 @@ PetscErrorCode PhlexOptionsSetUsedOverridden(const char file[])
         if (strncasecmp(o, option, strlen(option))) continue;
         for (oe = o; *oe && !isspace((unsigned char)*oe) && *oe != '#'; oe++) {}
         *oe = 0;
+        PetscCall(OnCommandLine(o + 1, &given));
+        if (given) continue;
         PetscCall(PetscOptionsHasName(NULL, NULL, o, &set)); /* a query marks the option as read */
       }
       fclose(g);
