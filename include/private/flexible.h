@@ -158,6 +158,11 @@ struct _p_PhlexFlexible {
   PetscBool           floating;         /* rigid motion of the frame is an unknown */
   PhlexFrameCondition frame_condition;  /* patch or mean axes */
   PetscBool           frozen_inertia;   /* mass operator at u_f = 0 (models constant, constant_without_gyroscopic) */
+  PetscReal           pc_rate_tol;      /* > 0: the factored condensed operator takes the node-wise inertia terms of the
+                                           frame's rate once they exceed this share of the shift, and again whenever they
+                                           drift by as much (0: never) */
+  PetscReal           pc_rate_B[9];     /* the node-wise block Bvv + Bvu / shift in the factored operator (0: none) */
+  PetscInt            pc_rate_count;    /* refactorizations for the rate */
   PetscBool           gyroscopic;       /* with it: the gyroscopic loads kept (constant) */
   const char         *inertia_model;    /* full, constant, constant_without_gyroscopic */
   PetscReal           origin[3];        /* frame origin P (SI mesh coordinates) */

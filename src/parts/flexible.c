@@ -50,7 +50,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   char         *rptr[PHLEX_MAX_MATERIALS + 1], **pptr; /* room for one more region: too many are refused, not cut */
   PetscInt      nregions = PHLEX_MAX_MATERIALS + 1, nports;
   PetscBool     flg, flg_mesh = PETSC_FALSE, has_body_material, fcond = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE;
-  PetscBool     spin_given = PETSC_FALSE, center_given = PETSC_FALSE;
+  PetscBool     spin_given = PETSC_FALSE, center_given = PETSC_FALSE, rate_given = PETSC_FALSE;
   PetscInt      motion = 0, inertia = 0, cond = PHLEX_FRAME_PATCH;
   const char   *given = NULL;
   char          who[PHLEX_NAME_LEN + 8];
@@ -89,6 +89,8 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-frame_moment", "Floating body: moment about the frame origin P (body frame) [N m]", "PhlexFlexibleSetFromOptions", 3, b->frame_moment, &fm));
   PetscCall(PetscOptionsBool("-geometric_stiffening", "Green-Lagrange strain of the field in its frame (Saint Venant-Kirchhoff): the stress stiffens the field against transverse displacement (centrifugal stiffening of a spinning beam); the power balance still holds exactly", "PhlexFlexibleSetFromOptions", b->stiffening, &b->stiffening, NULL));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin", "Fixed body: constant angular velocity of its hub; the body's frame rotates uniformly about -spin_center (inertial loads of the rotating frame; the linearised analysis linearises about the steady spin) [rad/s]", "PhlexFlexibleSetFromOptions", 3, b->spin, &spin_given));
+  b->pc_rate_tol = 1e-3;
+  PetscCall(PetscOptionsReal("-preconditioner_rate_tol", "Floating body: once the Coriolis and centrifugal terms of the frame's angular velocity exceed this share of the step's shift (about w dt), the preconditioner factors them with the condensed operator (not symmetric: LU instead of Cholesky), and again whenever they drift by as much; 0: never (the symmetric operator without them)", "PhlexFlexibleSetFromOptions", b->pc_rate_tol, &b->pc_rate_tol, &rate_given));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin_center", "Fixed body with -spin: a point of the spin axis (mesh coordinates) [m]", "PhlexFlexibleSetFromOptions", 3, b->spin_center, &center_given));
   PetscOptionsEnd();
   b->spinning = (PetscBool)(spin_given && (b->spin[0] != 0 || b->spin[1] != 0 || b->spin[2] != 0));
@@ -103,9 +105,10 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   b->gyroscopic     = inertia == 1 ? PETSC_TRUE : PETSC_FALSE;
   b->inertia_model  = PhlexInertiaTypes[inertia];
   b->frame_loaded   = (ff || fm) ? PETSC_TRUE : PETSC_FALSE;
+  PetscCheck(b->pc_rate_tol >= 0 && !PetscIsInfOrNanReal(b->pc_rate_tol), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%spreconditioner_rate_tol must be >= 0 (0: off), got %g", b->name, b->prefix, (double)b->pc_rate_tol);
   /* a fixed body has no rigid state: its rigid options would be silently ignored */
   if (!b->floating) {
-    if (!given) given = ff ? "frame_force" : fm ? "frame_moment" : fcond ? "frame" : b->origin_given ? "frame_origin" : NULL;
+    if (!given) given = ff ? "frame_force" : fm ? "frame_moment" : fcond ? "frame" : b->origin_given ? "frame_origin" : (rate_given && b->pc_rate_tol > 0) ? "preconditioner_rate_tol" : NULL;
     PetscCheck(!given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%s%s describes the rigid motion of a floating frame; the body is fixed (-%smotion fixed): add -%smotion floating or remove the option", b->name, b->prefix, given, b->prefix, b->prefix);
   } else {
     /* the frame condition: as given, else the frame patch if there is one, else mean axes */

@@ -587,6 +587,41 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   PetscFunctionReturn(0);
 }
 
+/* Sv = K / shift + (shift I + B) Mv with B node-wise (3x3): the condensed operator with the node-wise inertia terms
+   of the frame's rate (Coriolis, centrifugal), on Sv's pattern (full 3x3 blocks, those of K); not symmetric */
+static PetscErrorCode RateOperator(PhlexFlexible b, PetscReal shift, const PetscReal B[9])
+{
+  PetscInt rstart, rend;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCopy(b->Kaij, b->Sv, b->kpattern));
+  PetscCall(MatScale(b->Sv, 1.0 / shift));
+  PetscCall(MatGetOwnershipRange(b->Mvaij, &rstart, &rend));
+  for (PetscInt row = rstart; row < rend; row++) {
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscInt           nc, n = 0, c = row % 3, *idx;
+    PetscScalar       *v;
+    PetscCall(MatGetRow(b->Mvaij, row, &nc, &cols, &vals));
+    PetscCall(PetscMalloc2(3 * nc, &idx, 3 * nc, &v));
+    for (PetscInt k = 0; k < nc; k++) {
+      if (cols[k] % 3 != c || vals[k] == 0.0) continue; /* Mv couples equal components only */
+      for (PetscInt d = 0; d < 3; d++) {
+        idx[n] = cols[k] - c + d;
+        v[n++] = vals[k] * ((c == d ? shift : 0.0) + B[3 * c + d]);
+      }
+    }
+    PetscCall(MatRestoreRow(b->Mvaij, row, &nc, &cols, &vals));
+    PetscCall(MatSetValues(b->Sv, 1, &row, n, idx, v, ADD_VALUES));
+    PetscCall(PetscFree2(idx, v));
+  }
+  PetscCall(MatAssemblyBegin(b->Sv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(b->Sv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_FALSE));
+  PetscCall(MatSetOption(b->Sv, MAT_SYMMETRIC, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
 /* the derivatives of the inputs with directions fixed in the inertial frame with respect to R (own columns) */
 static PetscErrorCode InertialLoadsJacobian(PhlexPart part, PetscReal Arr[324])
 {
@@ -661,6 +696,24 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   PetscCall(PetscLogEventBegin(PHLEX_FloatJacobian, 0, 0, 0, 0));
   PetscCall(AddJointLoads(part));
   PetscCall(PhlexFrameJacobian(&b->frame, &b->fs, shift, X->u, X->v, b->Bc, b->Cu, b->Cv, n, b->Bvv, b->Bvu, Arr));
+  if (new_shift || b->stiffening)
+    for (PetscInt k = 0; k < 9; k++) b->pc_rate_B[k] = 0.0; /* Sv was rebuilt above without the rate's terms */
+  if (b->pc_rate_tol > 0 && !b->stiffening) {
+    /* the preconditioner's operator with the node-wise terms of the rate once they exceed the tolerance, refactored
+       when they drift by as much again (not with geometric stiffening: its operator is rebuilt at every Jacobian,
+       and LU would double that) */
+    PetscReal B[9], d = 0.0;
+    for (PetscInt k = 0; k < 9; k++) {
+      B[k] = b->Bvv[k] + b->Bvu[k] / shift;
+      d += PetscSqr(B[k] - b->pc_rate_B[k]);
+    }
+    if (PetscSqrtReal(d) > b->pc_rate_tol * shift) {
+      PetscCall(RateOperator(b, shift, B));
+      for (PetscInt k = 0; k < 9; k++) b->pc_rate_B[k] = B[k];
+      b->pc_rate_count++;
+      PetscCall(PetscInfo(NULL, "body %s: condensed operator refactored with the frame's rate (%" PetscInt_FMT " time(s))\n", b->name, b->pc_rate_count));
+    }
+  }
   PetscCall(InertialLoadsJacobian(part, Arr));
   if (b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
     /* rows T^T v and the force -T mu': column c (translation) t(l) e_c, column a (rotation) e_a x w(l) */

@@ -93,6 +93,24 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     if (pb->Astate[i] == sa && pb->Wstate[i] == sw && (pb->Y[i] || !bd->W[i])) continue;
     PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pc, 0, 0, 0));
     PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
+    {
+      /* a body whose condensed operator is not symmetric (the node-wise inertia of its frame's rate) takes LU where
+         Cholesky was asked for, with the same factorization package */
+      PC        inner;
+      PetscBool chol, set, symm;
+      PetscCall(KSPGetPC(pb->ksp[i], &inner));
+      PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCCHOLESKY, &chol));
+      PetscCall(MatIsSymmetricKnown(bd->A[i], &set, &symm));
+      if (chol && set && !symm) {
+        MatSolverType type;
+        char          package[64] = "";
+        PetscCall(PCFactorGetMatSolverType(inner, &type));
+        if (type) PetscCall(PetscStrncpy(package, type, sizeof(package)));
+        PetscCall(PCSetType(inner, PCLU));
+        if (package[0]) PetscCall(PCFactorSetMatSolverType(inner, package));
+        PetscCall(PetscInfo(pc, "block %" PetscInt_FMT ": not symmetric, LU instead of Cholesky\n", i));
+      }
+    }
     PetscCall(KSPSetUp(pb->ksp[i]));
     PetscCall(MatDestroy(&pb->Y[i]));
     if (bd->W[i]) {
