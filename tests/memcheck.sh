@@ -13,6 +13,7 @@ pass=0; fail=0
 cases='cantilever_p1|-options_file options/cantilever.yaml -ts_max_steps 2 -body0_petscspace_degree 1 -body0_ic_velocity_type beam -body0_ic_velocity_direction 0,0,1|0
 modes_p1|-options_file options/cantilever_modes.yaml -modes_nev 2 -body0_petscspace_degree 1|0
 floating_modes|-options_file options/free_bar_modes.yaml -modes_nev 2 -body0_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1|0
+floating_rate|-options_file options/floating_tumbling.yaml -body0_dm_plex_filename meshes/bar_struct_n2.msh -ts_max_steps 3 -output_fields 0|0
 double_pendulum|-options_file options/double_pendulum.yaml -ts_max_steps 3|0
 heavy_top|-options_file options/heavy_top.yaml -ts_max_steps 3|0
 swinging_tip_body|-options_file tests/scenes/swinging_tip_body.yaml -ts_max_steps 2|0
