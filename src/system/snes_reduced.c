@@ -43,7 +43,6 @@ typedef struct {
   Vec         sp, bv;   /* stress field: Sigma_p, B v */
   Vec         P, Pp, dv, wv; /* velocity field: G^T Sigma at the iterate and at Sigma_p, v - v0, work */
   Vec         Z, Dz;    /* {velocity, discrete}: residual, Newton correction */
-  Vec         wq;       /* {discrete}: work */
   IS          isv, isq; /* the blocks of the {velocity, discrete} vectors */
   PetscReal   shift;    /* non-dimensional shift of the Jacobian (0: none yet) */
   PetscReal   vrtol;    /* the velocity rows' convergence, relative to their residual at the initial guess */
@@ -209,7 +208,6 @@ static PetscErrorCode SetUpOperators(SNES_Reduced *c)
   PetscCall(MatShellSetOperation(c->Jred, MATOP_MULT, (void (*)(void))MatMult_Reduced));
   PetscCall(PetscObjectSetName((PetscObject)c->Jred, "reduced Jacobian"));
   PetscCall(MatCreateVecs(Pvq, &c->Z, &c->Dz));
-  PetscCall(MatCreateVecs(sys->Dq, &c->wq, NULL));
   PetscCall(KSPSetOperators(c->ksp, c->Jred, Pvq));
   PetscFunctionReturn(0);
 }
@@ -392,7 +390,6 @@ static PetscErrorCode SNESReset_Reduced(SNES snes)
   PetscCall(VecDestroy(&c->wv));
   PetscCall(VecDestroy(&c->Z));
   PetscCall(VecDestroy(&c->Dz));
-  PetscCall(VecDestroy(&c->wq));
   PetscCall(ISDestroy(&c->isv));
   PetscCall(ISDestroy(&c->isq));
   c->shift = 0.0;
