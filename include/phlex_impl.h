@@ -144,6 +144,9 @@ PETSC_INTERN PetscErrorCode PhlexOptionsListLength(const char[], const char[], P
 PETSC_INTERN PetscErrorCode PhlexExpectMax(MPI_Comm, const char[], const char[], PetscReal, PetscReal, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexExpectValues(MPI_Comm, const char[], const char[], PetscInt, const PetscReal[], PetscInt, const PetscReal[], PetscReal);
 
+/* mat_shell.c: shell matrices without a transpose */
+PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, PetscInt, PetscInt, void *, PetscErrorCode (*)(Mat, Vec, Vec), Mat *);
+
 /* format.c: numbers echoed to the user at full precision */
 PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);
 

@@ -529,12 +529,9 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
     if (!b->floating) {
       PetscCall(MatDuplicate(b->Mvaij, MAT_COPY_VALUES, &b->Jvv));
     } else {
-      PetscCall(MatCreateShell(b->comm, n, n, N, N, b, &b->Jvv));
-      PetscCall(MatShellSetOperation(b->Jvv, MATOP_MULT, (void (*)(void))MatMult_Avv));
-      PetscCall(MatCreateShell(b->comm, n, n, N, N, b, &b->Jvu));
-      PetscCall(MatShellSetOperation(b->Jvu, MATOP_MULT, (void (*)(void))MatMult_Avu));
-      PetscCall(MatCreateShell(b->comm, n, n, N, N, b, &b->Jvc));
-      PetscCall(MatShellSetOperation(b->Jvc, MATOP_MULT, (void (*)(void))MatMult_Avc));
+      PetscCall(PhlexMatCreateShell(b->comm, n, n, N, N, b, MatMult_Avv, &b->Jvv));
+      PetscCall(PhlexMatCreateShell(b->comm, n, n, N, N, b, MatMult_Avu, &b->Jvu));
+      PetscCall(PhlexMatCreateShell(b->comm, n, n, N, N, b, MatMult_Avc, &b->Jvc));
       PetscCall(VecDuplicate(b->load, &b->ud));
       PetscCall(VecDuplicate(b->load, &b->vd));
       PetscCall(PetscCalloc4(PetscMax(n * part->nq, 1), &b->Bc, PetscMax(n * part->nq, 1), &b->Cu, PetscMax(n * part->nq, 1), &b->Cv, PetscMax(n * part->nq, 1), &b->Cpre));

@@ -126,8 +126,7 @@ static PetscErrorCode MatMult_Cpre(Mat A, Vec x, Vec y)
 static PetscErrorCode CreateShell(PhlexSystem sys, PetscInt m, PetscInt n, PetscInt M, PetscInt N, PetscErrorCode (*mult)(Mat, Vec, Vec), const char name[], Mat *A)
 {
   PetscFunctionBeginUser;
-  PetscCall(MatCreateShell(sys->comm, m, n, M, N, sys, A));
-  PetscCall(MatShellSetOperation(*A, MATOP_MULT, (void (*)(void))mult));
+  PetscCall(PhlexMatCreateShell(sys->comm, m, n, M, N, sys, mult, A));
   PetscCall(PetscObjectSetName((PetscObject)*A, name));
   PetscFunctionReturn(0);
 }

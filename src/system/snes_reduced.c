@@ -204,8 +204,7 @@ static PetscErrorCode SetUpOperators(SNES_Reduced *c)
   c->isq = rows[1];
   PetscCall(MatGetLocalSize(Pvq, &m, NULL));
   PetscCall(MatGetSize(Pvq, &M, NULL));
-  PetscCall(MatCreateShell(sys->comm, m, m, M, M, c, &c->Jred));
-  PetscCall(MatShellSetOperation(c->Jred, MATOP_MULT, (void (*)(void))MatMult_Reduced));
+  PetscCall(PhlexMatCreateShell(sys->comm, m, m, M, M, c, MatMult_Reduced, &c->Jred));
   PetscCall(PetscObjectSetName((PetscObject)c->Jred, "reduced Jacobian"));
   PetscCall(MatCreateVecs(Pvq, &c->Z, &c->Dz));
   PetscCall(KSPSetOperators(c->ksp, c->Jred, Pvq));
