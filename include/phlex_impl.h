@@ -147,6 +147,9 @@ PETSC_INTERN PetscErrorCode PhlexExpectValues(MPI_Comm, const char[], const char
 /* mat_shell.c: shell matrices without a transpose */
 PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, PetscInt, PetscInt, void *, PetscErrorCode (*)(Mat, Vec, Vec), Mat *);
 
+/* mat_block_mult.c: a matrix times a block of vectors */
+PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
+
 /* format.c: numbers echoed to the user at full precision */
 PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);
 

@@ -141,6 +141,7 @@ struct _p_PhlexFlexible {
   PetscInt            ngroups;
   PhlexPhysicalGroup *groups;
   PetscInt            degree;            /* velocity P_k, stress P_{k-1} discontinuous */
+  PetscBool           rcm;               /* the mesh's points renumbered by reverse Cuthill-McKee (-node_order rcm) */
   PetscInt            extra_refinements; /* uniform refinements on top of -dm_refine (convergence studies) */
   char                frame_patch[PHLEX_NAME_LEN]; /* Dirichlet patch Gamma_D ("" for none) */
   PetscInt            frame_tag;

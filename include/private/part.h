@@ -133,6 +133,8 @@ struct _p_PhlexPart {
   char              prefix[32];
   char              name[PHLEX_NAME_LEN];
   char              type[32];
+  char              numbering[16]; /* how its field unknowns are numbered when not as read ("": as read), part of a
+                                      checkpoint's fingerprint */
   PhlexPartOps      ops;
   void             *data;
   const PhlexUnits *units;

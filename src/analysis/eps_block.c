@@ -166,8 +166,13 @@ static PetscErrorCode ApplyB(EPS eps, BV X, BV BX)
   PetscFunctionBegin;
   if (eps->isgeneralized) {
     Mat B;
+    Mat Xm, Ym;
     PetscCall(STGetMatrix(eps->st, 1, &B));
-    PetscCall(BVMatMult(X, B, BX));
+    PetscCall(BVGetMat(X, &Xm));
+    PetscCall(BVGetMat(BX, &Ym));
+    PetscCall(PhlexMatMultBlock(B, Xm, Ym));
+    PetscCall(BVRestoreMat(BX, &Ym));
+    PetscCall(BVRestoreMat(X, &Xm));
   } else PetscCall(BVCopy(X, BX));
   PetscFunctionReturn(0);
 }

@@ -60,7 +60,7 @@ static PetscErrorCode Fingerprint(MonitorContext *m, char **fingerprint, PetscRe
   *fingerprint = parts;
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PetscCall(PetscStrlen(parts, &n));
-    PetscCall(PetscSNPrintf(parts + n, len - n, "%s%s:%s:%" PetscInt_FMT ":%" PetscInt_FMT, i ? " " : "", sys->parts[i]->name, sys->parts[i]->type, sys->parts[i]->Nu + sys->parts[i]->Ns + sys->parts[i]->Nv, sys->parts[i]->nq));
+    PetscCall(PetscSNPrintf(parts + n, len - n, "%s%s:%s:%" PetscInt_FMT ":%" PetscInt_FMT "%s%s", i ? " " : "", sys->parts[i]->name, sys->parts[i]->type, sys->parts[i]->Nu + sys->parts[i]->Ns + sys->parts[i]->Nv, sys->parts[i]->nq, sys->parts[i]->numbering[0] ? ":" : "", sys->parts[i]->numbering));
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
     PetscCall(PetscStrlen(parts, &n));
@@ -274,7 +274,7 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
   PetscCall(PetscStrcmp(parts, ck_parts, &same));
   if (!same) {
     char msg[PETSC_MAX_PATH_LEN];
-    PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for another scene: its parts and joints (name:kind:field unknowns:discrete unknowns) are '%s', this scene's '%s'", file, ck_parts, parts));
+    PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for another scene: its parts and joints (name:kind:field unknowns:discrete unknowns[:numbering of the unknowns, -body<k>_node_order]) are '%s', this scene's '%s'", file, ck_parts, parts));
     PetscCall(PetscFree(parts));
     PetscCall(PetscFree(ck_parts));
     SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);

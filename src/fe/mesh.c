@@ -289,6 +289,23 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
   }
 
   PetscCallMPI(MPI_Comm_size(body->comm, &size));
+  {
+    PetscBool reorder;
+    PetscCall(PetscOptionsHasName(NULL, body->prefix, "-dm_plex_reorder", &reorder));
+    PetscCheck(!reorder, body->comm, PETSC_ERR_USER_INPUT, "body %s: -%sdm_plex_reorder: phlex numbers the mesh before distributing it (PETSc's reordering comes after, and breaks a distributed mesh); use -%snode_order rcm (the default) or file", body->name, body->prefix, body->prefix);
+  }
+  if (body->rcm) {
+    /* on the reading rank, before the distribution (DMPlexPermute ignores a distributed mesh's star forest); the
+       labels (physical groups) follow their points */
+    IS perm;
+    DM pdm;
+    PetscCall(DMPlexGetOrdering(dm, MATORDERINGRCM, NULL, &perm));
+    PetscCall(DMPlexPermute(dm, perm, &pdm));
+    PetscCall(ISDestroy(&perm));
+    PetscCall(DMDestroy(&dm));
+    dm = pdm;
+    PetscCall(PetscObjectSetName((PetscObject)dm, body->name));
+  }
   PetscCall(DMSetOptionsPrefix(dm, body->prefix));
   PetscCall(DMPlexGetPartitioner(dm, &part));
   PetscCall(PetscObjectSetOptionsPrefix((PetscObject)part, body->prefix));
