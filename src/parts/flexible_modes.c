@@ -136,6 +136,10 @@ PetscErrorCode PhlexModesEPSCreate(MPI_Comm comm, EPS *eps, PetscReal *ftarget, 
   PetscCall(EPSSetPurify(*eps, PETSC_FALSE));
   PetscCall(EPSGetST(*eps, &st));
   PetscCall(STSetType(st, STSINVERT));
+  /* A - sigma B formed in A's storage (and A restored after the solve) rather than in a copy: 85 MB less at 2.2e5
+     DOFs with a nonzero shift (free bodies), the same eigenpairs to the last digit (BENCHMARKS.md section 12);
+     -modes_st_matmode copy restores the copy */
+  PetscCall(STSetMatMode(st, ST_MATMODE_INPLACE));
   PetscCall(STGetKSP(st, &ksp));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
   PetscCall(KSPGetPC(ksp, &pc));
