@@ -386,6 +386,7 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(PhlexFrameStateDestroy(&b->fs));
   PetscCall(MatDestroy(&b->Gt));
   PetscCall(MatDestroy(&b->Mvaij));
+  PetscCall(MatDestroy(&b->Mvp));
   PetscCall(MatDestroy(&b->Kaij));
   PetscCall(MatDestroy(&b->Jvv));
   PetscCall(MatDestroy(&b->Jvu));

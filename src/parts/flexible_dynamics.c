@@ -389,7 +389,7 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
   if (b->floating) PetscCall(VecAXPY(F->v, 1.0, b->fs.Mvd));
   else {
     PetscCall(VecScale(F->v, 1.0 / T));
-    PetscCall(MatMultAdd(b->Mv, Xdot->v, F->v, F->v));
+    PetscCall(MatMultAdd(b->Mvp ? b->Mvp : b->Mv, Xdot->v, F->v, F->v));
     PetscCall(VecScale(F->v, T));
   }
   if (!b->floating) {
@@ -452,13 +452,34 @@ static PetscErrorCode FlexPostStep(PhlexPart part, PetscReal *q, PetscReal *defe
 /* Jacobian                                                                                                       */
 
 /* y = (a I + B) Mv x with B a node-wise 3x3 matrix: the elastic blocks of the moving frame */
+/* Mv = M (x) I_3 (the mass couples each velocity component only with itself): its products go through the scalar
+   mass M in a MAIJ matrix, which reads a ninth of Mv's entries (Mv's 3x3 blocks are diagonal, SBAIJ stores them
+   whole); M is Mv's rows and columns of the x components */
+static PetscErrorCode MassProductSetUp(PhlexFlexible b)
+{
+  IS       isx;
+  Mat      M;
+  PetscInt rstart, rend;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetOwnershipRange(b->Mvaij, &rstart, &rend));
+  PetscCall(ISCreateStride(b->comm, (rend - rstart) / 3, rstart, 3, &isx));
+  PetscCall(MatCreateSubMatrix(b->Mvaij, isx, isx, MAT_INITIAL_MATRIX, &M));
+  PetscCall(ISDestroy(&isx));
+  PetscCall(MatCreateMAIJ(M, 3, &b->Mvp));
+  PetscCall(MatDestroy(&M));
+  PetscCall(PetscObjectSetName((PetscObject)b->Mvp, "velocity mass (products)"));
+  if (b->floating) b->frame.Mv = b->Mvp;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode NodeMassMult(PhlexFlexible b, PetscReal a, const PetscReal B[9], Vec x, Vec y)
 {
   PetscScalar *ya;
   PetscInt     n;
 
   PetscFunctionBeginUser;
-  PetscCall(MatMult(b->Mv, x, y));
+  PetscCall(MatMult(b->Mvp, x, y));
   PetscCall(VecGetLocalSize(y, &n));
   PetscCall(VecGetArray(y, &ya));
   for (PetscInt l = 0; l < n / 3; l++) {
@@ -517,6 +538,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
     PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
     PetscCall(MatTranspose(b->G, MAT_INITIAL_MATRIX, &b->Gt));
     PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    PetscCall(MassProductSetUp(b));
     /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv */
     PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
     PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));

@@ -544,7 +544,7 @@ PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible b, Vec v, Vec s, PetscReal *kin
   if (!b->ews) PetscCall(VecDuplicate(s, &b->ews));
   wv = b->ewv;
   ws = b->ews;
-  PetscCall(MatMult(b->Mv, v, wv));
+  PetscCall(MatMult(b->Mvp ? b->Mvp : b->Mv, v, wv));
   PetscCall(VecDot(wv, v, &e));
   *kinetic = 0.5 * PetscRealPart(e);
   PetscCall(MatMult(b->Ms, s, ws));
