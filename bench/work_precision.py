@@ -14,9 +14,15 @@
 
 Writes bench/results/work_precision_<case>.csv and, when matplotlib is installed, .png beside them.
 
+Dimensions beyond the discretisation (each a comma-separated list; every point is run for each value):
+  --np        ranks (mpiexec -n)
+  --presets   transient and mechanism: solver presets options/solver/<name>.opts (default: the scene's own)
+  --eps-types modes: eigensolvers (-modes_eps_type: phlexblock, krylovschur, ...)
+
 usage: bench/work_precision.py [--cases transient,modes,mechanism] [--mesh meshes/bench/bar_h0.02.msh]
                                [--meshes meshes/bar_h0.05.msh,meshes/bench/bar_h0.02.msh,meshes/bench/bar_h0.01.msh]
-                               [--coupler-cells 8,16,32] [--mechanism-dts 4e-5,2e-5,1e-5] [--np 1] [--phlex bin/phlex]
+                               [--coupler-cells 8,16,32] [--mechanism-dts 4e-5,2e-5,1e-5] [--np 1,2]
+                               [--presets exact,iterative] [--eps-types phlexblock,krylovschur] [--phlex bin/phlex]
 """
 import argparse
 import csv
@@ -57,6 +63,16 @@ def launcher(np_):
     return ["mpiexec", "-n", str(np_)] if np_ > 1 else []
 
 
+def preset_options(preset):
+    """the options of a solver preset ("" or "default": the scene's own)"""
+    if preset in ("", "default"):
+        return []
+    path = os.path.join("options", "solver", preset + ".opts")
+    if not os.path.exists(os.path.join(ROOT, path)):
+        sys.exit("no solver preset %s" % path)
+    return ["-solver_options_file", path]
+
+
 def last_row(path):
     with open(path) as f:
         rows = list(csv.DictReader(f))
@@ -68,10 +84,11 @@ def transient(a, out):
     dts = [float(x) for x in a.dts.split(",")]
     outdir = tempfile.mkdtemp(prefix="phlex_wp_")
 
-    def one(scheme, dt):
-        cmd = launcher(a.np) + [a.phlex, "-options_file", "options/cantilever_tip_load.yaml", "-body0_dm_plex_filename",
-                                a.mesh, "-ts_dt", repr(dt), "-ts_max_time", repr(tend), "-ts_max_steps", "100000000",
-                                "-output_fields", "0", "-output_dir", outdir, "-progress", "0"] + SCHEMES[scheme]
+    def one(scheme, dt, np_=1, preset=""):
+        cmd = launcher(np_) + [a.phlex, "-options_file", "options/cantilever_tip_load.yaml", "-body0_dm_plex_filename",
+                               a.mesh, "-ts_dt", repr(dt), "-ts_max_time", repr(tend), "-ts_max_steps", "100000000",
+                               "-output_fields", "0", "-output_dir", outdir, "-progress", "0"] + SCHEMES[scheme] \
+            + preset_options(preset)
         log, wall, rss = run(cmd)
         dofs = int(re.search(r"velocity P\d \((\d+) dofs\)", log).group(1))
         r = last_row(os.path.join(outdir, "cantilever_ports.csv"))
@@ -84,13 +101,17 @@ def transient(a, out):
     print("reference: midpoint, dt %g, %.1f s" % (dtref, wall), flush=True)
     nref = math.sqrt(sum(v * v for v in yref))
     rows = []
-    for scheme in SCHEMES:
-        for dt in dts:
-            y, wall, rss, dofs = one(scheme, dt)
-            err = math.sqrt(sum((u - v) ** 2 for u, v in zip(y, yref))) / nref
-            rows.append(dict(scheme=scheme, dt=dt, steps=round(tend / dt), error=err, wall_s=wall, peak_rss_gib=rss,
-                             dofs=dofs, ranks=a.np, mesh=a.mesh))
-            print("%-9s dt %-8g error %.3e  %.1f s" % (scheme, dt, err, wall), flush=True)
+    for np_ in a.nps:
+        for preset in a.preset_list:
+            for scheme in a.scheme_list:
+                for dt in dts:
+                    y, wall, rss, dofs = one(scheme, dt, np_, preset)
+                    err = math.sqrt(sum((u - v) ** 2 for u, v in zip(y, yref))) / nref
+                    rows.append(dict(scheme=scheme, dt=dt, steps=round(tend / dt), error=err, wall_s=wall,
+                                     peak_rss_gib=rss, dofs=dofs, ranks=np_, preset=preset or "default", mesh=a.mesh,
+                                     variant="%s %s np%d" % (scheme, preset or "default", np_)))
+                    print("%-9s %-9s np %d dt %-8g error %.3e  %.1f s" % (scheme, preset or "default", np_, dt, err,
+                                                                        wall), flush=True)
     write(out, rows)
     return rows
 
@@ -99,11 +120,12 @@ def modes(a, out):
     outdir = tempfile.mkdtemp(prefix="phlex_wp_")
     meshes = a.meshes.split(",")
 
-    def one(mesh, degree):
-        cmd = launcher(a.np) + [a.phlex, "-analysis", "modes", "-body0_dm_plex_filename", mesh,
-                                "-body0_youngs_modulus", "2.1e11", "-body0_poissons_ratio", "0.3", "-body0_density",
-                                "7800", "-body0_petscspace_degree", str(degree), "-modes_nev", "10",
-                                "-modes_eps_tol", a.tol, "-output_dir", outdir, "-output_fields", "0", "-progress", "0"]
+    def one(mesh, degree, np_=1, eps_type=""):
+        cmd = launcher(np_) + [a.phlex, "-analysis", "modes", "-body0_dm_plex_filename", mesh,
+                               "-body0_youngs_modulus", "2.1e11", "-body0_poissons_ratio", "0.3", "-body0_density",
+                               "7800", "-body0_petscspace_degree", str(degree), "-modes_nev", "10",
+                               "-modes_eps_tol", a.tol, "-output_dir", outdir, "-output_fields", "0", "-progress", "0"] \
+            + (["-modes_eps_type", eps_type] if eps_type else [])
         log, wall, rss = run(cmd)
         dofs = int(re.search(r"velocity P\d \((\d+) dofs\)", log).group(1))
         with open(os.path.join(outdir, "modes.csv")) as f:
@@ -111,15 +133,21 @@ def modes(a, out):
         elastic = [float(r["frequency_hz"]) for r in rows if r["rigid"] == "0"]
         return elastic[:10], wall, rss, dofs
 
-    ref, _, _, _ = one(meshes[-1], 2)
+    ref, _, _, _ = one(a.reference or meshes[-1], 2)
     rows = []
-    for degree in (1, 2):
-        for mesh in meshes:
-            f, wall, rss, dofs = one(mesh, degree)
-            err = max(abs(x - y) / y for x, y in zip(f, ref))
-            rows.append(dict(degree=degree, mesh=mesh, error=err, wall_s=wall, peak_rss_gib=rss, dofs=dofs,
-                             ranks=a.np, tol=a.tol))
-            print("P%d %-32s %8d DOFs error %.3e  %.1f s" % (degree, mesh, dofs, err, wall), flush=True)
+    for np_ in a.nps:
+        for eps_type in a.eps_list:
+            for degree in (1, 2):
+                for mesh in meshes:
+                    if degree == 2 and mesh == a.reference:
+                        continue  # the reference itself
+                    f, wall, rss, dofs = one(mesh, degree, np_, eps_type)
+                    err = max(abs(x - y) / y for x, y in zip(f, ref))
+                    rows.append(dict(degree=degree, mesh=mesh, error=err, wall_s=wall, peak_rss_gib=rss, dofs=dofs,
+                                     ranks=np_, eps_type=eps_type or "default", tol=a.tol,
+                                     variant="P%d %s np%d" % (degree, eps_type or "default", np_)))
+                    print("P%d %-32s %-11s np %d %8d DOFs error %.3e  %.1f s  %.2f GiB"
+                          % (degree, mesh, eps_type or "default", np_, dofs, err, wall, rss), flush=True)
     write(out, rows)
     return rows
 
@@ -128,10 +156,11 @@ def mechanism(a, out):
     outdir = tempfile.mkdtemp(prefix="phlex_wp_")
     tend = 8.0 / 150.0  # 8 rad of crank angle
 
-    def one(cells, dt):
-        cmd = launcher(a.np) + [a.phlex, "-options_file", "options/crankslider.yaml", "-body1_dm_plex_filename",
-                                "meshes/crankslider_coupler_nx%d.msh" % cells, "-ts_dt", repr(dt), "-ts_max_time",
-                                repr(tend), "-output_fields", "0", "-output_dir", outdir, "-progress", "0"]
+    def one(cells, dt, np_=1, preset=""):
+        cmd = launcher(np_) + [a.phlex, "-options_file", "options/crankslider.yaml", "-body1_dm_plex_filename",
+                               "meshes/crankslider_coupler_nx%d.msh" % cells, "-ts_dt", repr(dt), "-ts_max_time",
+                               repr(tend), "-output_fields", "0", "-output_dir", outdir, "-progress", "0"] \
+            + preset_options(preset)
         log, wall, rss = run(cmd)
         dofs = int(re.search(r"velocity P\d \((\d+) dofs\)", log).group(1))
         check = subprocess.run([sys.executable, "tools/crankslider_midpoint.py", outdir], cwd=ROOT,
@@ -142,13 +171,18 @@ def mechanism(a, out):
         return float(m.group(1)), wall, rss, dofs
 
     rows = []
-    for cells in [int(x) for x in a.coupler_cells.split(",")]:
-        for dt in [float(x) for x in a.mechanism_dts.split(",")]:
-            err, wall, rss, dofs = one(cells, dt)
-            rows.append(dict(cells=cells, dt=dt, steps=round(tend / dt), error=err, wall_s=wall,
-                             wall_per_simulated_s=wall / tend, peak_rss_gib=rss, dofs=dofs, ranks=a.np))
-            print("coupler %2d cells (%5d DOFs) dt %-6g deviation %.2e  %.1f s (%.0f s per simulated s)"
-                  % (cells, dofs, dt, err, wall, wall / tend), flush=True)
+    for np_ in a.nps:
+        for preset in a.preset_list:
+            for cells in [int(x) for x in a.coupler_cells.split(",")]:
+                for dt in [float(x) for x in a.mechanism_dts.split(",")]:
+                    err, wall, rss, dofs = one(cells, dt, np_, preset)
+                    rows.append(dict(cells=cells, dt=dt, steps=round(tend / dt), error=err, wall_s=wall,
+                                     wall_per_simulated_s=wall / tend, peak_rss_gib=rss, dofs=dofs, ranks=np_,
+                                     preset=preset or "default",
+                                     variant="%d cells %s np%d" % (cells, preset or "default", np_)))
+                    print("coupler %2d cells (%5d DOFs) %-9s np %d dt %-6g deviation %.2e  %.1f s (%.0f s per "
+                          "simulated s)" % (cells, dofs, preset or "default", np_, dt, err, wall, wall / tend),
+                          flush=True)
     write(out, rows)
     return rows
 
@@ -173,7 +207,7 @@ def plot(path, rows, group, title, ylabel="relative error"):
     for g in sorted({r[group] for r in rows}, key=lambda v: (str(type(v)), v)):
         pts = [(r["wall_s"], r["error"]) for r in rows if r[group] == g and r["error"] > 0]
         if pts:
-            ax.loglog(*zip(*pts), "o-", label="%s %s" % (group, g))
+            ax.loglog(*zip(*pts), "o-", label=str(g))
     ax.set_xlabel("wall time [s]")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
@@ -188,7 +222,11 @@ def main():
     p = argparse.ArgumentParser()
     p.add_argument("--cases", default="transient,modes,mechanism")
     p.add_argument("--phlex", default="bin/phlex")
-    p.add_argument("--np", type=int, default=1)
+    p.add_argument("--np", default="1", help="ranks, a list: 1,2")
+    p.add_argument("--presets", default="", help="transient, mechanism: solver presets (options/solver/<name>.opts)")
+    p.add_argument("--eps-types", default="", help="modes: eigensolvers (-modes_eps_type)")
+    p.add_argument("--schemes", default=",".join(SCHEMES), help="transient: integrators (%s)" % ", ".join(SCHEMES))
+    p.add_argument("--reference", default="", help="modes: the P2 mesh of the reference (default: the last of --meshes)")
     p.add_argument("--mesh", default="meshes/bench/bar_h0.02.msh")
     p.add_argument("--dts", default="4.8e-4,2.4e-4,1.2e-4,6e-5")
     p.add_argument("--tend", type=float, default=0.00576)
@@ -198,20 +236,27 @@ def main():
     p.add_argument("--coupler-cells", default="8,16,32")
     p.add_argument("--mechanism-dts", default="4e-5,2e-5,1e-5")
     a = p.parse_args()
+    a.nps = [int(x) for x in a.np.split(",")]
+    a.preset_list = a.presets.split(",")
+    a.eps_list = a.eps_types.split(",")
+    a.scheme_list = a.schemes.split(",")
+    for sc in a.scheme_list:
+        if sc not in SCHEMES:
+            sys.exit("unknown scheme %s (%s)" % (sc, ", ".join(SCHEMES)))
     os.makedirs(RESULTS, exist_ok=True)
-    if a.np > 1:
+    if max(a.nps) > 1:
         os.environ.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
     for case in a.cases.split(","):
         base = os.path.join(RESULTS, "work_precision_%s" % case)
         if case == "transient":
             rows = transient(a, base + ".csv")
-            plot(base + ".png", rows, "scheme", "cantilever tip velocity at t = %g s, %d DOFs" % (a.tend, rows[0]["dofs"]))
+            plot(base + ".png", rows, "variant", "cantilever tip velocity at t = %g s, %d DOFs" % (a.tend, rows[0]["dofs"]))
         elif case == "modes":
             rows = modes(a, base + ".csv")
-            plot(base + ".png", rows, "degree", "free-free bar, first 10 elastic frequencies")
+            plot(base + ".png", rows, "variant", "free-free bar, first 10 elastic frequencies")
         elif case == "mechanism":
             rows = mechanism(a, base + ".csv")
-            plot(base + ".png", rows, "cells", "crank-slider midpoint deflection over 8 rad, against FFRF",
+            plot(base + ".png", rows, "variant", "crank-slider midpoint deflection over 8 rad, against FFRF",
                  "max |u_y/L - FFRF|")
         else:
             sys.exit("unknown case %s" % case)
