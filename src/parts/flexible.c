@@ -67,7 +67,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCall(PetscOptionsString("-dm_plex_filename", "gmsh mesh file of the body (.msh 2.2 or 4.1)", "PhlexFlexibleSetFromOptions", b->mesh_file, b->mesh_file, sizeof(b->mesh_file), &flg_mesh));
   PetscCall(PetscOptionsInt("-petscspace_degree", "Velocity degree k (1 or 2); stress: discontinuous degree k-1", "PhlexFlexibleSetFromOptions", b->degree, &b->degree, NULL));
   /* rcm: the unknowns of neighbouring nodes close in memory; the sparse products gather their vectors from cache
-     (a mass matrix times 8 vectors: 2.2 x faster, BENCHMARKS.md section 12), the factorizations order for themselves */
+     (a mass matrix times 8 vectors: 2.2 x faster, BENCHMARKS.md section 14), the factorizations order for themselves */
   PetscCall(PetscOptionsEList("-node_order", "Numbering of the mesh's points and so of the unknowns: rcm (reverse Cuthill-McKee, neighbours close in memory: faster sparse products) or file (as read)", "PhlexFlexibleSetFromOptions", PhlexNodeOrders, 2, PhlexNodeOrders[order], &order, NULL));
   PetscCall(PetscOptionsEList("-motion", "Rigid motion of the body frame: fixed (clamped patch held) or floating (the frame moves)", "PhlexFlexibleSetFromOptions", PhlexMotionTypes, 2, PhlexMotionTypes[motion], &motion, NULL));
   PetscCall(PetscOptionsString("-frame_patch", "Physical surface where u_f = v_f = 0: the clamp of a fixed body, the frame patch of a floating one", "PhlexFlexibleSetFromOptions", b->frame_patch, b->frame_patch, sizeof(b->frame_patch), NULL));

@@ -136,15 +136,52 @@ PetscErrorCode PhlexModesEPSCreate(MPI_Comm comm, EPS *eps, PetscReal *ftarget, 
   PetscCall(EPSSetPurify(*eps, PETSC_FALSE));
   PetscCall(EPSGetST(*eps, &st));
   PetscCall(STSetType(st, STSINVERT));
-  /* A - sigma B formed in A's storage (and A restored after the solve) rather than in a copy: 85 MB less at 2.2e5
-     DOFs with a nonzero shift (free bodies), the same eigenpairs to the last digit (BENCHMARKS.md section 12);
-     -modes_st_matmode copy restores the copy */
-  PetscCall(STSetMatMode(st, ST_MATMODE_INPLACE));
   PetscCall(STGetKSP(st, &ksp));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCCHOLESKY));
   if (PetscDefined(HAVE_MUMPS)) PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscFunctionReturn(0);
+}
+
+/* Where A - sigma B is stored. K and Mv come from the same preallocation and element loop: their patterns are the
+   same (compared, on one process), which makes the shifted sum a plain sum of value arrays. In place (A overwritten,
+   restored by SLEPc after the solve) saves the copy, 85 MB at 2.2e5 DOFs (BENCHMARKS.md section 14), but only where
+   nothing needs A during the solve or bit for bit afterwards: EPS phlexblock reads only B (Krylov-Schur with true
+   residuals reads A), the restored K = (K - sigma M) + sigma M differs from K by round-off (a transient whose initial
+   condition is this mode builds its operators from K: may_modify_A false), and on one process (on several, PETSc's MPISBAIJ
+   sum builds a new matrix anyway); -modes_st_matmode, when given, decides. */
+static PetscErrorCode ShiftedOperatorStorage(PhlexFlexible b, EPS eps, Mat A, Mat B, PetscBool may_modify_A)
+{
+  ST          st;
+  PetscBool   block, trueres, given;
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetST(eps, &st));
+  PetscCallMPI(MPI_Comm_size(b->comm, &size));
+  if (A == b->K && B == b->Mv && size == 1) {
+    /* compared, not assumed: a wrong claim would add the value arrays of different patterns (on several processes
+       the off-process parts of MPISBAIJ are numbered per matrix, and such a claim gave wrong eigenvalues) */
+    const PetscInt *ia, *ja, *ib, *jb;
+    PetscInt        na, nb;
+    PetscBool       da, db, same = PETSC_FALSE;
+    PetscCall(MatGetRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &na, &ia, &ja, &da));
+    PetscCall(MatGetRowIJ(B, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ib, &jb, &db));
+    if (da && db && na == nb && ia[na] == ib[nb]) {
+      same = PETSC_TRUE;
+      for (PetscInt k = 0; k <= na && same; k++) same = ia[k] == ib[k] ? PETSC_TRUE : PETSC_FALSE;
+      for (PetscInt k = 0; k < ia[na] && same; k++) same = ja[k] == jb[k] ? PETSC_TRUE : PETSC_FALSE;
+    }
+    PetscCall(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &na, &ia, &ja, &da));
+    PetscCall(MatRestoreRowIJ(B, 0, PETSC_FALSE, PETSC_TRUE, &nb, &ib, &jb, &db));
+    if (same) PetscCall(STSetMatStructure(st, SAME_NONZERO_PATTERN));
+  }
+  PetscCall(PetscOptionsHasName(NULL, "modes_", "-st_matmode", &given));
+  if (given) PetscFunctionReturn(0);
+  PetscCall(PetscObjectTypeCompare((PetscObject)eps, EPSPHLEXBLOCK, &block));
+  PetscCall(EPSGetTrueResidual(eps, &trueres));
+  if (block && !trueres && size == 1 && (may_modify_A || A != b->K)) PetscCall(STSetMatMode(st, ST_MATMODE_INPLACE));
   PetscFunctionReturn(0);
 }
 
@@ -164,7 +201,8 @@ PetscErrorCode PhlexModesEPSCreate(MPI_Comm comm, EPS *eps, PetscReal *ftarget, 
 . vecs   - eigenvectors (Mv-normalised; the elastic part of a floating body's), may be NULL
 . rigid  - floating body: the rigid part (v_P, w_P) of each eigenvector, 6 per mode, on every rank; may be NULL
 - resid  - relative residual norms ||K x - lambda Mv x|| / (|lambda| ||x||) (rigid modes: the backward error
-           ||K x - lambda Mv x|| / ((||K|| + |lambda| ||Mv||) ||x||)), may be NULL
+           ||K x - lambda Mv x|| / ((||K|| + |lambda| ||Mv||) ||x||)), may be NULL: then the caller (a transient's
+           initial condition) keeps K bit for bit (the shifted operator is not formed in K's storage)
 
   Notes:
   A floating body is solved on the pencil of its linearisation at rest (FloatingPencil): six rigid modes, then the
@@ -222,6 +260,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
   }
   PetscCall(EPSSetFromOptions(eps));
+  PetscCall(ShiftedOperatorStorage(b, eps, A, B, resid != NULL));
   PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "body %s", part->name));
   PetscCall(PhlexProgressStart(&progress));
   PetscCall(EPSMonitorSet(eps, PhlexProgressEPSMonitor, &progress, NULL));

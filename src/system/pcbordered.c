@@ -34,29 +34,39 @@ typedef struct {
 } PC_Bordered;
 
 /* PETSc 3.18's SuperLU_DIST interface keeps one process grid per communicator for "the" factorization on it; with
-   the factors of several bodies on one communicator a run on several processes crashed (segmentation fault in
-   pdgssvx's Allgather, or in MPI_Comm_free at PetscFinalize) once the consistent start's factors were destroyed and
-   the steps' made. Refused with the alternatives rather than left to crash. */
-static PetscErrorCode RefuseSharedSuperLUDist(PC pc, PC_Bordered *pb, PetscInt i, const char name[])
+   the factors of two bodies on one communicator a run on several processes crashed (segmentation fault in
+   pdgssvx's Allgather, abort, or MPI_Comm_free at PetscFinalize) once the consistent start's factors were destroyed
+   and the steps' made; one body on SuperLU_DIST (the others on MUMPS) ran. Refused with the alternatives rather than
+   left to crash. */
+static PetscErrorCode RefuseSharedSuperLUDist(PC pc, PC_Bordered *pb)
 {
-  PC            inner;
-  PetscBool     factor, sld = PETSC_FALSE;
-  PetscMPIInt   size;
-  MatSolverType type = NULL;
-  const char   *prefix;
+  PetscMPIInt size;
+  PetscInt    count = 0;
+  char        names[256] = "";
+  const char *prefix;
 
   PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)pb->ksp[i]), &size));
+  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)pc), &size));
   if (pb->nb < 2 || size < 2) PetscFunctionReturn(0);
-  PetscCall(KSPGetPC(pb->ksp[i], &inner));
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)inner, &factor, PCLU, PCCHOLESKY, ""));
-  if (factor) PetscCall(PCFactorGetMatSolverType(inner, &type));
-  if (type) PetscCall(PetscStrcmp(type, MATSOLVERSUPERLU_DIST, &sld));
-  if (!sld) PetscFunctionReturn(0);
+  for (PetscInt i = 0; i < pb->nb; i++) {
+    PC            inner;
+    PetscBool     factor, sld = PETSC_FALSE;
+    MatSolverType type = NULL;
+    const char   *name;
+    PetscCall(KSPGetPC(pb->ksp[i], &inner));
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)inner, &factor, PCLU, PCCHOLESKY, ""));
+    if (factor) PetscCall(PCFactorGetMatSolverType(inner, &type));
+    if (type) PetscCall(PetscStrcmp(type, MATSOLVERSUPERLU_DIST, &sld));
+    if (!sld) continue;
+    PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
+    if (count++) PetscCall(PetscStrlcat(names, ", ", sizeof(names)));
+    PetscCall(PetscStrlcat(names, name, sizeof(names)));
+  }
+  if (count < 2) PetscFunctionReturn(0);
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
-  SETERRQ(PetscObjectComm((PetscObject)inner), PETSC_ERR_USER_INPUT,
-          "-%sbordered_[%s_]pc_factor_mat_solver_type superlu_dist: SuperLU_DIST cannot factor the %" PetscInt_FMT " bodies of this scene on %d processes (PETSc 3.18 shares one SuperLU_DIST process grid per communicator and crashes); use mumps (the preset's), or -%sbordered_pc_type redundant for a sequential solver per body",
-          prefix ? prefix : "", name, pb->nb, (int)size, prefix ? prefix : "");
+  SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT,
+          "-%sbordered_[<body>_]pc_factor_mat_solver_type superlu_dist for %" PetscInt_FMT " bodies (%s) on %d processes: SuperLU_DIST cannot hold the factors of two bodies at once (PETSc 3.18 shares one SuperLU_DIST process grid per communicator and crashes); use mumps (the preset's) for all but one, or -%sbordered_pc_type redundant for a sequential solver per body",
+          prefix ? prefix : "", count, names, (int)size, prefix ? prefix : "");
   PetscFunctionReturn(0);
 }
 
@@ -92,8 +102,8 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
     PetscCall(PetscSNPrintf(bprefix, sizeof(bprefix), "%s_", name));
     PetscCall(KSPAppendOptionsPrefix(pb->ksp[i], bprefix));
     PetscCall(KSPSetFromOptions(pb->ksp[i]));
-    PetscCall(RefuseSharedSuperLUDist(pc, pb, i, name));
   }
+  PetscCall(RefuseSharedSuperLUDist(pc, pb));
   PetscFunctionReturn(0);
 }
 

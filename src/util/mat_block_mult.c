@@ -66,6 +66,11 @@ PetscErrorCode PhlexMatMultBlock(Mat A, Mat X, Mat Y)
   PetscCall(PetscObjectTypeCompare((PetscObject)A, MATSEQSBAIJ, &seqsbaij));
   PetscCall(MatGetBlockSize(A, &bs));
   PetscCall(MatGetSize(X, NULL, &k));
+  {
+    PetscInt ky;
+    PetscCall(MatGetSize(Y, NULL, &ky));
+    PetscCheck(ky == k, PetscObjectComm((PetscObject)A), PETSC_ERR_ARG_SIZ, "PhlexMatMultBlock: X has %" PetscInt_FMT " columns, Y %" PetscInt_FMT, k, ky);
+  }
   PetscCall(MatGetLocalSize(A, &n, NULL));
   if (seqsbaij && bs == 3 && k > 1) {
     const PetscInt    *ai, *aj;
