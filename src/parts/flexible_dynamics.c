@@ -451,7 +451,6 @@ static PetscErrorCode FlexPostStep(PhlexPart part, PetscReal *q, PetscReal *defe
 /* ------------------------------------------------------------------------------------------------------------ */
 /* Jacobian                                                                                                       */
 
-/* y = (a I + B) Mv x with B a node-wise 3x3 matrix: the elastic blocks of the moving frame */
 /* Mv = M (x) I_3 (the mass couples each velocity component only with itself): its products go through the scalar
    mass M in a MAIJ matrix, which reads a ninth of Mv's entries (Mv's 3x3 blocks are diagonal, SBAIJ stores them
    whole); M is Mv's rows and columns of the x components */
@@ -473,6 +472,7 @@ static PetscErrorCode MassProductSetUp(PhlexFlexible b)
   PetscFunctionReturn(0);
 }
 
+/* y = (a I + B) Mv x with B a node-wise 3x3 matrix: the elastic blocks of the moving frame */
 static PetscErrorCode NodeMassMult(PhlexFlexible b, PetscReal a, const PetscReal B[9], Vec x, Vec y)
 {
   PetscScalar *ya;

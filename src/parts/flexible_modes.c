@@ -150,7 +150,7 @@ PetscErrorCode PhlexModesEPSCreate(MPI_Comm comm, EPS *eps, PetscReal *ftarget, 
    nothing needs A during the solve or bit for bit afterwards: EPS phlexblock reads only B (Krylov-Schur with true
    residuals reads A), the restored K = (K - sigma M) + sigma M differs from K by round-off (a transient whose initial
    condition is this mode builds its operators from K: may_modify_A false), and on one process (on several, PETSc's MPISBAIJ
-   sum builds a new matrix anyway); -modes_st_matmode, when given, decides. */
+   sum builds a new matrix anyway); -modes_st_matmode and -modes_st_matstructure, when given, decide. */
 static PetscErrorCode ShiftedOperatorStorage(PhlexFlexible b, EPS eps, Mat A, Mat B, PetscBool may_modify_A)
 {
   ST          st;
@@ -160,7 +160,8 @@ static PetscErrorCode ShiftedOperatorStorage(PhlexFlexible b, EPS eps, Mat A, Ma
   PetscFunctionBeginUser;
   PetscCall(EPSGetST(eps, &st));
   PetscCallMPI(MPI_Comm_size(b->comm, &size));
-  if (A == b->K && B == b->Mv && size == 1) {
+  PetscCall(PetscOptionsHasName(NULL, "modes_", "-st_matstructure", &given));
+  if (A == b->K && B == b->Mv && size == 1 && !given) {
     /* compared, not assumed: a wrong claim would add the value arrays of different patterns (on several processes
        the off-process parts of MPISBAIJ are numbered per matrix, and such a claim gave wrong eigenvalues) */
     const PetscInt *ia, *ja, *ib, *jb;
