@@ -77,7 +77,8 @@ static PetscErrorCode EPSSetDefaultST_PhlexBlock(EPS eps)
 }
 
 /* PETSc multiplies SBAIJ by a dense block through a generic path, 4x slower per column (2.2e5 DOFs) than its
-   MatMult: the products of bv with B one column at a time */
+   MatMult: V's B-inner products (set at the end, for the normalization) one column at a time. The solver's own
+   products with B go through PhlexMatMultBlock. */
 static PetscErrorCode SetMatMultMethod(EPS eps, BV bv)
 {
   Mat       B;
@@ -98,7 +99,6 @@ static PetscErrorCode WorkBV(EPS eps, PetscInt k, BV *bv)
   PetscCall(BVDestroy(bv));
   PetscCall(BVDuplicateResize(eps->V, k, bv));
   PetscCall(BVSetMatrix(*bv, NULL, PETSC_FALSE));
-  PetscCall(SetMatMultMethod(eps, *bv));
   PetscFunctionReturn(0);
 }
 

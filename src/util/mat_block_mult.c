@@ -8,47 +8,42 @@
 
 #define PHLEX_PANEL 8 /* vectors per pass: a panel of 8 doubles is one cache line */
 
-/* Y (row-major, n x w) = A X (row-major, n x w), A upper-triangular 3x3-block storage (blocks column-major); the
-   body is instantiated for a full panel (w a constant: the compiler unrolls and vectorizes the loops over it) and for
-   the last, narrower one */
-#define SBAIJ3_PANEL_BODY(w) \
-  do { \
-    for (PetscInt k = 0; k < 3 * mbs * (w); k++) Y[k] = 0.0; \
-    for (PetscInt i = 0; i < mbs; i++) { \
-      const PetscScalar *xi = X + 3 * i * (w); \
-      PetscScalar       *yi = Y + 3 * i * (w); \
-      for (PetscInt p = ai[i]; p < ai[i + 1]; p++) { \
-        const MatScalar *v = aa + 9 * p; \
-        const PetscInt   j = aj[p]; \
-        if (j == i) { /* the diagonal block: its upper triangle is the stored part */ \
-          for (PetscInt c = 0; c < (w); c++) { \
-            const PetscScalar x0 = xi[c], x1 = xi[(w) + c], x2 = xi[2 * (w) + c]; \
-            yi[c] += v[0] * x0 + v[3] * x1 + v[6] * x2; \
-            yi[(w) + c] += v[3] * x0 + v[4] * x1 + v[7] * x2; \
-            yi[2 * (w) + c] += v[6] * x0 + v[7] * x1 + v[8] * x2; \
-          } \
-        } else { /* A_ij x_j into row i, A_ij^T x_i into row j */ \
-          const PetscScalar *xj = X + 3 * j * (w); \
-          PetscScalar       *yj = Y + 3 * j * (w); \
-          for (PetscInt c = 0; c < (w); c++) { \
-            const PetscScalar a0 = xi[c], a1 = xi[(w) + c], a2 = xi[2 * (w) + c]; \
-            const PetscScalar b0 = xj[c], b1 = xj[(w) + c], b2 = xj[2 * (w) + c]; \
-            yi[c] += v[0] * b0 + v[3] * b1 + v[6] * b2; \
-            yi[(w) + c] += v[1] * b0 + v[4] * b1 + v[7] * b2; \
-            yi[2 * (w) + c] += v[2] * b0 + v[5] * b1 + v[8] * b2; \
-            yj[c] += v[0] * a0 + v[1] * a1 + v[2] * a2; \
-            yj[(w) + c] += v[3] * a0 + v[4] * a1 + v[5] * a2; \
-            yj[2 * (w) + c] += v[6] * a0 + v[7] * a1 + v[8] * a2; \
-          } \
-        } \
-      } \
-    } \
-  } while (0)
-
+/* Y (row-major, n x w) = A X (row-major, n x w), A upper-triangular 3x3-block storage (blocks column-major). The time
+   goes into fetching the rows of X and Y of the node a block couples to, not into arithmetic: a compile-time panel
+   width or -O3 -march=native changed nothing (BENCHMARKS.md section 14); a numbering that keeps neighbours close
+   (-body<k>_node_order rcm) made it 2.2 x faster. */
 static void SBAIJ3Panel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *aa, PetscInt w, const PetscScalar *X, PetscScalar *Y)
 {
-  if (w == PHLEX_PANEL) SBAIJ3_PANEL_BODY(PHLEX_PANEL);
-  else SBAIJ3_PANEL_BODY(w);
+  for (PetscInt k = 0; k < 3 * mbs * w; k++) Y[k] = 0.0;
+  for (PetscInt i = 0; i < mbs; i++) {
+    const PetscScalar *xi = X + 3 * i * w;
+    PetscScalar       *yi = Y + 3 * i * w;
+    for (PetscInt p = ai[i]; p < ai[i + 1]; p++) {
+      const MatScalar *v = aa + 9 * p;
+      const PetscInt   j = aj[p];
+      if (j == i) { /* the diagonal block: its upper triangle is the stored part */
+        for (PetscInt c = 0; c < w; c++) {
+          const PetscScalar x0 = xi[c], x1 = xi[w + c], x2 = xi[2 * w + c];
+          yi[c] += v[0] * x0 + v[3] * x1 + v[6] * x2;
+          yi[w + c] += v[3] * x0 + v[4] * x1 + v[7] * x2;
+          yi[2 * w + c] += v[6] * x0 + v[7] * x1 + v[8] * x2;
+        }
+      } else { /* A_ij x_j into row i, A_ij^T x_i into row j */
+        const PetscScalar *xj = X + 3 * j * w;
+        PetscScalar       *yj = Y + 3 * j * w;
+        for (PetscInt c = 0; c < w; c++) {
+          const PetscScalar a0 = xi[c], a1 = xi[w + c], a2 = xi[2 * w + c];
+          const PetscScalar b0 = xj[c], b1 = xj[w + c], b2 = xj[2 * w + c];
+          yi[c] += v[0] * b0 + v[3] * b1 + v[6] * b2;
+          yi[w + c] += v[1] * b0 + v[4] * b1 + v[7] * b2;
+          yi[2 * w + c] += v[2] * b0 + v[5] * b1 + v[8] * b2;
+          yj[c] += v[0] * a0 + v[1] * a1 + v[2] * a2;
+          yj[w + c] += v[3] * a0 + v[4] * a1 + v[5] * a2;
+          yj[2 * w + c] += v[6] * a0 + v[7] * a1 + v[8] * a2;
+        }
+      }
+    }
+  }
 }
 
 /*@C
