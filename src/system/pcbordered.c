@@ -19,6 +19,7 @@
    per body -<prefix>bordered_<body>_ksp_type ... */
 #include <phlex_impl.h>
 #include <petsc/private/pcimpl.h>
+#include <ctype.h>
 
 typedef struct {
   PhlexBorderedData *bd;
@@ -31,6 +32,8 @@ typedef struct {
   PetscBLASInt      *S_piv;
   IS                *is;     /* per block: its rows in the PC's vector */
   PetscInt           nfactor;
+  PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
+  char             **copy_from, **copy_to;
 } PC_Bordered;
 
 /* PETSc 3.18's SuperLU_DIST interface keeps one process grid per communicator for "the" factorization on it; with
@@ -70,6 +73,107 @@ static PetscErrorCode RefuseSharedSuperLUDist(PC pc, PC_Bordered *pb)
   PetscFunctionReturn(0);
 }
 
+/* An option under the common prefix (-<prefix>bordered_...) reaches a body's solver through the first
+   KSPSetFromOptions only; the objects that solver creates later read the body's full prefix alone (the factor's
+   -..._mat_mumps_icntl_*, GAMG's -..._mg_levels_*), so such options never arrived. Each common option is copied to
+   every body that does not give its own (the body's value wins); BorderedCopiesUsed then counts the common option as
+   used when a copy was, so that the never-used warning names what the user typed. */
+static PetscErrorCode BorderedCopyCommonOptions(PC_Bordered *pb, const char *common)
+{
+  PhlexBorderedData *bd = pb->bd;
+  char              *all;
+  PetscToken         token;
+  char             **tok = NULL;
+  PetscInt           ntok = 0, cap = 0;
+  size_t             lc;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrlen(common, &lc));
+  PetscCall(PetscOptionsGetAll(NULL, &all));
+  PetscCall(PetscTokenCreate(all, ' ', &token));
+  for (;;) {
+    char *t;
+    PetscCall(PetscTokenFind(token, &t));
+    if (!t) break;
+    if (ntok == cap) {
+      char **grown;
+      cap = 2 * cap + 64;
+      PetscCall(PetscMalloc1(cap, &grown));
+      if (ntok) PetscCall(PetscArraycpy(grown, tok, ntok));
+      PetscCall(PetscFree(tok));
+      tok = grown;
+    }
+    tok[ntok++] = t;
+  }
+  for (PetscInt k = 0; k < ntok; k++) {
+    const char *rest;
+    const char *value = NULL;
+    PetscBool   match, of_body = PETSC_FALSE;
+    if (tok[k][0] != '-' || !(isalpha((unsigned char)tok[k][1]) || tok[k][1] == '_')) continue; /* a value */
+    PetscCall(PetscStrncmp(tok[k] + 1, common, lc, &match));
+    if (!match) continue;
+    rest = tok[k] + 1 + lc;
+    if (k + 1 < ntok && !(tok[k + 1][0] == '-' && (isalpha((unsigned char)tok[k + 1][1]) || tok[k + 1][1] == '_'))) value = tok[k + 1];
+    for (PetscInt i = 0; i < pb->nb && !of_body; i++) {
+      const char *name;
+      size_t      ln;
+      PetscCall((*bd->blockprefix)(bd->ctx, i, &name));
+      PetscCall(PetscStrlen(name, &ln));
+      PetscCall(PetscStrncmp(rest, name, ln, &of_body));
+      of_body = (PetscBool)(of_body && rest[ln] == '_');
+    }
+    if (of_body) continue; /* a body's own option */
+    for (PetscInt i = 0; i < pb->nb; i++) {
+      const char *name;
+      char        to[512];
+      PetscBool   given = PETSC_FALSE;
+      PetscCall((*bd->blockprefix)(bd->ctx, i, &name));
+      PetscCall(PetscSNPrintf(to, sizeof(to), "-%s%s_%s", common, name, rest));
+      for (PetscInt l = 0; l < ntok && !given; l++) PetscCall(PetscStrcasecmp(tok[l], to, &given));
+      if (given) continue;
+      PetscCall(PetscOptionsSetValue(NULL, to, value));
+      if (!pb->copy_from) PetscCall(PetscCalloc2(ntok * pb->nb, &pb->copy_from, ntok * pb->nb, &pb->copy_to));
+      PetscCall(PetscStrallocpy(tok[k], &pb->copy_from[pb->ncopy]));
+      PetscCall(PetscStrallocpy(to, &pb->copy_to[pb->ncopy]));
+      pb->ncopy++;
+    }
+  }
+  PetscCall(PetscFree(tok));
+  PetscCall(PetscTokenDestroy(&token));
+  PetscCall(PetscFree(all));
+  PetscFunctionReturn(0);
+}
+
+/* after the bodies' solvers are set up: a common option whose copy was read counts as used; the copies themselves
+   are never reported */
+static PetscErrorCode BorderedCopiesFree(PC_Bordered *pb)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < pb->ncopy; c++) {
+    PetscCall(PetscFree(pb->copy_from[c]));
+    PetscCall(PetscFree(pb->copy_to[c]));
+  }
+  PetscCall(PetscFree2(pb->copy_from, pb->copy_to));
+  pb->ncopy = 0;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode BorderedCopiesUsed(PC_Bordered *pb)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < pb->ncopy; c++) {
+    PetscBool used, flg;
+    PetscCall(PetscOptionsUsed(NULL, pb->copy_to[c] + 1, &used));
+    if (used) PetscCall(PetscOptionsHasName(NULL, NULL, pb->copy_from[c], &flg));
+  }
+  for (PetscInt c = 0; c < pb->ncopy; c++) {
+    PetscBool flg;
+    PetscCall(PetscOptionsHasName(NULL, NULL, pb->copy_to[c], &flg));
+  }
+  PetscCall(BorderedCopiesFree(pb));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
 {
   PhlexBorderedData *bd = pb->bd;
@@ -84,6 +188,11 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   PetscCall(PetscMalloc2(PetscMax(pb->m * pb->m, 1), &pb->S, PetscMax(pb->m, 1), &pb->S_piv));
   PetscCall(MatGetOwnershipRange(pc->pmat, &rstart, NULL));
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  {
+    char common[256];
+    PetscCall(PetscSNPrintf(common, sizeof(common), "%sbordered_", prefix ? prefix : ""));
+    PetscCall(BorderedCopyCommonOptions(pb, common));
+  }
   for (PetscInt i = 0; i < pb->nb; i++) {
     const char *name;
     char        bprefix[256];
@@ -164,6 +273,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     pb->nfactor++;
     PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pc, 0, 0, 0));
   }
+  if (pb->ncopy) PetscCall(BorderedCopiesUsed(pb));
   if (!pb->m) PetscFunctionReturn(0);
   /* S = D - sum_i (C_i Y_i) beta_i */
   PetscCall(PetscLogEventBegin(PHLEX_BorderedSetUp, pc, 0, 0, 0));
@@ -284,6 +394,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscCall(PetscFree5(pb->ksp, pb->Y, pb->Astate, pb->Wstate, pb->beta));
   PetscCall(PetscFree(pb->is));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
+  PetscCall(BorderedCopiesFree(pb));
   pb->bd = NULL;
   pb->nb = pb->m = 0;
   PetscFunctionReturn(0);
