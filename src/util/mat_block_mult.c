@@ -5,6 +5,7 @@
    is packed row-major (the vectors of one node side by side), so each 3x3 block of A is applied to a 3 x k panel,
    and its transpose (the lower triangle, not stored) in the same pass. Other matrices: one MatMult per column. */
 #include <phlex_impl.h>
+#include <petsc/private/petscimpl.h> /* PetscObjectStateGet */
 
 #define PHLEX_PANEL 8 /* vectors per pass: a panel of 8 doubles is one cache line */
 
@@ -46,6 +47,93 @@ static void SBAIJ3Panel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, co
   }
 }
 
+/* The same product for a matrix whose 3x3 blocks are multiples of the identity, M (x) I_3 (a velocity mass: each
+   component couples only with itself): the blocks' scalars m (one per stored block, in the matrix's order, copied
+   once) and the loops over the 3 x w contiguous values of a node, which vectorize: a ninth of the matrix's bytes and a
+   third of its arithmetic. The sums run in the order of SBAIJ3Panel, whose zero entries add exact zeros: the two give
+   the same bits. The node loops vectorize with GCC's dynamic cost model (the Makefile gives this file
+   -fvect-cost-model=dynamic; -O2's default model leaves them scalar): 0.83 -> 0.66 s for the 22 block products of the
+   2.2e5-DOF modes. */
+static void SBAIJ3ScalarPanel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *m, PetscInt w, const PetscScalar *X, PetscScalar *Y)
+{
+  const PetscInt w3 = 3 * w;
+
+  for (PetscInt k = 0; k < w3 * mbs; k++) Y[k] = 0.0;
+  for (PetscInt i = 0; i < mbs; i++) {
+    const PetscScalar *xi = X + w3 * i;
+    PetscScalar       *yi = Y + w3 * i;
+    for (PetscInt p = ai[i]; p < ai[i + 1]; p++) {
+      const MatScalar mp = m[p];
+      const PetscInt  j  = aj[p];
+      if (j == i) {
+        for (PetscInt c = 0; c < w3; c++) yi[c] += mp * xi[c];
+      } else {
+        const PetscScalar *xj = X + w3 * j;
+        PetscScalar       *yj = Y + w3 * j;
+        for (PetscInt c = 0; c < w3; c++) {
+          yi[c] += mp * xj[c];
+          yj[c] += mp * xi[c];
+        }
+      }
+    }
+  }
+}
+
+typedef struct {
+  PetscObjectState state; /* of the matrix when m was taken */
+  MatScalar       *m;     /* the blocks' scalars, or NULL: the matrix is not M (x) I_3 */
+} ScalarI3;
+
+static PetscErrorCode ScalarI3Destroy(void *ctx)
+{
+  ScalarI3 *s = (ScalarI3 *)ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(s->m));
+  PetscCall(PetscFree(s));
+  PetscFunctionReturn(0);
+}
+
+/* the blocks' scalars when every stored 3x3 block is a multiple of the identity, bit for bit (of a diagonal block its
+   upper triangle, the stored part), else NULL; kept with the matrix and taken again when its state changes */
+static PetscErrorCode ScalarTimesI3(Mat A, PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *aa, const MatScalar **m)
+{
+  PetscContainer   c;
+  ScalarI3        *s;
+  PetscObjectState state;
+  PetscBool        yes = PETSC_TRUE;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectStateGet((PetscObject)A, &state));
+  PetscCall(PetscObjectQuery((PetscObject)A, "phlex_scalar_I3", (PetscObject *)&c));
+  if (c) {
+    PetscCall(PetscContainerGetPointer(c, (void **)&s));
+    if (s->state == state) {
+      *m = s->m;
+      PetscFunctionReturn(0);
+    }
+  }
+  for (PetscInt i = 0; i < mbs && yes; i++)
+    for (PetscInt p = ai[i]; p < ai[i + 1] && yes; p++) {
+      const MatScalar *v     = aa + 9 * p;
+      const PetscBool  lower = (PetscBool)(aj[p] != i && (v[1] != 0.0 || v[2] != 0.0 || v[5] != 0.0));
+      if (lower || v[3] != 0.0 || v[6] != 0.0 || v[7] != 0.0 || v[4] != v[0] || v[8] != v[0]) yes = PETSC_FALSE;
+    }
+  PetscCall(PetscNew(&s));
+  s->state = state;
+  if (yes) {
+    PetscCall(PetscMalloc1(ai[mbs], &s->m));
+    for (PetscInt p = 0; p < ai[mbs]; p++) s->m[p] = aa[9 * p];
+  }
+  PetscCall(PetscContainerCreate(PetscObjectComm((PetscObject)A), &c));
+  PetscCall(PetscContainerSetPointer(c, s));
+  PetscCall(PetscContainerSetUserDestroy(c, ScalarI3Destroy));
+  PetscCall(PetscObjectCompose((PetscObject)A, "phlex_scalar_I3", (PetscObject)c));
+  PetscCall(PetscContainerDestroy(&c));
+  *m = s->m;
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexMatMultBlock - Y = A X for the columns of the dense matrices X and Y (same number of columns)
 
@@ -71,6 +159,7 @@ PetscErrorCode PhlexMatMultBlock(Mat A, Mat X, Mat Y)
     const PetscInt    *ai, *aj;
     PetscInt           mbs, ldx, ldy;
     PetscBool          done;
+    const MatScalar   *m = NULL;
     MatScalar         *aa;
     const PetscScalar *x;
     PetscScalar       *y, *xp, *yp;
@@ -81,12 +170,14 @@ PetscErrorCode PhlexMatMultBlock(Mat A, Mat X, Mat Y)
     PetscCall(MatDenseGetLDA(Y, &ldy));
     PetscCall(MatDenseGetArrayRead(X, &x));
     PetscCall(MatDenseGetArrayWrite(Y, &y));
+    PetscCall(ScalarTimesI3(A, mbs, ai, aj, aa, &m));
     PetscCall(PetscMalloc2(n * PHLEX_PANEL, &xp, n * PHLEX_PANEL, &yp));
     for (PetscInt c0 = 0; c0 < k; c0 += PHLEX_PANEL) {
       const PetscInt w = PetscMin(PHLEX_PANEL, k - c0);
       for (PetscInt r = 0; r < n; r++)
         for (PetscInt c = 0; c < w; c++) xp[r * w + c] = x[(c0 + c) * ldx + r];
-      SBAIJ3Panel(mbs, ai, aj, aa, w, xp, yp);
+      if (m) SBAIJ3ScalarPanel(mbs, ai, aj, m, w, xp, yp);
+      else SBAIJ3Panel(mbs, ai, aj, aa, w, xp, yp);
       for (PetscInt c = 0; c < w; c++)
         for (PetscInt r = 0; r < n; r++) y[(c0 + c) * ldy + r] = yp[r * w + c];
     }
@@ -94,7 +185,7 @@ PetscErrorCode PhlexMatMultBlock(Mat A, Mat X, Mat Y)
     PetscCall(MatDenseRestoreArrayWrite(Y, &y));
     PetscCall(MatDenseRestoreArrayRead(X, &x));
     PetscCall(MatSeqSBAIJRestoreArray(A, &aa));
-    PetscCall(PetscLogFlops(4.0 * 9.0 * (PetscLogDouble)ai[mbs] * (PetscLogDouble)k));
+    PetscCall(PetscLogFlops((m ? 4.0 * 3.0 : 4.0 * 9.0) * (PetscLogDouble)ai[mbs] * (PetscLogDouble)k));
     PetscCall(MatRestoreRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &mbs, &ai, &aj, &done));
   } else {
     for (PetscInt c = 0; c < k; c++) {
