@@ -4,8 +4,9 @@
   transient  the tip-loaded cantilever (options/cantilever_tip_load.yaml) on one mesh, integrators x time steps; the
              error is that of the tip port's velocity (vx vy vz wx wy wz) at the end time against a run of the
              implicit midpoint rule with a step --ref-factor times smaller than the smallest, relative to its norm
-  modes      the free-free bar, P1 and P2 on a sequence of meshes; the error is the largest relative error of the
-             first 10 elastic frequencies against the finest P2 mesh
+  modes      the steel bar free-free and clamped at x = 0 (the cantilever), P1 and P2 on a sequence of meshes; the
+             error is the largest relative error of the first 10 elastic frequencies against the finest P2 mesh (or
+             --reference) with the same support
   mechanism  the paper's crank-slider (options/crankslider.yaml: rigid crank at 150 rad/s, flexible coupler on mean
              axes, slider), coupler meshes x time steps over 8 rad of crank angle; the error is the largest deviation
              of the coupler's midpoint deflection u_y/L from the converged FFRF model
@@ -18,11 +19,13 @@ Dimensions beyond the discretisation (each a comma-separated list; every point i
   --np        ranks (mpiexec -n)
   --presets   transient and mechanism: solver presets options/solver/<name>.opts (default: the scene's own)
   --eps-types modes: eigensolvers (-modes_eps_type: phlexblock, krylovschur, ...)
+  --supports  modes: free (the free-free bar, 6 rigid modes) and clamped (the cantilever, frame patch "clamp")
 
 usage: bench/work_precision.py [--cases transient,modes,mechanism] [--mesh meshes/bench/bar_h0.02.msh]
                                [--meshes meshes/bar_h0.05.msh,meshes/bench/bar_h0.02.msh,meshes/bench/bar_h0.01.msh]
                                [--coupler-cells 8,16,32] [--mechanism-dts 4e-5,2e-5,1e-5] [--np 1,2]
-                               [--presets exact,iterative] [--eps-types phlexblock,krylovschur] [--phlex bin/phlex]
+                               [--presets exact,iterative] [--eps-types phlexblock,krylovschur] [--supports free,clamped]
+                               [--phlex bin/phlex]
 """
 import argparse
 import csv
@@ -116,38 +119,44 @@ def transient(a, out):
     return rows
 
 
+SUPPORTS = {"free": [], "clamped": ["-body0_frame_patch", "clamp"]}
+
+
 def modes(a, out):
     outdir = tempfile.mkdtemp(prefix="phlex_wp_")
     meshes = a.meshes.split(",")
 
-    def one(mesh, degree, np_=1, eps_type=""):
+    def one(mesh, degree, support, np_=1, eps_type=""):
         cmd = launcher(np_) + [a.phlex, "-analysis", "modes", "-body0_dm_plex_filename", mesh,
                                "-body0_youngs_modulus", "2.1e11", "-body0_poissons_ratio", "0.3", "-body0_density",
                                "7800", "-body0_petscspace_degree", str(degree), "-modes_nev", "10",
                                "-modes_eps_tol", a.tol, "-output_dir", outdir, "-output_fields", "0", "-progress", "0"] \
-            + (["-modes_eps_type", eps_type] if eps_type else [])
+            + SUPPORTS[support] + (["-modes_eps_type", eps_type] if eps_type else [])
         log, wall, rss = run(cmd)
         dofs = int(re.search(r"velocity P\d \((\d+) dofs\)", log).group(1))
         with open(os.path.join(outdir, "modes.csv")) as f:
             rows = [r for r in csv.DictReader(f)]
         elastic = [float(r["frequency_hz"]) for r in rows if r["rigid"] == "0"]
+        assert len(elastic) >= 10, "%s: %d elastic modes" % (" ".join(cmd), len(elastic))
         return elastic[:10], wall, rss, dofs
 
-    ref, _, _, _ = one(a.reference or meshes[-1], 2)
     rows = []
-    for np_ in a.nps:
-        for eps_type in a.eps_list:
-            for degree in (1, 2):
-                for mesh in meshes:
-                    if degree == 2 and mesh == a.reference:
-                        continue  # the reference itself
-                    f, wall, rss, dofs = one(mesh, degree, np_, eps_type)
-                    err = max(abs(x - y) / y for x, y in zip(f, ref))
-                    rows.append(dict(degree=degree, mesh=mesh, error=err, wall_s=wall, peak_rss_gib=rss, dofs=dofs,
-                                     ranks=np_, eps_type=eps_type or "default", tol=a.tol,
-                                     variant="P%d %s np%d" % (degree, eps_type or "default", np_)))
-                    print("P%d %-32s %-11s np %d %8d DOFs error %.3e  %.1f s  %.2f GiB"
-                          % (degree, mesh, eps_type or "default", np_, dofs, err, wall, rss), flush=True)
+    for support in a.support_list:
+        ref, wall, _, dofs = one(a.reference or meshes[-1], 2, support)
+        print("reference (%s): P2 %s, %d DOFs, %.1f s" % (support, a.reference or meshes[-1], dofs, wall), flush=True)
+        for np_ in a.nps:
+            for eps_type in a.eps_list:
+                for degree in (1, 2):
+                    for mesh in meshes:
+                        if degree == 2 and mesh == (a.reference or meshes[-1]):
+                            continue  # the reference itself
+                        f, wall, rss, dofs = one(mesh, degree, support, np_, eps_type)
+                        err = max(abs(x - y) / y for x, y in zip(f, ref))
+                        rows.append(dict(support=support, degree=degree, mesh=mesh, error=err, wall_s=wall,
+                                         peak_rss_gib=rss, dofs=dofs, ranks=np_, eps_type=eps_type or "default",
+                                         tol=a.tol, variant="P%d %s np%d" % (degree, eps_type or "default", np_)))
+                        print("%-7s P%d %-32s %-11s np %d %8d DOFs error %.3e  %.1f s  %.2f GiB"
+                              % (support, degree, mesh, eps_type or "default", np_, dofs, err, wall, rss), flush=True)
     write(out, rows)
     return rows
 
@@ -227,6 +236,7 @@ def main():
     p.add_argument("--eps-types", default="", help="modes: eigensolvers (-modes_eps_type)")
     p.add_argument("--schemes", default=",".join(SCHEMES), help="transient: integrators (%s)" % ", ".join(SCHEMES))
     p.add_argument("--reference", default="", help="modes: the P2 mesh of the reference (default: the last of --meshes)")
+    p.add_argument("--supports", default="free,clamped", help="modes: free (free-free bar), clamped (cantilever)")
     p.add_argument("--mesh", default="meshes/bench/bar_h0.02.msh")
     p.add_argument("--dts", default="4.8e-4,2.4e-4,1.2e-4,6e-5")
     p.add_argument("--tend", type=float, default=0.00576)
@@ -240,6 +250,10 @@ def main():
     a.preset_list = a.presets.split(",")
     a.eps_list = a.eps_types.split(",")
     a.scheme_list = a.schemes.split(",")
+    a.support_list = a.supports.split(",")
+    for sp in a.support_list:
+        if sp not in SUPPORTS:
+            sys.exit("unknown support %s (%s)" % (sp, ", ".join(SUPPORTS)))
     for sc in a.scheme_list:
         if sc not in SCHEMES:
             sys.exit("unknown scheme %s (%s)" % (sc, ", ".join(SCHEMES)))
@@ -253,7 +267,9 @@ def main():
             plot(base + ".png", rows, "variant", "cantilever tip velocity at t = %g s, %d DOFs" % (a.tend, rows[0]["dofs"]))
         elif case == "modes":
             rows = modes(a, base + ".csv")
-            plot(base + ".png", rows, "variant", "free-free bar, first 10 elastic frequencies")
+            for sp in a.support_list:
+                plot("%s_%s.png" % (base, sp), [r for r in rows if r["support"] == sp], "variant",
+                     "%s bar, first 10 elastic frequencies" % ("free-free" if sp == "free" else "cantilever"))
         elif case == "mechanism":
             rows = mechanism(a, base + ".csv")
             plot(base + ".png", rows, "variant", "crank-slider midpoint deflection over 8 rad, against FFRF",
