@@ -36,10 +36,11 @@ $(BIN): $(OBJ) | bin
 
 build/%.o: src/%.c
 	@mkdir -p $(@D)
-	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+	$(CC) $(CPPFLAGS) $(CFLAGS) $(VECFLAGS) -c $< -o $@
 
-# the block mass kernel's node loops vectorize only with GCC's dynamic cost model (-O2's leaves them scalar)
-build/util/mat_block_mult.o: CFLAGS += -fvect-cost-model=dynamic
+# the block mass kernel's node loops vectorize only with GCC's dynamic cost model (-O2's leaves them scalar); a
+# variable of its own, so that make CFLAGS=... keeps it
+build/util/mat_block_mult.o: VECFLAGS = -fvect-cost-model=dynamic
 
 bin:
 	@mkdir -p $@
