@@ -186,8 +186,9 @@ static PetscErrorCode ShiftedOperatorStorage(PhlexFlexible b, EPS eps, Mat A, Ma
   PetscFunctionReturn(0);
 }
 
-/* With -modes_eps_true_residual SLEPc tests ||A x - lambda B x|| / |lambda| of each Ritz pair, which a rigid mode
-   (lambda ~ 0, its residual at round-off of ||A||) never passes: a free body's run ended with no mode at all. Below
+/* With -modes_eps_true_residual Krylov-Schur (and Arnoldi) test ||A x - lambda B x|| / |lambda| of each Ritz pair,
+   which a rigid mode (lambda ~ 0, its residual at round-off of ||A||) never passes: a free body's run ended with no
+   mode at all. Below
    rigid_below the test is the backward error ||A x - lambda B x|| / (||A||_inf + |lambda| ||B||_inf), what phlex
    reports for rigid modes; above it SLEPc's relative test. */
 typedef struct {
@@ -350,11 +351,14 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   }
   PetscCall(EPSSetFromOptions(eps));
   {
-    PetscBool trueres;
+    PetscBool trueres, krylov;
     EPSConv   conv;
     PetscCall(EPSGetTrueResidual(eps, &trueres));
     PetscCall(EPSGetConvergenceTest(eps, &conv));
-    if (free_body && !mean_axes && trueres && conv == EPS_CONV_REL) {
+    /* the types whose convergence loop passes back-transformed eigenvalues with true residuals (others refuse a
+       user test, or pass the shift-and-invert Ritz values) */
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)eps, &krylov, EPSKRYLOVSCHUR, EPSARNOLDI, ""));
+    if (free_body && !mean_axes && trueres && krylov && conv == EPS_CONV_REL) {
       ConvergedRigidCtx *c;
       PetscCall(PetscNew(&c));
       c->rigid_below = 1e-6 * omega * omega;
@@ -370,6 +374,9 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(EPSSolve(eps));
   PetscCall(EPSGetDimensions(eps, &want, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &n));
+  /* a modal analysis that has fewer pairs than asked for says so (a transient's initial mode and the convergence
+     study check the modes they need) */
+  PetscCheck(!resid || n >= want, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs asked of the eigensolver converged (-modes_nev%s, or -modes_eps_nev): raise -modes_eps_max_it or loosen -modes_eps_tol (with -modes_eps_true_residual a relative residual cannot go below the round-off of ||K x|| / lambda, about 1e-11 for a P2 bar)", part->name, n, want, free_body && !mean_axes ? " plus the 6 rigid-body modes" : "");
   n = PetscMin(n, want);
   {
     /* mean axes: the frame's six rigid modes (v = 0) come first */

@@ -19,7 +19,6 @@
    per body -<prefix>bordered_<body>_ksp_type ... */
 #include <phlex_impl.h>
 #include <petsc/private/pcimpl.h>
-#include <ctype.h>
 
 typedef struct {
   PhlexBorderedData *bd;
@@ -81,71 +80,64 @@ static PetscErrorCode RefuseSharedSuperLUDist(PC pc, PC_Bordered *pb)
 static PetscErrorCode BorderedCopyCommonOptions(PC_Bordered *pb, const char *common)
 {
   PhlexBorderedData *bd = pb->bd;
-  char              *all;
-  PetscToken         token;
-  char             **tok = NULL;
-  PetscInt           ntok = 0, cap = 0;
+  PetscInt           nleft;
+  char             **names, **values, *all;
   size_t             lc;
 
   PetscFunctionBeginUser;
   PetscCall(PetscStrlen(common, &lc));
-  PetscCall(PetscOptionsGetAll(NULL, &all));
-  PetscCall(PetscTokenCreate(all, ' ', &token));
-  for (;;) {
-    char *t;
-    PetscCall(PetscTokenFind(token, &t));
-    if (!t) break;
-    if (ntok == cap) {
-      char **grown;
-      cap = 2 * cap + 64;
-      PetscCall(PetscMalloc1(cap, &grown));
-      if (ntok) PetscCall(PetscArraycpy(grown, tok, ntok));
-      PetscCall(PetscFree(tok));
-      tok = grown;
-    }
-    tok[ntok++] = t;
-  }
-  for (PetscInt k = 0; k < ntok; k++) {
-    const char *rest;
-    const char *value = NULL;
+  /* the options not read yet, with their values as given (spaces, leading '-'); the common ones are among them: this
+     runs before the first KSPSetFromOptions reads them */
+  PetscCall(PetscOptionsLeftGet(NULL, &nleft, &names, &values));
+  PetscCall(PetscOptionsGetAll(NULL, &all)); /* to see whether a body gives an option itself (read or not) */
+  for (PetscInt k = 0; k < nleft; k++) {
+    const char *name = names[k][0] == '-' ? names[k] + 1 : names[k], *rest;
     PetscBool   match, of_body = PETSC_FALSE;
-    if (tok[k][0] != '-' || !(isalpha((unsigned char)tok[k][1]) || tok[k][1] == '_')) continue; /* a value */
-    PetscCall(PetscStrncmp(tok[k] + 1, common, lc, &match));
+    PetscCall(PetscStrncmp(name, common, lc, &match));
     if (!match) continue;
-    rest = tok[k] + 1 + lc;
-    if (k + 1 < ntok && !(tok[k + 1][0] == '-' && (isalpha((unsigned char)tok[k + 1][1]) || tok[k + 1][1] == '_'))) value = tok[k + 1];
+    rest = name + lc;
     for (PetscInt i = 0; i < pb->nb && !of_body; i++) {
-      const char *name;
+      const char *body;
       size_t      ln;
-      PetscCall((*bd->blockprefix)(bd->ctx, i, &name));
-      PetscCall(PetscStrlen(name, &ln));
-      PetscCall(PetscStrncmp(rest, name, ln, &of_body));
+      PetscCall((*bd->blockprefix)(bd->ctx, i, &body));
+      PetscCall(PetscStrlen(body, &ln));
+      PetscCall(PetscStrncmp(rest, body, ln, &of_body));
       of_body = (PetscBool)(of_body && rest[ln] == '_');
     }
     if (of_body) continue; /* a body's own option */
     for (PetscInt i = 0; i < pb->nb; i++) {
-      const char *name;
-      char        to[512];
+      const char *body;
+      char        to[512], *found = all;
       PetscBool   given = PETSC_FALSE;
-      PetscCall((*bd->blockprefix)(bd->ctx, i, &name));
-      PetscCall(PetscSNPrintf(to, sizeof(to), "-%s%s_%s", common, name, rest));
-      for (PetscInt l = 0; l < ntok && !given; l++) PetscCall(PetscStrcasecmp(tok[l], to, &given));
+      size_t      lt;
+      PetscCall((*bd->blockprefix)(bd->ctx, i, &body));
+      PetscCall(PetscSNPrintf(to, sizeof(to), "-%s%s_%s", common, body, rest));
+      PetscCall(PetscStrlen(to, &lt));
+      /* "-name " or "-name" at the end of the list of every option given */
+      while (!given && found) {
+        PetscCall(PetscStrstr(found, to, &found));
+        if (found) {
+          given = (PetscBool)((found == all || found[-1] == ' ') && (found[lt] == ' ' || found[lt] == 0));
+          found += lt;
+        }
+      }
       if (given) continue;
-      PetscCall(PetscOptionsSetValue(NULL, to, value));
-      if (!pb->copy_from) PetscCall(PetscCalloc2(ntok * pb->nb, &pb->copy_from, ntok * pb->nb, &pb->copy_to));
-      PetscCall(PetscStrallocpy(tok[k], &pb->copy_from[pb->ncopy]));
+      PetscCall(PetscOptionsSetValue(NULL, to, values[k] && values[k][0] ? values[k] : NULL));
+      if (!pb->copy_from) PetscCall(PetscCalloc2(nleft * pb->nb, &pb->copy_from, nleft * pb->nb, &pb->copy_to));
+      {
+        char from[512];
+        PetscCall(PetscSNPrintf(from, sizeof(from), "-%s", name));
+        PetscCall(PetscStrallocpy(from, &pb->copy_from[pb->ncopy]));
+      }
       PetscCall(PetscStrallocpy(to, &pb->copy_to[pb->ncopy]));
       pb->ncopy++;
     }
   }
-  PetscCall(PetscFree(tok));
-  PetscCall(PetscTokenDestroy(&token));
   PetscCall(PetscFree(all));
+  PetscCall(PetscOptionsLeftRestore(NULL, &nleft, &names, &values));
   PetscFunctionReturn(0);
 }
 
-/* after the bodies' solvers are set up: a common option whose copy was read counts as used; the copies themselves
-   are never reported */
 static PetscErrorCode BorderedCopiesFree(PC_Bordered *pb)
 {
   PetscFunctionBeginUser;

@@ -51,9 +51,9 @@ static void SBAIJ3Panel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, co
    component couples only with itself): the blocks' scalars m (one per stored block, in the matrix's order, copied
    once) and the loops over the 3 x w contiguous values of a node, which vectorize: a ninth of the matrix's bytes and a
    third of its arithmetic. The sums run in the order of SBAIJ3Panel, whose zero entries add exact zeros: the two give
-   the same bits. The node loops vectorize with GCC's dynamic cost model (the Makefile gives this file
-   -fvect-cost-model=dynamic; -O2's default model leaves them scalar): 0.83 -> 0.66 s for the 22 block products of the
-   2.2e5-DOF modes. */
+   the same bits as long as no multiply-add is fused (the Makefile gives this file -ffp-contract=off). The node loops
+   vectorize with GCC's dynamic cost model (also from the Makefile; -O2's default model leaves them scalar): 0.83 ->
+   0.66 s for the 22 block products of the 2.2e5-DOF modes. */
 static void SBAIJ3ScalarPanel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *m, PetscInt w, const PetscScalar *X, PetscScalar *Y)
 {
   const PetscInt w3 = 3 * w;
