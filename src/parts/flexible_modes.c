@@ -188,9 +188,8 @@ static PetscErrorCode ShiftedOperatorStorage(PhlexFlexible b, EPS eps, Mat A, Ma
 
 /* With -modes_eps_true_residual Krylov-Schur (and Arnoldi) test ||A x - lambda B x|| / |lambda| of each Ritz pair,
    which a rigid mode (lambda ~ 0, its residual at round-off of ||A||) never passes: a free body's run ended with no
-   mode at all. Below
-   rigid_below the test is the backward error ||A x - lambda B x|| / (||A||_inf + |lambda| ||B||_inf), what phlex
-   reports for rigid modes; above it SLEPc's relative test. */
+   mode at all. Below rigid_below the test is the backward error ||A x - lambda B x|| / (||A||_inf + |lambda|
+   ||B||_inf), what phlex reports for rigid modes; above it SLEPc's relative test. */
 typedef struct {
   PetscReal rigid_below, nrma, nrmb;
 } ConvergedRigidCtx;
