@@ -315,6 +315,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   EPS           eps;
   PhlexProgress progress;
   PetscReal omega = FrequencyScale(b, units), sigma, ftarget = -1;
+  const PetscReal rigid_below = 1e-6 * omega * omega; /* |lambda| below: a rigid mode */
   PetscBool free_body = (!b->frame_patch[0] || b->floating) ? PETSC_TRUE : PETSC_FALSE, flg;
   PetscInt  n, want;
   Mat       A = b->K, B = b->Mv;
@@ -360,7 +361,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     if (free_body && !mean_axes && trueres && krylov && conv == EPS_CONV_REL) {
       ConvergedRigidCtx *c;
       PetscCall(PetscNew(&c));
-      c->rigid_below = 1e-6 * omega * omega;
+      c->rigid_below = rigid_below;
       PetscCall(MatNorm(A, NORM_INFINITY, &c->nrma));
       PetscCall(MatNorm(B, NORM_INFINITY, &c->nrmb));
       PetscCall(EPSSetConvergenceTestFunction(eps, ConvergedRelativeOrBackward, c, ConvergedRigidDestroy));
@@ -394,14 +395,14 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
       if (rigid) (*rigid)[6 * i + i] = 1.0;
     }
     *nrigid = r0;
-    if (resid) PetscCall(EigenpairResiduals(eps, n, 1e-6 * omega * omega, *resid + r0));
+    if (resid) PetscCall(EigenpairResiduals(eps, n, rigid_below, *resid + r0));
     PetscCall(MatCreateVecs(A, &x, NULL));
     for (PetscInt e = 0; e < n; e++) {
       const PetscInt i = r0 + e;
       PetscScalar    kr, ki;
       PetscCall(EPSGetEigenpair(eps, e, &kr, &ki, x, NULL));
       (*lambda)[i] = PetscRealPart(kr);
-      if (PetscAbsReal((*lambda)[i]) < 1e-6 * omega * omega) (*nrigid)++; /* its residual is the backward error */
+      if (PetscAbsReal((*lambda)[i]) < rigid_below) (*nrigid)++; /* its residual is the backward error */
       if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
       if (!b->floating || mean_axes) {
         if (vecs) PetscCall(VecCopy(x, (*vecs)[i]));
