@@ -6,14 +6,24 @@
    and its transpose (the lower triangle, not stored) in the same pass. Other matrices: one MatMult per column. */
 #include <phlex_impl.h>
 #include <petsc/private/petscimpl.h> /* PetscObjectStateGet */
+#include <stdint.h>
 
 #define PHLEX_PANEL 8 /* vectors per pass: a panel of 8 doubles is one cache line */
+
+/* x86-64 with GCC: the kernels are compiled twice, for AVX2 and the baseline (SSE2), the first taken where the
+   processor has it (an ifunc, resolved once): the node loops then run 4 doubles wide instead of 2. The sums are the
+   same (no multiply-add fused, no reduction across a loop's lanes): the same bits either way. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+  #define PHLEX_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+  #define PHLEX_KERNEL_CLONES
+#endif
 
 /* Y (row-major, n x w) = A X (row-major, n x w), A upper-triangular 3x3-block storage (blocks column-major). The time
    goes into fetching the rows of X and Y of the node a block couples to, not into arithmetic: a compile-time panel
    width or -O3 -march=native changed nothing (BENCHMARKS.md section 14); a numbering that keeps neighbours close
    (-body<k>_node_order rcm) made it 2.2 x faster. */
-static void SBAIJ3Panel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *aa, PetscInt w, const PetscScalar *X, PetscScalar *Y)
+PHLEX_KERNEL_CLONES static void SBAIJ3Panel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *aa, PetscInt w, const PetscScalar *X, PetscScalar *Y)
 {
   for (PetscInt k = 0; k < 3 * mbs * w; k++) Y[k] = 0.0;
   for (PetscInt i = 0; i < mbs; i++) {
@@ -54,7 +64,7 @@ static void SBAIJ3Panel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, co
    the same bits as long as no multiply-add is fused (the Makefile gives this file -ffp-contract=off). The node loops
    vectorize with GCC's dynamic cost model (also from the Makefile; -O2's default model leaves them scalar): 0.83 ->
    0.66 s for the 22 block products of the 2.2e5-DOF modes. */
-static void SBAIJ3ScalarPanel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *m, PetscInt w, const PetscScalar *X, PetscScalar *Y)
+PHLEX_KERNEL_CLONES static void SBAIJ3ScalarPanel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *m, PetscInt w, const PetscScalar *X, PetscScalar *Y)
 {
   const PetscInt w3 = 3 * w;
 
@@ -162,7 +172,8 @@ PetscErrorCode PhlexMatMultBlock(Mat A, Mat X, Mat Y)
     const MatScalar   *m = NULL;
     MatScalar         *aa;
     const PetscScalar *x;
-    PetscScalar       *y, *xp, *yp;
+    PetscScalar       *y, *xbuf, *yp;
+    PetscBool          inY;
     PetscCall(MatGetRowIJ(A, 0, PETSC_FALSE, PETSC_TRUE, &mbs, &ai, &aj, &done));
     PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_PLIB, "MatGetRowIJ failed on a SeqSBAIJ matrix");
     PetscCall(MatSeqSBAIJGetArray(A, &aa));
@@ -171,17 +182,24 @@ PetscErrorCode PhlexMatMultBlock(Mat A, Mat X, Mat Y)
     PetscCall(MatDenseGetArrayRead(X, &x));
     PetscCall(MatDenseGetArrayWrite(Y, &y));
     PetscCall(ScalarTimesI3(A, mbs, ai, aj, aa, &m));
-    PetscCall(PetscMalloc2(n * PHLEX_PANEL, &xp, n * PHLEX_PANEL, &yp));
+    /* the packed panel of X goes into the columns of Y it is the product for, when they are contiguous and apart from
+       X (the memory of one panel less: it counts in the modal solve's peak); else into a buffer */
+    {
+      const uintptr_t x0 = (uintptr_t)x, x1 = (uintptr_t)(x + (size_t)ldx * k), y0 = (uintptr_t)y, y1 = (uintptr_t)(y + (size_t)ldy * k);
+      inY = (PetscBool)(ldy == n && (y1 <= x0 || x1 <= y0));
+    }
+    PetscCall(PetscMalloc2(inY ? 0 : n * PHLEX_PANEL, &xbuf, n * PHLEX_PANEL, &yp));
     for (PetscInt c0 = 0; c0 < k; c0 += PHLEX_PANEL) {
-      const PetscInt w = PetscMin(PHLEX_PANEL, k - c0);
+      const PetscInt w  = PetscMin(PHLEX_PANEL, k - c0);
+      PetscScalar   *xp = inY ? y + (size_t)c0 * ldy : xbuf;
       for (PetscInt r = 0; r < n; r++)
         for (PetscInt c = 0; c < w; c++) xp[r * w + c] = x[(c0 + c) * ldx + r];
       if (m) SBAIJ3ScalarPanel(mbs, ai, aj, m, w, xp, yp);
       else SBAIJ3Panel(mbs, ai, aj, aa, w, xp, yp);
-      for (PetscInt c = 0; c < w; c++)
-        for (PetscInt r = 0; r < n; r++) y[(c0 + c) * ldy + r] = yp[r * w + c];
+      for (PetscInt r = 0; r < n; r++) /* each row of the panel read once, written to w sequential streams */
+        for (PetscInt c = 0; c < w; c++) y[(c0 + c) * ldy + r] = yp[r * w + c];
     }
-    PetscCall(PetscFree2(xp, yp));
+    PetscCall(PetscFree2(xbuf, yp));
     PetscCall(MatDenseRestoreArrayWrite(Y, &y));
     PetscCall(MatDenseRestoreArrayRead(X, &x));
     PetscCall(MatSeqSBAIJRestoreArray(A, &aa));
