@@ -15,7 +15,9 @@
    from the orthogonalization coefficients (block classical Gram-Schmidt twice against V, Cholesky QR inside the
    block, a shifted Cholesky QR where the block is numerically rank deficient). B V is kept beside V and carried
    through the same recurrences: it gives the next right-hand sides and the B-inner products without more products
-   with B (Krylov-Schur: about three per vector with its B inner product). The Ritz pairs (theta, y) of the
+   with B (Krylov-Schur: about three per vector with its B inner product). Without it (-eps_phlexblock_keep_bv 0:
+   ncv vectors less memory, a sixth of a 2.2e5-DOF modal run's peak without the factor) B Z is computed again after
+   each projection that removed more than round-off, about three products per block. The Ritz pairs (theta, y) of the
    symmetric part of H[0:j, 0:j] give the eigenpairs lambda = sigma + 1/theta, and the Arnoldi relation gives their
    residuals in the transformed problem without another product:
 
@@ -32,7 +34,8 @@
    Options: -eps_phlexblock_block_size <bs> (default: nev, at most 8), -eps_ncv (default the larger of 2 nev + 3 bs
    and nev + 15; at least nev + 3 bs, so that nev must stay 3 below the problem's dimension), -eps_max_it (restart
    cycles; after the first, a cycle is one block step: the default is Krylov-Schur's, times the blocks of half a
-   basis), -eps_phlexblock_rayleigh_quotient. Real scalars only; -eps_true_residual is not supported. */
+   basis), -eps_phlexblock_rayleigh_quotient, -eps_phlexblock_keep_bv. Real scalars only; -eps_true_residual is not
+   supported. */
 #include <phlex_impl.h>
 #include <slepc/private/epsimpl.h>
 #include <petscblaslapack.h>
@@ -41,8 +44,11 @@ typedef struct {
   PetscInt     bsopt;      /* the block size asked for (-eps_phlexblock_block_size; 0: default) */
   PetscInt     bs;         /* the block size of the current set-up */
   PetscScalar *H;          /* ncv x ncv, column major: the block Arnoldi coefficients */
-  BV           BV;         /* B V, column by column (kept through the recurrences, no product with B) */
-  BV           W, Z, BZ;   /* one block: the right-hand sides, the block being orthonormalized and B times it */
+  PetscInt     keepbvopt;  /* -eps_phlexblock_keep_bv: 1, 0, or -1: decided by the cost of the products with B */
+  PetscBool    keepbv;     /* B V kept beside V in this set-up: one product with B per block, else about three */
+  BV           BV;         /* B V, column by column (kept through the recurrences, no product with B), or NULL */
+  BV           W, Z, BZ;   /* one block: B times the last block of V (the next right-hand sides), the block being
+                              orthonormalized and B times it; allocated for a solve only */
   BV           C, BC;      /* the deflation space (constraints of eps->V) and B C, NULL without */
   Mat          Cv, Cc;     /* coefficients against V (ncv x bs), against the constraints (nds x bs) */
   Mat          G, Rm;      /* bs x bs: Gram matrix, inverse of a triangular factor */
@@ -57,6 +63,9 @@ typedef struct {
 /* the loss of norm beyond which the projected B Z is recomputed rather than taken from the recurrence: the
    recurrence's round-off relative to the projected block grows with the loss, 1e4 keeps it near 1e-12 */
 #define PHLEX_EPS_BLOCK_LOSS 1e4
+/* without B V: the relative size of B V C (C the coefficients a projection removed) below which B Z is not computed
+   again after it (a few units of round-off) */
+#define PHLEX_EPS_BLOCK_STALE 1e-15
 
 /* the eigenvalues nearest the target: in the transformed space, the largest |theta| first */
 static PetscErrorCode EPSSetUpSort_PhlexBlock(EPS eps)
@@ -102,6 +111,32 @@ static PetscErrorCode WorkBV(EPS eps, PetscInt k, BV *bv)
   PetscFunctionReturn(0);
 }
 
+/* the solve's work space, B V (when kept) and three blocks, exists during the solve only: what follows it (the
+   eigenvectors' residuals, the caller's copies of them) then does not add to the peak memory */
+static PetscErrorCode AllocateWork(EPS eps)
+{
+  EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
+
+  PetscFunctionBegin;
+  if (ctx->keepbv) PetscCall(WorkBV(eps, eps->ncv, &ctx->BV));
+  PetscCall(WorkBV(eps, ctx->bs, &ctx->W));
+  PetscCall(WorkBV(eps, ctx->bs, &ctx->Z));
+  PetscCall(WorkBV(eps, ctx->bs, &ctx->BZ));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FreeWork(EPS eps)
+{
+  EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
+
+  PetscFunctionBegin;
+  PetscCall(BVDestroy(&ctx->BV));
+  PetscCall(BVDestroy(&ctx->W));
+  PetscCall(BVDestroy(&ctx->Z));
+  PetscCall(BVDestroy(&ctx->BZ));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode EPSSetUp_PhlexBlock(EPS eps)
 {
   EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
@@ -135,6 +170,20 @@ static PetscErrorCode EPSSetUp_PhlexBlock(EPS eps)
   PetscCheck(eps->ncv >= eps->nev + 3 * bs, PetscObjectComm((PetscObject)eps), PETSC_ERR_USER_INPUT, "EPS phlexblock: -%seps_ncv %" PetscInt_FMT " is too small for %" PetscInt_FMT " eigenpairs and block size %" PetscInt_FMT " (at least eigenpairs + 3 x block size = %" PetscInt_FMT ")", prefix, eps->ncv, eps->nev, bs, eps->nev + 3 * bs);
   ctx->bs  = bs;
   eps->mpd = eps->ncv;
+  /* B V: a product with a block of vectors of the mass (PhlexMatMultBlock on a SeqSBAIJ with 3x3 blocks) costs a few
+     sweeps over the vectors: the two more per block cost no time at 2.2e5 DOFs and ncv vectors less memory
+     (BENCHMARKS.md section 16); other B go one MatMult per column, and a standard problem's B V is V */
+  if (ctx->keepbvopt >= 0) ctx->keepbv = ctx->keepbvopt ? PETSC_TRUE : PETSC_FALSE;
+  else if (!eps->isgeneralized) ctx->keepbv = PETSC_FALSE;
+  else {
+    Mat       B;
+    PetscBool seqsbaij;
+    PetscInt  bsB;
+    PetscCall(STGetMatrix(eps->st, 1, &B));
+    PetscCall(PetscObjectTypeCompare((PetscObject)B, MATSEQSBAIJ, &seqsbaij));
+    PetscCall(MatGetBlockSize(B, &bsB));
+    ctx->keepbv = (PetscBool)!(seqsbaij && bsB == 3);
+  }
   /* after the first cycle a cycle is one block step: Krylov-Schur's default restarts, times the blocks of half a
      basis (the vectors one of its restarts adds) */
   if (eps->max_it == PETSC_DEFAULT || eps->max_it == PETSC_DECIDE) eps->max_it = PetscMax(100, 2 * eps->n / eps->ncv) * ((eps->ncv + 2 * bs - 1) / (2 * bs));
@@ -145,10 +194,7 @@ static PetscErrorCode EPSSetUp_PhlexBlock(EPS eps)
   PetscCall(PetscCalloc1(eps->ncv * eps->ncv, &ctx->H));
   PetscCall(PetscFree2(ctx->lock, ctx->lockerr));
   PetscCall(PetscMalloc2(eps->ncv, &ctx->lock, eps->ncv, &ctx->lockerr));
-  PetscCall(WorkBV(eps, eps->ncv, &ctx->BV));
-  PetscCall(WorkBV(eps, bs, &ctx->W));
-  PetscCall(WorkBV(eps, bs, &ctx->Z));
-  PetscCall(WorkBV(eps, bs, &ctx->BZ));
+  PetscCall(FreeWork(eps)); /* allocated by the solve */
   PetscCall(MatDestroy(&ctx->Cv));
   PetscCall(MatDestroy(&ctx->G));
   PetscCall(MatDestroy(&ctx->Rm));
@@ -268,9 +314,9 @@ static PetscErrorCode CholQR(EPS eps, PetscScalar *Rtot, PetscBool *shifted, Pet
   PetscFunctionReturn(0);
 }
 
-/* removes from Z (and BZ) its components along the constraints and V[:, 0:nv], B-orthogonally; when j0 >= 0 adds
-   the coefficients against V, times Rtot (bs x bs, NULL for the identity), to H[0:nv, j0:j0+bs]. The squared norms
-   of the coefficients removed go to cn2. */
+/* removes from Z (and from BZ: along V only with B V kept) its components along the constraints and V[:, 0:nv],
+   B-orthogonally; when j0 >= 0 adds the coefficients against V, times Rtot (bs x bs, NULL for the identity), to
+   H[0:nv, j0:j0+bs]. The squared norms of the coefficients removed go to cn2. */
 static PetscErrorCode ProjectOut(EPS eps, PetscInt nv, PetscInt j0, const PetscScalar *Rtot)
 {
   EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
@@ -290,10 +336,12 @@ static PetscErrorCode ProjectOut(EPS eps, PetscInt nv, PetscInt j0, const PetscS
   }
   if (!nv) PetscFunctionReturn(0);
   PetscCall(BVSetActiveColumns(eps->V, 0, nv));
-  PetscCall(BVSetActiveColumns(ctx->BV, 0, nv));
   PetscCall(BVDot(ctx->BZ, eps->V, ctx->Cv));
   PetscCall(BVMult(ctx->Z, -1.0, 1.0, eps->V, ctx->Cv));
-  PetscCall(BVMult(ctx->BZ, -1.0, 1.0, ctx->BV, ctx->Cv));
+  if (ctx->BV) { /* else BZ is left stale: RefreshBZ */
+    PetscCall(BVSetActiveColumns(ctx->BV, 0, nv));
+    PetscCall(BVMult(ctx->BZ, -1.0, 1.0, ctx->BV, ctx->Cv));
+  }
   PetscCall(MatDenseGetArray(ctx->Cv, &c));
   for (PetscInt j = 0; j < bs; j++)
     for (PetscInt i = 0; i < nv; i++) ctx->cn2[j] += PetscRealPart(c[i + j * ld] * PetscConj(c[i + j * ld]));
@@ -310,10 +358,36 @@ static PetscErrorCode ProjectOut(EPS eps, PetscInt nv, PetscInt j0, const PetscS
   PetscFunctionReturn(0);
 }
 
+/* Without B V, a projection against V leaves BZ as B times the block before it, off by B V C (C the coefficients
+   removed, their squared norms in cn2). B Z is computed again unless that is below round-off of what is left of each
+   column (the first projection of a Krylov block always removes more; the second, after a small loss, may not). */
+static PetscErrorCode RefreshBZ(EPS eps)
+{
+  EPS_PhlexBlock    *ctx = (EPS_PhlexBlock *)eps->data;
+  const PetscInt     bs  = ctx->bs;
+  const PetscScalar *g;
+  PetscBool          stale = PETSC_FALSE;
+
+  PetscFunctionBegin;
+  PetscCall(BVDot(ctx->BZ, ctx->Z, ctx->G));
+  PetscCall(MatDenseGetArrayRead(ctx->G, &g));
+  for (PetscInt i = 0; i < bs && !stale; i++) {
+    const PetscReal gii = PetscRealPart(g[i + i * bs]);
+    if (!(gii > 0) || ctx->cn2[i] > PetscSqr(PHLEX_EPS_BLOCK_STALE) * gii) stale = PETSC_TRUE;
+  }
+  PetscCall(MatDenseRestoreArrayRead(ctx->G, &g));
+  if (stale) {
+    PetscCall(ApplyB(eps, ctx->Z, ctx->BZ));
+    ctx->nBexact++;
+  }
+  PetscFunctionReturn(0);
+}
+
 /* Z (with BZ = B Z) made B-orthonormal to the constraints and to V[:, 0:nv] (block classical Gram-Schmidt twice,
    more passes while a Cholesky QR needs its shift): Z_in = V[:, 0:nv] H[0:nv, j0:j0+bs] + Z_out Rtot. B Z is carried
-   along by the same operations, and recomputed where the projection cancelled most of a column (its round-off
-   would then be large relative to what is left) or the block was numerically rank deficient. */
+   along by the same operations (without B V: computed again after a projection, RefreshBZ), and recomputed where
+   the projection cancelled most of a column (its round-off would then be large relative to what is left) or the
+   block was numerically rank deficient. */
 static PetscErrorCode OrthonormalizeBlock(EPS eps, PetscInt nv, PetscInt j0, PetscScalar *Rtot)
 {
   EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
@@ -327,6 +401,7 @@ static PetscErrorCode OrthonormalizeBlock(EPS eps, PetscInt nv, PetscInt j0, Pet
     PetscBool exact;
     PetscCheck(pass < 5, PetscObjectComm((PetscObject)eps), PETSC_ERR_CONV_FAILED, "EPS phlexblock: a block stays numerically dependent on the basis after %" PetscInt_FMT " orthogonalizations", pass);
     PetscCall(ProjectOut(eps, nv, j0, pass ? Rtot : NULL));
+    if (!ctx->BV && nv) PetscCall(RefreshBZ(eps));
     PetscCall(CholQR(eps, Rtot, &shifted, &loss));
     exact = (PetscBool)(shifted || loss > PHLEX_EPS_BLOCK_LOSS);
     if (exact && eps->isgeneralized) {
@@ -338,6 +413,21 @@ static PetscErrorCode OrthonormalizeBlock(EPS eps, PetscInt nv, PetscInt j0, Pet
   PetscFunctionReturn(0);
 }
 
+/* B times the new block V[:, nv:nv+bs], BZ: to B V (when kept) and to W, the next right-hand sides (the last block
+   stays the last through a restart) */
+static PetscErrorCode SaveBZ(EPS eps, PetscInt nv)
+{
+  EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
+
+  PetscFunctionBegin;
+  if (ctx->BV) {
+    PetscCall(BVSetActiveColumns(ctx->BV, nv, nv + ctx->bs));
+    PetscCall(BVCopy(ctx->BZ, ctx->BV));
+  }
+  PetscCall(BVCopy(ctx->BZ, ctx->W));
+  PetscFunctionReturn(0);
+}
+
 /* one block step: V[:, nv:nv+bs] from Op V[:, j0:j0+bs], with H[0:nv+bs, j0:j0+bs] */
 static PetscErrorCode Expand(EPS eps, PetscInt j0, PetscInt nv)
 {
@@ -345,9 +435,7 @@ static PetscErrorCode Expand(EPS eps, PetscInt j0, PetscInt nv)
   const PetscInt  bs = ctx->bs, ld = eps->ncv;
 
   PetscFunctionBegin;
-  /* Z = Op V[:, j0:j0+bs] from the kept B V[:, j0:j0+bs] (one solve), then B Z (one product) */
-  PetscCall(BVSetActiveColumns(ctx->BV, j0, j0 + bs));
-  PetscCall(BVCopy(ctx->BV, ctx->W));
+  /* Z = Op V[:, j0:j0+bs] from W = B V[:, j0:j0+bs], the last block's (one solve), then B Z (one product) */
   PetscCall(ApplyOp(eps, NULL, ctx->W, ctx->Z));
   PetscCall(ApplyB(eps, ctx->Z, ctx->BZ));
   for (PetscInt j = 0; j < bs; j++)
@@ -357,8 +445,7 @@ static PetscErrorCode Expand(EPS eps, PetscInt j0, PetscInt nv)
     for (PetscInt i = 0; i < bs; i++) ctx->H[nv + i + (j0 + j) * ld] = ctx->Rtot[i + j * bs];
   PetscCall(BVSetActiveColumns(eps->V, nv, nv + bs));
   PetscCall(BVCopy(ctx->Z, eps->V));
-  PetscCall(BVSetActiveColumns(ctx->BV, nv, nv + bs));
-  PetscCall(BVCopy(ctx->BZ, ctx->BV));
+  PetscCall(SaveBZ(eps, nv));
   PetscCall(BVSetActiveColumns(eps->V, 0, nv + bs));
   PetscFunctionReturn(0);
 }
@@ -439,7 +526,7 @@ static PetscErrorCode Rotate(EPS eps, PetscInt j, const PetscScalar *Y, PetscInt
   PetscCall(MatDenseRestoreArray(Q, &q));
   PetscCall(BVSetActiveColumns(eps->V, 0, nv));
   PetscCall(BVMultInPlace(eps->V, Q, 0, m));
-  if (restart) {
+  if (restart && ctx->BV) {
     PetscCall(BVSetActiveColumns(ctx->BV, 0, nv));
     PetscCall(BVMultInPlace(ctx->BV, Q, 0, m));
   }
@@ -467,8 +554,7 @@ static PetscErrorCode FirstBlock(EPS eps)
   PetscCall(ApplyB(eps, ctx->Z, ctx->BZ));
   PetscCall(OrthonormalizeBlock(eps, 0, -1, ctx->Rtot));
   PetscCall(BVCopy(ctx->Z, eps->V));
-  PetscCall(BVSetActiveColumns(ctx->BV, 0, bs));
-  PetscCall(BVCopy(ctx->BZ, ctx->BV));
+  PetscCall(SaveBZ(eps, 0));
   PetscFunctionReturn(0);
 }
 
@@ -481,19 +567,34 @@ static PetscErrorCode FirstBlock(EPS eps)
 static PetscErrorCode RefineRitzValues(EPS eps, PetscInt n)
 {
   EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
-  BV              Z   = NULL, BX = ctx->BV; /* B V is no longer needed: B x goes there */
+  BV              BX = NULL, Z = NULL, L = NULL, R = NULL, X = eps->V;
   Vec             x, bx, z;
+  PetscInt        m;
 
   PetscFunctionBegin;
   if (!n) PetscFunctionReturn(0);
-  PetscCall(WorkBV(eps, n, &Z));
+  /* B X into B V when kept (no longer needed), else new; Op B X into V's columns past the n vectors when they fit
+     (free after the final rotation), else new: no more memory than the iterations took */
+  PetscCall(BVDestroy(&ctx->W));
+  PetscCall(BVDestroy(&ctx->Z));
+  PetscCall(BVDestroy(&ctx->BZ));
+  if (ctx->BV) BX = ctx->BV;
+  else PetscCall(WorkBV(eps, n, &BX));
   PetscCall(BVSetActiveColumns(eps->V, 0, n));
   PetscCall(BVSetActiveColumns(BX, 0, n));
   PetscCall(ApplyB(eps, eps->V, BX));
+  PetscCall(BVGetSizes(eps->V, NULL, NULL, &m));
+  if (m - n >= n) {
+    PetscCall(BVSetActiveColumns(eps->V, n, m)); /* the split: V[:, 0:n] and the rest */
+    PetscCall(BVGetSplit(eps->V, &L, &R));
+    PetscCall(BVSetActiveColumns(R, 0, n));
+    Z = R;
+    X = L;
+  } else PetscCall(WorkBV(eps, n, &Z));
   PetscCall(ApplyOp(eps, NULL, BX, Z));
   for (PetscInt i = 0; i < n; i++) {
     PetscScalar num, den;
-    PetscCall(BVGetColumn(eps->V, i, &x));
+    PetscCall(BVGetColumn(X, i, &x));
     PetscCall(BVGetColumn(BX, i, &bx));
     PetscCall(BVGetColumn(Z, i, &z));
     PetscCall(VecDot(z, bx, &num));
@@ -501,9 +602,13 @@ static PetscErrorCode RefineRitzValues(EPS eps, PetscInt n)
     eps->eigr[i] = num / den;
     PetscCall(BVRestoreColumn(Z, i, &z));
     PetscCall(BVRestoreColumn(BX, i, &bx));
-    PetscCall(BVRestoreColumn(eps->V, i, &x));
+    PetscCall(BVRestoreColumn(X, i, &x));
   }
-  PetscCall(BVDestroy(&Z));
+  if (R) {
+    PetscCall(BVRestoreSplit(eps->V, &L, &R));
+    PetscCall(BVSetActiveColumns(eps->V, 0, n));
+  } else PetscCall(BVDestroy(&Z));
+  if (BX != ctx->BV) PetscCall(BVDestroy(&BX));
   PetscFunctionReturn(0);
 }
 
@@ -519,7 +624,8 @@ static PetscErrorCode EPSSolve_PhlexBlock(EPS eps)
 
   PetscFunctionBegin;
   PetscCall(PetscMalloc3(ncv, &theta, ncv, &res, ncv * ncv, &Y));
-  /* the B products are explicit (B V is kept): V's inner product is the Euclidean one during the solve */
+  PetscCall(AllocateWork(eps));
+  /* the B products are explicit: V's inner product is the Euclidean one during the solve */
   PetscCall(BVGetMatrix(eps->V, &B, &indef));
   PetscCall(PetscObjectReference((PetscObject)B));
   PetscCall(BVSetMatrix(eps->V, NULL, PETSC_FALSE));
@@ -609,8 +715,9 @@ static PetscErrorCode EPSSolve_PhlexBlock(EPS eps)
   eps->nconv = nconv;
   PetscCall(BVSetMatrix(eps->V, B, indef));
   PetscCall(MatDestroy(&B));
-  PetscCall(PetscInfo(eps, "%" PetscInt_FMT " restart cycles, %" PetscInt_FMT " block steps of %" PetscInt_FMT " vectors, %" PetscInt_FMT " products with B beyond one per block\n", eps->its, steps, bs, ctx->nBexact));
+  PetscCall(PetscInfo(eps, "%" PetscInt_FMT " restart cycles, %" PetscInt_FMT " block steps of %" PetscInt_FMT " vectors, %" PetscInt_FMT " products with B beyond one per block%s\n", eps->its, steps, bs, ctx->nBexact, ctx->keepbv ? "" : " (B V not kept)"));
   PetscCall(PetscFree3(theta, res, Y));
+  PetscCall(FreeWork(eps));
   PetscCall(BVDestroy(&ctx->C));
   PetscCall(BVDestroy(&ctx->BC));
   PetscCall(MatDestroy(&ctx->Cc));
@@ -651,6 +758,11 @@ static PetscErrorCode EPSSetFromOptions_PhlexBlock(EPS eps, PetscOptionItems *Pe
     PetscCheck(bs >= 1, PetscObjectComm((PetscObject)eps), PETSC_ERR_USER_INPUT, "-%seps_phlexblock_block_size must be >= 1, got %" PetscInt_FMT, prefix ? prefix : "", bs);
     ctx->bsopt = bs;
   }
+  {
+    PetscBool keep = ctx->keepbvopt == 1 ? PETSC_TRUE : PETSC_FALSE, set;
+    PetscCall(PetscOptionsBool("-eps_phlexblock_keep_bv", "Keep B V beside the basis V: one product with B per block, else about three and ncv vectors less memory (default: kept unless B is a sequential 3x3-block SBAIJ, whose block products are cheap)", "EPSPhlexBlock", keep, &keep, &set));
+    if (set) ctx->keepbvopt = keep ? 1 : 0;
+  }
   PetscCall(PetscOptionsBool("-eps_phlexblock_rayleigh_quotient", "Converged eigenvalues from the Rayleigh quotients of their vectors (one more block solve; accurate to 13 digits where the Ritz values agree to about 11)", "EPSPhlexBlock", ctx->refine, &ctx->refine, NULL));
   PetscOptionsHeadEnd();
   PetscFunctionReturn(0);
@@ -663,7 +775,10 @@ static PetscErrorCode EPSView_PhlexBlock(EPS eps, PetscViewer viewer)
 
   PetscFunctionBegin;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
-  if (ascii) PetscCall(PetscViewerASCIIPrintf(viewer, "  block shift-and-invert Krylov-Schur, block size %" PetscInt_FMT ", eigenvalues from %s\n", ctx->bs, ctx->refine ? "Rayleigh quotients" : "Ritz values"));
+  if (ascii) {
+    PetscCall(PetscViewerASCIIPrintf(viewer, "  block shift-and-invert Krylov-Schur, block size %" PetscInt_FMT ", eigenvalues from %s\n", ctx->bs, ctx->refine ? "Rayleigh quotients" : "Ritz values"));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "  B V %s\n", ctx->keepbv ? "kept beside the basis" : "not kept (B Z computed again after each projection)"));
+  }
   PetscFunctionReturn(0);
 }
 
@@ -674,10 +789,7 @@ static PetscErrorCode EPSReset_PhlexBlock(EPS eps)
   PetscFunctionBegin;
   PetscCall(PetscFree(ctx->H));
   PetscCall(PetscFree2(ctx->lock, ctx->lockerr));
-  PetscCall(BVDestroy(&ctx->BV));
-  PetscCall(BVDestroy(&ctx->W));
-  PetscCall(BVDestroy(&ctx->Z));
-  PetscCall(BVDestroy(&ctx->BZ));
+  PetscCall(FreeWork(eps));
   PetscCall(BVDestroy(&ctx->C));
   PetscCall(BVDestroy(&ctx->BC));
   PetscCall(MatDestroy(&ctx->Cv));
@@ -703,6 +815,7 @@ static PetscErrorCode EPSCreate_PhlexBlock(EPS eps)
   PetscFunctionBegin;
   PetscCall(PetscNew(&ctx));
   ctx->refine              = PETSC_TRUE;
+  ctx->keepbvopt           = -1;
   eps->data                = (void *)ctx;
   eps->categ               = EPS_CATEGORY_KRYLOV;
   eps->useds               = PETSC_FALSE;
