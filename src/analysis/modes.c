@@ -170,11 +170,13 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     PhlexPart  part = scene->parts[b];
     PetscInt   nconv, nrigid, nrigid_expected;
     PetscReal *lambda, *resid, *freq, *rigid;
-    Vec       *vecs;
+    Vec       *vecs = NULL;
     char       kind[64];
+    PetscBool  shapes; /* the mode shapes are written: the eigenvectors are needed (else not taken, nor held) */
     if (!part->ops.modes) continue;
+    shapes = (PetscBool)(scene->output->fields && part->ops.modesoutput);
     PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
-    PetscCall((*part->ops.modes)(part, nev, &nconv, &nrigid, &lambda, &vecs, &rigid, &resid));
+    PetscCall((*part->ops.modes)(part, nev, &nconv, &nrigid, &lambda, shapes ? &vecs : NULL, &rigid, &resid));
     PetscCall(PetscLogStagePop());
     PetscCall(PetscMalloc1(nconv, &freq));
     for (PetscInt i = 0; i < nconv; i++) freq[i] = Frequency(lambda[i], &scene->units);
@@ -191,14 +193,14 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
       const PetscReal lam = lambda[i] / PetscSqr(scene->units.time);
       PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d,%s\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0, part->name));
     }
-    if (scene->output->fields && part->ops.modesoutput) PetscCall((*part->ops.modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid, NULL));
+    if (shapes) PetscCall((*part->ops.modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid, NULL));
     if (o.nrefine > 0) PetscCall(ConvergenceStudy(scene, part, o.nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid, o.order_expect, o.order_tol));
     if (nexp) {
       nfexp = nconv - nrigid;
       PetscCall(PetscMalloc1(PetscMax(nfexp, 1), &fexp));
       PetscCall(PetscArraycpy(fexp, freq + nrigid, nfexp));
     }
-    for (PetscInt i = 0; i < nconv; i++) PetscCall(VecDestroy(&vecs[i]));
+    for (PetscInt i = 0; vecs && i < nconv; i++) PetscCall(VecDestroy(&vecs[i]));
     PetscCall(PetscFree(vecs));
     PetscCall(PetscFree(rigid));
     PetscCall(PetscFree(lambda));

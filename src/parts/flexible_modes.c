@@ -381,6 +381,8 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   {
     /* mean axes: the frame's six rigid modes (v = 0) come first */
     const PetscInt r0 = mean_axes ? 6 : 0, ntot = n + r0;
+    /* the eigenvectors are taken only for the caller's copies or a floating pencil's rigid parts */
+    const PetscBool need_x = (PetscBool)(vecs || (rigid && b->floating && !mean_axes));
     PetscCall(PetscMalloc1(ntot, lambda));
     if (resid) PetscCall(PetscMalloc1(ntot, resid));
     if (vecs) PetscCall(PetscMalloc1(ntot, vecs));
@@ -400,9 +402,11 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     for (PetscInt e = 0; e < n; e++) {
       const PetscInt i = r0 + e;
       PetscScalar    kr, ki;
-      PetscCall(EPSGetEigenpair(eps, e, &kr, &ki, x, NULL));
+      if (need_x) PetscCall(EPSGetEigenpair(eps, e, &kr, &ki, x, NULL));
+      else PetscCall(EPSGetEigenvalue(eps, e, &kr, &ki));
       (*lambda)[i] = PetscRealPart(kr);
       if (PetscAbsReal((*lambda)[i]) < rigid_below) (*nrigid)++; /* its residual is the backward error */
+      if (!need_x) continue;
       if (vecs) PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
       if (!b->floating || mean_axes) {
         if (vecs) PetscCall(VecCopy(x, (*vecs)[i]));
