@@ -48,7 +48,7 @@ typedef struct {
   PetscBool    keepbv;     /* B V kept beside V in this set-up: one product with B per block, else about three */
   BV           BV;         /* B V, column by column (kept through the recurrences, no product with B), or NULL */
   BV           W, Z, BZ;   /* one block: B times the last block of V (the next right-hand sides), the block being
-                              orthonormalized and B times it; allocated for a solve only */
+                              orthonormalized and B times it (in W's storage); allocated for a solve only */
   BV           C, BC;      /* the deflation space (constraints of eps->V) and B C, NULL without */
   Mat          Cv, Cc;     /* coefficients against V (ncv x bs), against the constraints (nds x bs) */
   Mat          G, Rm;      /* bs x bs: Gram matrix, inverse of a triangular factor */
@@ -121,7 +121,10 @@ static PetscErrorCode AllocateWork(EPS eps)
   if (ctx->keepbv) PetscCall(WorkBV(eps, eps->ncv, &ctx->BV));
   PetscCall(WorkBV(eps, ctx->bs, &ctx->W));
   PetscCall(WorkBV(eps, ctx->bs, &ctx->Z));
-  PetscCall(WorkBV(eps, ctx->bs, &ctx->BZ));
+  /* B Z shares W's storage: W (the right-hand sides) is read by the solve that makes Z, B Z is formed after it and
+     is the next W (SaveBZ) */
+  PetscCall(PetscObjectReference((PetscObject)ctx->W));
+  ctx->BZ = ctx->W;
   PetscFunctionReturn(0);
 }
 
@@ -359,8 +362,9 @@ static PetscErrorCode ProjectOut(EPS eps, PetscInt nv, PetscInt j0, const PetscS
 }
 
 /* Without B V, a projection against V leaves BZ as B times the block before it, off by B V C (C the coefficients
-   removed, their squared norms in cn2). B Z is computed again unless that is below round-off of what is left of each
-   column (the first projection of a Krylov block always removes more; the second, after a small loss, may not). */
+   removed, their squared norms in cn2, with those against the constraints, whose B C is applied: a conservative
+   test). B Z is computed again unless that is below round-off of what is left of each column (the first projection
+   of a Krylov block always removes more; the second, after a small loss, may not). */
 static PetscErrorCode RefreshBZ(EPS eps)
 {
   EPS_PhlexBlock    *ctx = (EPS_PhlexBlock *)eps->data;
@@ -404,7 +408,8 @@ static PetscErrorCode OrthonormalizeBlock(EPS eps, PetscInt nv, PetscInt j0, Pet
     if (!ctx->BV && nv) PetscCall(RefreshBZ(eps));
     PetscCall(CholQR(eps, Rtot, &shifted, &loss));
     exact = (PetscBool)(shifted || loss > PHLEX_EPS_BLOCK_LOSS);
-    if (exact && eps->isgeneralized) {
+    /* (without B V, B Z was computed after the projection: a large loss needs another pass, not another product) */
+    if ((shifted || (exact && ctx->BV)) && eps->isgeneralized) {
       PetscCall(ApplyB(eps, ctx->Z, ctx->BZ));
       ctx->nBexact++;
     }
@@ -424,7 +429,7 @@ static PetscErrorCode SaveBZ(EPS eps, PetscInt nv)
     PetscCall(BVSetActiveColumns(ctx->BV, nv, nv + ctx->bs));
     PetscCall(BVCopy(ctx->BZ, ctx->BV));
   }
-  PetscCall(BVCopy(ctx->BZ, ctx->W));
+  if (ctx->BZ != ctx->W) PetscCall(BVCopy(ctx->BZ, ctx->W));
   PetscFunctionReturn(0);
 }
 
@@ -567,14 +572,15 @@ static PetscErrorCode FirstBlock(EPS eps)
 static PetscErrorCode RefineRitzValues(EPS eps, PetscInt n)
 {
   EPS_PhlexBlock *ctx = (EPS_PhlexBlock *)eps->data;
-  BV              BX = NULL, Z = NULL, L = NULL, R = NULL, X = eps->V;
+  BV              BX = NULL, Z = NULL;
   Vec             x, bx, z;
   PetscInt        m;
 
   PetscFunctionBegin;
   if (!n) PetscFunctionReturn(0);
-  /* B X into B V when kept (no longer needed), else new; Op B X into V's columns past the n vectors when they fit
-     (free after the final rotation), else new: no more memory than the iterations took */
+  /* B X into B V when kept (no longer needed), else new; Op B X into V's columns n..2n when they exist (free after
+     the final rotation; V itself, not a split of it: SLEPc keeps a split's view of the storage, which a later
+     BVResize frees), else new: no more memory than the iterations took */
   PetscCall(BVDestroy(&ctx->W));
   PetscCall(BVDestroy(&ctx->Z));
   PetscCall(BVDestroy(&ctx->BZ));
@@ -584,30 +590,32 @@ static PetscErrorCode RefineRitzValues(EPS eps, PetscInt n)
   PetscCall(BVSetActiveColumns(BX, 0, n));
   PetscCall(ApplyB(eps, eps->V, BX));
   PetscCall(BVGetSizes(eps->V, NULL, NULL, &m));
-  if (m - n >= n) {
-    PetscCall(BVSetActiveColumns(eps->V, n, m)); /* the split: V[:, 0:n] and the rest */
-    PetscCall(BVGetSplit(eps->V, &L, &R));
-    PetscCall(BVSetActiveColumns(R, 0, n));
-    Z = R;
-    X = L;
-  } else PetscCall(WorkBV(eps, n, &Z));
-  PetscCall(ApplyOp(eps, NULL, BX, Z));
+  if (2 * n <= m) {
+    Mat Xm, Ym;
+    PetscCall(BVSetActiveColumns(eps->V, n, 2 * n));
+    PetscCall(BVGetMat(BX, &Xm));
+    PetscCall(BVGetMat(eps->V, &Ym));
+    PetscCall(STMatMatSolve(eps->st, Xm, Ym));
+    PetscCall(BVRestoreMat(eps->V, &Ym));
+    PetscCall(BVRestoreMat(BX, &Xm));
+  } else {
+    PetscCall(WorkBV(eps, n, &Z));
+    PetscCall(ApplyOp(eps, NULL, BX, Z));
+  }
   for (PetscInt i = 0; i < n; i++) {
     PetscScalar num, den;
-    PetscCall(BVGetColumn(X, i, &x));
+    PetscCall(BVGetColumn(eps->V, i, &x));
     PetscCall(BVGetColumn(BX, i, &bx));
-    PetscCall(BVGetColumn(Z, i, &z));
+    PetscCall(BVGetColumn(Z ? Z : eps->V, Z ? i : n + i, &z));
     PetscCall(VecDot(z, bx, &num));
     PetscCall(VecDot(x, bx, &den));
     eps->eigr[i] = num / den;
-    PetscCall(BVRestoreColumn(Z, i, &z));
+    PetscCall(BVRestoreColumn(Z ? Z : eps->V, Z ? i : n + i, &z));
     PetscCall(BVRestoreColumn(BX, i, &bx));
-    PetscCall(BVRestoreColumn(X, i, &x));
+    PetscCall(BVRestoreColumn(eps->V, i, &x));
   }
-  if (R) {
-    PetscCall(BVRestoreSplit(eps->V, &L, &R));
-    PetscCall(BVSetActiveColumns(eps->V, 0, n));
-  } else PetscCall(BVDestroy(&Z));
+  PetscCall(BVSetActiveColumns(eps->V, 0, n));
+  PetscCall(BVDestroy(&Z));
   if (BX != ctx->BV) PetscCall(BVDestroy(&BX));
   PetscFunctionReturn(0);
 }

@@ -169,14 +169,15 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   for (PetscInt b = 0; b < scene->nparts; b++) {
     PhlexPart  part = scene->parts[b];
     PetscInt   nconv, nrigid, nrigid_expected;
-    PetscReal *lambda, *resid, *freq, *rigid;
+    PetscReal *lambda, *resid, *freq, *rigid = NULL;
     Vec       *vecs = NULL;
     char       kind[64];
-    PetscBool  shapes; /* the mode shapes are written: the eigenvectors are needed (else not taken, nor held) */
+    PetscBool  shapes; /* the mode shapes are written: the caller's copies of the eigenvectors are needed (else the
+                          eigensolver's are read only for the residuals) */
     if (!part->ops.modes) continue;
     shapes = (PetscBool)(scene->output->fields && part->ops.modesoutput);
     PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
-    PetscCall((*part->ops.modes)(part, nev, &nconv, &nrigid, &lambda, shapes ? &vecs : NULL, &rigid, &resid));
+    PetscCall((*part->ops.modes)(part, nev, &nconv, &nrigid, &lambda, shapes ? &vecs : NULL, shapes ? &rigid : NULL, &resid));
     PetscCall(PetscLogStagePop());
     PetscCall(PetscMalloc1(nconv, &freq));
     for (PetscInt i = 0; i < nconv; i++) freq[i] = Frequency(lambda[i], &scene->units);

@@ -381,7 +381,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   {
     /* mean axes: the frame's six rigid modes (v = 0) come first */
     const PetscInt r0 = mean_axes ? 6 : 0, ntot = n + r0;
-    /* the eigenvectors are taken only for the caller's copies or a floating pencil's rigid parts */
+    /* the eigenvectors are copied out only for the caller's copies or a floating pencil's rigid parts */
     const PetscBool need_x = (PetscBool)(vecs || (rigid && b->floating && !mean_axes));
     PetscCall(PetscMalloc1(ntot, lambda));
     if (resid) PetscCall(PetscMalloc1(ntot, resid));
@@ -398,7 +398,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     }
     *nrigid = r0;
     if (resid) PetscCall(EigenpairResiduals(eps, n, rigid_below, *resid + r0));
-    PetscCall(MatCreateVecs(A, &x, NULL));
+    if (need_x) PetscCall(MatCreateVecs(A, &x, NULL));
     for (PetscInt e = 0; e < n; e++) {
       const PetscInt i = r0 + e;
       PetscScalar    kr, ki;

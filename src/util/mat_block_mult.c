@@ -13,16 +13,20 @@
 /* x86-64 with GCC: the kernels are compiled twice, for AVX2 and the baseline (SSE2), the first taken where the
    processor has it (an ifunc, resolved once): the node loops then run 4 doubles wide instead of 2. The sums are the
    same (no multiply-add fused, no reduction across a loop's lanes): the same bits either way. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-  #define PHLEX_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
-#else
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__GLIBC__) && defined(__has_attribute)
+  #if __has_attribute(target_clones) /* and glibc's ifunc (musl has none) */
+    #define PHLEX_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+  #endif
+#endif
+#ifndef PHLEX_KERNEL_CLONES
   #define PHLEX_KERNEL_CLONES
 #endif
 
-/* Y (row-major, n x w) = A X (row-major, n x w), A upper-triangular 3x3-block storage (blocks column-major). The time
-   goes into fetching the rows of X and Y of the node a block couples to, not into arithmetic: a compile-time panel
-   width or -O3 -march=native changed nothing (BENCHMARKS.md section 14); a numbering that keeps neighbours close
-   (-body<k>_node_order rcm) made it 2.2 x faster. */
+/* Y (row-major, n x w) = A X (row-major, n x w), A upper-triangular 3x3-block storage (blocks column-major). With the
+   mesh file's numbering the time went into fetching the rows of X and Y of the node a block couples to: a
+   compile-time panel width or -O3 -march=native changed nothing (BENCHMARKS.md section 14), a numbering that keeps
+   neighbours close (-body<k>_node_order rcm) made it 2.2 x faster; after that the arithmetic shows (the AVX2 clone
+   of the scalar kernel below: 10 % of its time, section 16). */
 PHLEX_KERNEL_CLONES static void SBAIJ3Panel(PetscInt mbs, const PetscInt *ai, const PetscInt *aj, const MatScalar *aa, PetscInt w, const PetscScalar *X, PetscScalar *Y)
 {
   for (PetscInt k = 0; k < 3 * mbs * w; k++) Y[k] = 0.0;
@@ -185,7 +189,8 @@ PetscErrorCode PhlexMatMultBlock(Mat A, Mat X, Mat Y)
     /* the packed panel of X goes into the columns of Y it is the product for, when they are contiguous and apart from
        X (the memory of one panel less: it counts in the modal solve's peak); else into a buffer */
     {
-      const uintptr_t x0 = (uintptr_t)x, x1 = (uintptr_t)(x + (size_t)ldx * k), y0 = (uintptr_t)y, y1 = (uintptr_t)(y + (size_t)ldy * k);
+      const uintptr_t x0 = (uintptr_t)x, x1 = x0 + sizeof(PetscScalar) * (size_t)ldx * (size_t)k;
+      const uintptr_t y0 = (uintptr_t)y, y1 = y0 + sizeof(PetscScalar) * (size_t)ldy * (size_t)k;
       inY = (PetscBool)(ldy == n && (y1 <= x0 || x1 <= y0));
     }
     PetscCall(PetscMalloc2(inY ? 0 : n * PHLEX_PANEL, &xbuf, n * PHLEX_PANEL, &yp));
