@@ -3,6 +3,8 @@
 #ifndef PHLEX_PRIVATE_FLEXIBLE_H
 #define PHLEX_PRIVATE_FLEXIBLE_H
 
+#include <stdint.h> /* uint64_t */
+
 #define PHLEX_MAX_MATERIALS 16
 
 /* Stress components (Voigt order) of the 6-component stress field; shear components hold the tensor entry. */
@@ -266,6 +268,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleGetBasis(PhlexFlexible, PetscBool, Phle
 PETSC_INTERN PetscErrorCode PhlexFlexibleRestoreBasis(PhlexElementBasis *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible, Vec, Vec, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexFlexiblePlacement(PhlexFlexible, uint64_t *);
 
 /* flexible_port.c */
 typedef PetscErrorCode (*PhlexSurfaceFunc)(void *, PetscInt, const PetscReal *, const PetscReal *, const PetscReal *, const PetscInt *, const PetscInt *, PetscInt);

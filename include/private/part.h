@@ -133,8 +133,9 @@ struct _p_PhlexPart {
   char              prefix[32];
   char              name[PHLEX_NAME_LEN];
   char              type[32];
-  char              numbering[16]; /* how its field unknowns are numbered when not as read ("": as read), part of a
-                                      checkpoint's fingerprint */
+  char              numbering[48]; /* how its field unknowns are numbered ("rcm" or "file", and "@" a hash of where
+                                      they are, PhlexFlexiblePlacement; "": no field unknowns), part of a checkpoint's
+                                      fingerprint */
   PhlexPartOps      ops;
   void             *data;
   const PhlexUnits *units;

@@ -45,6 +45,19 @@ static void UnpackMonitor(MonitorContext *m, const PetscReal a[CHECKPOINT_NMONIT
   m->last_written = (PetscInt)a[k++], m->nretries = (PetscInt)a[k++];
 }
 
+/* removes the placement hashes ("@" and 16 hex digits, PhlexFlexiblePlacement) from a fingerprint */
+static void StripPlacementHashes(char *s)
+{
+  char *w = s;
+  for (const char *r = s; *r;) {
+    if (*r == '@') {
+      r++;
+      while ((*r >= '0' && *r <= '9') || (*r >= 'a' && *r <= 'f')) r++;
+    } else *w++ = *r++;
+  }
+  *w = 0;
+}
+
 /* what the state vector means: the parts and joints by name and kind, the sizes, the scales; a restart checks that
    its own run has the same */
 static PetscErrorCode Fingerprint(MonitorContext *m, char **fingerprint, PetscReal units[4])
@@ -274,6 +287,22 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
   PetscCall(PetscStrcmp(parts, ck_parts, &same));
   if (!same) {
     char msg[PETSC_MAX_PATH_LEN];
+    char *a, *c;
+    PetscBool numbering;
+    /* the same scene but its field unknowns placed otherwise (the hashes after '@' differ) */
+    PetscCall(PetscStrallocpy(parts, &a));
+    PetscCall(PetscStrallocpy(ck_parts, &c));
+    StripPlacementHashes(a);
+    StripPlacementHashes(c);
+    PetscCall(PetscStrcmp(a, c, &numbering));
+    PetscCall(PetscFree(a));
+    PetscCall(PetscFree(c));
+    if (numbering) {
+      PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for this scene with its field unknowns numbered otherwise (its parts '%s', this scene's '%s'; after '@' a hash of where each body's unknowns are in its mesh): restart with the same mesh files, their nodes in the same order, the same -body<k>_node_order and partitioner", file, ck_parts, parts));
+      PetscCall(PetscFree(parts));
+      PetscCall(PetscFree(ck_parts));
+      SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);
+    }
     PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for another scene: its parts and joints (name:kind:field unknowns:discrete unknowns[:numbering of the unknowns, -body<k>_node_order]) are '%s', this scene's '%s'", file, ck_parts, parts));
     PetscCall(PetscFree(parts));
     PetscCall(PetscFree(ck_parts));

@@ -107,7 +107,6 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCheck(!center_given || spin_given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin_center without -%sspin: give the spin's angular velocity", b->name, b->prefix, b->prefix);
   b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
   b->rcm            = order ? PETSC_TRUE : PETSC_FALSE;
-  PetscCall(PetscStrncpy(part->numbering, b->rcm ? "rcm" : "", sizeof(part->numbering)));
   b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
   b->gyroscopic     = inertia == 1 ? PETSC_TRUE : PETSC_FALSE;
   b->inertia_model  = PhlexInertiaTypes[inertia];
@@ -287,6 +286,11 @@ static PetscErrorCode FlexSetUp(PhlexPart part)
 
   PetscFunctionBeginUser;
   PetscCall(PhlexFlexibleSetUpFE(b, u));
+  {
+    uint64_t h;
+    PetscCall(PhlexFlexiblePlacement(b, &h));
+    PetscCall(PetscSNPrintf(part->numbering, sizeof(part->numbering), "%s@%016llx", b->rcm ? "rcm" : "file", (unsigned long long)h));
+  }
   if (!b->floating) PetscCall(PhlexFlexibleSetUpInertia(b, u)); /* nodal int rho phi: gravity on a fixed body */
   PetscCall(SetUpPorts(part));
   PetscCall(SetUpLayout(part));

@@ -1,6 +1,8 @@
 /* A flexible body's finite element spaces and its constant body-frame operators (velocity mass, stress compliance
    mass, Grad coupling, condensed stiffness, inertia invariants), assembled once (paper Section 4). */
 #include <phlex_impl.h>
+#include <stdint.h>
+#include <string.h> /* memcpy */
 
 
 /* Discontinuous P_{k-1} Lagrange element with 6 components (the symmetric stress in Voigt order). */
@@ -631,6 +633,82 @@ PetscErrorCode PhlexFlexibleSetUpInertia(PhlexFlexible b, const PhlexUnits *u)
   }
   for (PetscInt k = 0; k < 9; k++) b->inertia.E0[k] = glob[4 + k];
   b->inertia.vol = glob[13];
+  PetscFunctionReturn(0);
+}
+
+/* splitmix64's finalizer: a 64-bit mix in which every input bit reaches every output bit */
+static inline uint64_t Mix64(uint64_t x)
+{
+  x ^= x >> 30;
+  x *= 0xbf58476d1ce4e5b9ULL;
+  x ^= x >> 27;
+  x *= 0x94d049bb133111ebULL;
+  x ^= x >> 31;
+  return x;
+}
+
+/* XOR over the points of dm's global section that this process owns and that carry unknowns: their first global
+   number mixed with their place, the XOR of their closure's vertices' coordinate bits (order-free, no arithmetic on
+   them: a point gets the same key on any process count and in any numbering) */
+static PetscErrorCode PlacementOfSection(DM dm, uint64_t *h)
+{
+  PetscSection       gs, cs;
+  Vec                coords;
+  const PetscScalar *x;
+  PetscInt           pStart, pEnd, vStart, vEnd, dim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetGlobalSection(dm, &gs));
+  PetscCall(DMGetCoordinateSection(dm, &cs));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMGetCoordinateDim(dm, &dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(PetscSectionGetChart(gs, &pStart, &pEnd));
+  PetscCall(VecGetArrayRead(coords, &x));
+  for (PetscInt p = pStart; p < pEnd; p++) {
+    PetscInt dof, off, npts, *pts = NULL;
+    uint64_t key = 0;
+    PetscCall(PetscSectionGetDof(gs, p, &dof));
+    PetscCall(PetscSectionGetOffset(gs, p, &off));
+    if (dof <= 0 || off < 0) continue; /* no unknowns, or another process's */
+    PetscCall(DMPlexGetTransitiveClosure(dm, p, PETSC_TRUE, &npts, &pts));
+    for (PetscInt k = 0; k < npts; k++) {
+      const PetscInt v = pts[2 * k];
+      PetscInt       coff;
+      uint64_t       kv = 0x9e3779b97f4a7c15ULL;
+      if (v < vStart || v >= vEnd) continue;
+      PetscCall(PetscSectionGetOffset(cs, v, &coff));
+      for (PetscInt d = 0; d < dim; d++) {
+        uint64_t bits;
+        memcpy(&bits, &x[coff + d], sizeof(bits));
+        kv = Mix64(kv ^ bits);
+      }
+      key ^= kv;
+    }
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, p, PETSC_TRUE, &npts, &pts));
+    *h ^= Mix64(key ^ Mix64((uint64_t)off + 1));
+  }
+  PetscCall(VecRestoreArrayRead(coords, &x));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexiblePlacement - a 64-bit hash of where the body's unknowns are: each velocity node's and each cell's stress
+  unknowns' first global number with the coordinates of its place, over the processes. The same mesh, node order and
+  partition give the same hash on any machine; another order of the mesh file's nodes, -node_order, partitioner or
+  RCM implementation another: a checkpoint's fingerprint holds it, so that a restart never reads a state into
+  unknowns numbered otherwise.
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexiblePlacement(PhlexFlexible b, uint64_t *hash)
+{
+  uint64_t h = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PlacementOfSection(b->dm, &h));
+  PetscCall(PlacementOfSection(b->dm_s, &h));
+  PetscCallMPI(MPI_Allreduce(&h, hash, 1, MPI_UINT64_T, MPI_BXOR, b->comm));
   PetscFunctionReturn(0);
 }
 
