@@ -14,6 +14,7 @@
    difference is of the order of the scheme's local error. An adaptive step's first error estimate after a restart
    likewise lacks the previous step. */
 #include <phlex_impl.h>
+#include <string.h> /* strchr */
 #include <private/transient.h>
 #include <petscviewerhdf5.h>
 
@@ -297,6 +298,12 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
     PetscCall(PetscStrcmp(a, c, &numbering));
     PetscCall(PetscFree(a));
     PetscCall(PetscFree(c));
+    if (numbering && !strchr(ck_parts, '@')) {
+      PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written by an earlier phlex, which did not record where the bodies' unknowns are in their meshes ('%s'; this run '%s'): it cannot be checked against this run's numbering; continue that run with the phlex that wrote it", file, ck_parts, parts));
+      PetscCall(PetscFree(parts));
+      PetscCall(PetscFree(ck_parts));
+      SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);
+    }
     if (numbering) {
       PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for this scene with its field unknowns numbered otherwise (its parts '%s', this scene's '%s'; after '@' a hash of where each body's unknowns are in its mesh): restart with the same mesh files, their nodes in the same order, the same -body<k>_node_order and partitioner", file, ck_parts, parts));
       PetscCall(PetscFree(parts));
