@@ -768,7 +768,7 @@ static PetscErrorCode EPSSetFromOptions_PhlexBlock(EPS eps, PetscOptionItems *Pe
   }
   {
     PetscBool keep = ctx->keepbvopt == 1 ? PETSC_TRUE : PETSC_FALSE, set;
-    PetscCall(PetscOptionsBool("-eps_phlexblock_keep_bv", "Keep B V beside the basis V: one product with B per block, else about three and ncv vectors less memory (default: kept unless B is a sequential 3x3-block SBAIJ, whose block products are cheap)", "EPSPhlexBlock", keep, &keep, &set));
+    PetscCall(PetscOptionsBool("-eps_phlexblock_keep_bv", "Keep B V beside the basis V: one product with B per block, else about three and ncv vectors less memory (not given: auto, kept unless B is a sequential 3x3-block SBAIJ, whose block products are cheap; -eps_view says which)", "EPSPhlexBlock", keep, &keep, &set));
     if (set) ctx->keepbvopt = keep ? 1 : 0;
   }
   PetscCall(PetscOptionsBool("-eps_phlexblock_rayleigh_quotient", "Converged eigenvalues from the Rayleigh quotients of their vectors (one more block solve; accurate to 13 digits where the Ritz values agree to about 11)", "EPSPhlexBlock", ctx->refine, &ctx->refine, NULL));
