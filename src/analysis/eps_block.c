@@ -111,7 +111,7 @@ static PetscErrorCode WorkBV(EPS eps, PetscInt k, BV *bv)
   PetscFunctionReturn(0);
 }
 
-/* the solve's work space, B V (when kept) and three blocks, exists during the solve only: what follows it (the
+/* the solve's work space, B V (when kept) and two blocks (B Z in W's storage), exists during the solve only: what follows it (the
    eigenvectors' residuals, the caller's copies of them) then does not add to the peak memory */
 static PetscErrorCode AllocateWork(EPS eps)
 {
@@ -418,7 +418,7 @@ static PetscErrorCode OrthonormalizeBlock(EPS eps, PetscInt nv, PetscInt j0, Pet
   PetscFunctionReturn(0);
 }
 
-/* B times the new block V[:, nv:nv+bs], BZ: to B V (when kept) and to W, the next right-hand sides (the last block
+/* B times the new block V[:, nv:nv+bs], BZ, to B V when kept; BZ is W, the next right-hand sides (the last block
    stays the last through a restart) */
 static PetscErrorCode SaveBZ(EPS eps, PetscInt nv)
 {
@@ -429,7 +429,6 @@ static PetscErrorCode SaveBZ(EPS eps, PetscInt nv)
     PetscCall(BVSetActiveColumns(ctx->BV, nv, nv + ctx->bs));
     PetscCall(BVCopy(ctx->BZ, ctx->BV));
   }
-  if (ctx->BZ != ctx->W) PetscCall(BVCopy(ctx->BZ, ctx->W));
   PetscFunctionReturn(0);
 }
 
@@ -590,18 +589,9 @@ static PetscErrorCode RefineRitzValues(EPS eps, PetscInt n)
   PetscCall(BVSetActiveColumns(BX, 0, n));
   PetscCall(ApplyB(eps, eps->V, BX));
   PetscCall(BVGetSizes(eps->V, NULL, NULL, &m));
-  if (2 * n <= m) {
-    Mat Xm, Ym;
-    PetscCall(BVSetActiveColumns(eps->V, n, 2 * n));
-    PetscCall(BVGetMat(BX, &Xm));
-    PetscCall(BVGetMat(eps->V, &Ym));
-    PetscCall(STMatMatSolve(eps->st, Xm, Ym));
-    PetscCall(BVRestoreMat(eps->V, &Ym));
-    PetscCall(BVRestoreMat(BX, &Xm));
-  } else {
-    PetscCall(WorkBV(eps, n, &Z));
-    PetscCall(ApplyOp(eps, NULL, BX, Z));
-  }
+  if (2 * n <= m) PetscCall(BVSetActiveColumns(eps->V, n, 2 * n));
+  else PetscCall(WorkBV(eps, n, &Z));
+  PetscCall(ApplyOp(eps, NULL, BX, Z ? Z : eps->V));
   for (PetscInt i = 0; i < n; i++) {
     PetscScalar num, den;
     PetscCall(BVGetColumn(eps->V, i, &x));
