@@ -147,8 +147,23 @@ PETSC_INTERN PetscErrorCode PhlexExpectValues(MPI_Comm, const char[], const char
 /* mat_shell.c: shell matrices without a transpose */
 PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, PetscInt, PetscInt, void *, PetscErrorCode (*)(Mat, Vec, Vec), Mat *);
 
+/* x86-64 with GCC: a kernel marked PHLEX_KERNEL_CLONES is compiled twice, for AVX2 and the baseline (SSE2), the first
+   taken where the processor has it (an ifunc, resolved once): its loops then run 4 doubles wide instead of 2. The
+   sums are the same (no multiply-add fused, no reduction across a loop's lanes): the same bits either way. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__GLIBC__) && defined(__has_attribute)
+  #if __has_attribute(target_clones) /* and glibc's ifunc (musl has none) */
+    #define PHLEX_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
+  #endif
+#endif
+#ifndef PHLEX_KERNEL_CLONES
+  #define PHLEX_KERNEL_CLONES
+#endif
+
 /* mat_block_mult.c: a matrix times a block of vectors */
 PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
+
+/* mat_row_blocks.c: an AIJ matrix as dense blocks of rows sharing their columns (the cells' rows of G and B) */
+PETSC_INTERN PetscErrorCode PhlexMatCreateRowBlocks(Mat, PetscBool, Mat, Mat *);
 
 /* format.c: numbers echoed to the user at full precision */
 PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);

@@ -21,6 +21,7 @@
        product): the tip velocities moved by 1e-12 to 2e-11 of their scale.
    A step costs one solve, two products with B and one with G^T, against a residual (G, G^T, Ms, Mv) and a
    field-split Newton step (Ms^{-1} twice, G, G^T, copies of the five-times-larger stress field) on the generic path.
+   B and G^T are applied as dense blocks per cell (mat_row_blocks.c), with the sums of the AIJ products they replace.
 
    Used when every part is a fixed flexible body with constant operators (no frame, joint, spin or stiffening) and
    the integrator is the theta method without endpoint (the default implicit midpoint, backward Euler). The presets
@@ -34,7 +35,8 @@ typedef struct {
   PhlexSystem sys;
   TS          ts;
   KSP         ksp;   /* the condensed velocity operator s Mv + K / s (the bodies' Sv, block diagonal) */
-  Mat        *B;    /* per body: Ms^{-1} G */
+  Mat        *B;    /* per body: Ms^{-1} G, as dense blocks per cell (MatMult) */
+  Mat        *Gt;   /* per body: G as dense blocks per cell (MatMultTranspose: G^T) */
   Vec         r;     /* the condensed right-hand side */
   Vec         bv, sp; /* stress field: B v0, then B dv; Sigma_p */
   PetscReal   shift; /* non-dimensional shift of the operator last handed to the KSP (0: none) */
@@ -186,6 +188,62 @@ PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem sys, Mat *B, Vec v, Vec y)
   PetscFunctionReturn(0);
 }
 
+/*@C
+  PhlexSystemStressMapsToRowBlocks - each body's B as dense blocks per cell (mat_row_blocks.c: the same sums as the
+  AIJ product, 1.5 x fewer bytes to stream), in place
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemStressMapsToRowBlocks(PhlexSystem sys, Mat *B)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    Mat Bb;
+    PetscCall(PhlexMatCreateRowBlocks(B[i], PETSC_FALSE, B[i], &Bb));
+    PetscCall(MatDestroy(&B[i]));
+    B[i] = Bb;
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemCreateResultantMaps - per body G as dense blocks per cell, for the stress resultant G^T Sigma by
+  MatMultTranspose; its sums are those of MatMult with the body's G^T (like_gt) or of MatMultTranspose with its G
+  (the path it replaces); freed by the caller (MatDestroy each, PetscFree the array)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem sys, PetscBool like_gt, Mat **Gt)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(sys->nfparts, Gt));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCall(PhlexMatCreateRowBlocks(ops.G, PETSC_TRUE, like_gt ? ops.Gt : ops.G, &(*Gt)[i]));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemResultantMult - y = G^T Sigma over the bodies (Sigma a stress field vector, y a velocity field vector)
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemResultantMult(PhlexSystem sys, Mat *Gt, Vec sigma, Vec y)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    Vec yi, si;
+    PetscCall(VecGetSubVector(y, sys->fis[PHLEX_FIELD_VELOCITY][i], &yi));
+    PetscCall(VecGetSubVector(sigma, sys->fis[PHLEX_FIELD_STRESS][i], &si));
+    PetscCall(MatMultTranspose(Gt[i], si, yi));
+    PetscCall(VecRestoreSubVector(sigma, sys->fis[PHLEX_FIELD_STRESS][i], &si));
+    PetscCall(VecRestoreSubVector(y, sys->fis[PHLEX_FIELD_VELOCITY][i], &yi));
+  }
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode SNESSetUp_Condensed(SNES snes)
 {
   SNES_Condensed *c = (SNES_Condensed *)snes->data;
@@ -212,6 +270,9 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
   }
   PetscCall(KSPSetFromOptions(c->ksp));
   PetscCall(PhlexSystemCreateStressMaps(sys, &c->B));
+  /* the three products of a step as dense blocks per cell: the same sums as the AIJ products before */
+  PetscCall(PhlexSystemStressMapsToRowBlocks(sys, c->B));
+  PetscCall(PhlexSystemCreateResultantMaps(sys, PETSC_TRUE, &c->Gt));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
   PetscCall(VecDuplicate(c->sp, &c->bv));
   PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
@@ -261,7 +322,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
     PetscCall(VecGetSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
     PetscCall(VecGetSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
-    PetscCall(MatMult(ops.Gt, si, ri));
+    PetscCall(MatMultTranspose(c->Gt[i], si, ri));
     PetscCall(VecAYPX(ri, -1.0, ops.load));
     PetscCall(VecRestoreSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
     PetscCall(VecRestoreSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
@@ -299,10 +360,12 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   PetscFunctionBeginUser;
   PetscCall(KSPDestroy(&c->ksp));
   if (c->B) {
-    for (PetscInt i = 0; i < c->sys->nfparts; i++) {
-      PetscCall(MatDestroy(&c->B[i]));
-    }
+    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->B[i]));
     PetscCall(PetscFree(c->B));
+  }
+  if (c->Gt) {
+    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->Gt[i]));
+    PetscCall(PetscFree(c->Gt));
   }
   PetscCall(VecDestroy(&c->r));
   PetscCall(VecDestroy(&c->sp));

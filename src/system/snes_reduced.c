@@ -38,7 +38,8 @@ typedef struct {
   KSP         ksp;      /* reduced_: Krylov on Jred, PC phlexbordered on the system's {velocity, discrete} operator */
   Mat         Jred;     /* shell: the Jacobian of the velocity and discrete rows, u and Sigma eliminated */
   Mat         K;        /* the bodies' condensed stiffnesses (block diagonal, velocity field numbering) */
-  Mat        *B;        /* per body Ms^{-1} G */
+  Mat        *B;        /* per body Ms^{-1} G, as dense blocks per cell (MatMult) */
+  Mat        *Gt;       /* per body G as dense blocks per cell (MatMultTranspose: G^T) */
   Vec         Xd, F;    /* whole state: rate, residual */
   Vec         sp, bv;   /* stress field: Sigma_p, B v */
   Vec         P, Pp, dv, wv; /* velocity field: G^T Sigma at the iterate and at Sigma_p, v - v0, work */
@@ -174,6 +175,9 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
     for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(MatDestroy(&Kb[i]));
     PetscCall(PetscFree(Kb));
   }
+  /* the step's passes over the stress field as dense blocks per cell: the same sums as the AIJ products */
+  PetscCall(PhlexSystemStressMapsToRowBlocks(sys, c->B));
+  PetscCall(PhlexSystemCreateResultantMaps(sys, PETSC_FALSE, &c->Gt));
   PetscCall(VecDuplicate(snes->vec_sol, &c->Xd));
   PetscCall(VecDuplicate(snes->vec_sol, &c->F));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->P)); /* stress columns, velocity rows */
@@ -286,7 +290,7 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   PetscCall(PhlexSystemStressMapsMult(sys, c->B, v0, c->bv));
   PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
   PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
-  PetscCall(MatMultTranspose(sys->Jsv, c->sp, c->Pp)); /* G^T, block diagonal over the bodies */
+  PetscCall(PhlexSystemResultantMult(sys, c->Gt, c->sp, c->Pp));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(VecCopy(c->sp, xs));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
@@ -375,6 +379,10 @@ static PetscErrorCode SNESReset_Reduced(SNES snes)
   PetscCall(KSPDestroy(&c->ksp));
   PetscCall(MatDestroy(&c->Jred));
   PetscCall(MatDestroy(&c->K));
+  if (c->Gt) {
+    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->Gt[i]));
+    PetscCall(PetscFree(c->Gt));
+  }
   if (c->B) {
     for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->B[i]));
     PetscCall(PetscFree(c->B));

@@ -10,17 +10,7 @@
 
 #define PHLEX_PANEL 8 /* vectors per pass: a panel of 8 doubles is one cache line */
 
-/* x86-64 with GCC: the kernels are compiled twice, for AVX2 and the baseline (SSE2), the first taken where the
-   processor has it (an ifunc, resolved once): the node loops then run 4 doubles wide instead of 2. The sums are the
-   same (no multiply-add fused, no reduction across a loop's lanes): the same bits either way. */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__GLIBC__) && defined(__has_attribute)
-  #if __has_attribute(target_clones) /* and glibc's ifunc (musl has none) */
-    #define PHLEX_KERNEL_CLONES __attribute__((target_clones("avx2", "default")))
-  #endif
-#endif
-#ifndef PHLEX_KERNEL_CLONES
-  #define PHLEX_KERNEL_CLONES
-#endif
+/* the kernels are compiled for AVX2 and the baseline where GCC can (PHLEX_KERNEL_CLONES, phlex_impl.h) */
 
 /* Y (row-major, n x w) = A X (row-major, n x w), A upper-triangular 3x3-block storage (blocks column-major). With the
    mesh file's numbering the time went into fetching the rows of X and Y of the node a block couples to: a
