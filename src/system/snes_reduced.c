@@ -168,8 +168,12 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
     PetscCall(PetscMalloc1(sys->nfparts, &Kb));
     for (PetscInt i = 0; i < sys->nfparts; i++) {
       PhlexFieldOperators ops;
+      Mat                 K;
       PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-      PetscCall(MatTransposeMatMult(ops.G, c->B[i], MAT_INITIAL_MATRIX, PETSC_DEFAULT, &Kb[i]));
+      PetscCall(MatTransposeMatMult(ops.G, c->B[i], MAT_INITIAL_MATRIX, PETSC_DEFAULT, &K));
+      /* as dense blocks of rows (a node's three rows share their columns): K is only multiplied, with the same sums */
+      PetscCall(PhlexMatCreateRowBlocks(K, PETSC_FALSE, K, &Kb[i]));
+      PetscCall(MatDestroy(&K));
     }
     PetscCall(PhlexSystemBlockDiagonal(sys, Kb, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &c->K));
     for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(MatDestroy(&Kb[i]));
