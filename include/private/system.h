@@ -68,6 +68,8 @@ struct _p_PhlexSystem {
   Vec       *xu, *xv; /* work: per field part */
   Vec        Xwork;    /* work: a whole state (the joints' mid-step geometry) */
   PetscReal  fprev;    /* Newton: the previous residual norm (round-off floor test) */
+  PetscReal  vrtol;    /* Newton on the whole state of a scene with discrete unknowns: the velocity rows' tolerance */
+  PetscReal  fv0, fvprev; /* ... their residual at the stage's initial guess and at the previous iterate */
   /* the state the parts and joints were last evaluated at (a Jacobian right after a residual at the same state
      skips the evaluation): the vectors' ids and object states, and the time */
   PetscObjectId    eval_id[2];
@@ -94,6 +96,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemEnergy(PhlexSystem, PetscReal, Vec, Petsc
 PETSC_INTERN PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem, Vec, PetscReal);
 PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
+PETSC_INTERN PetscErrorCode PhlexSystemSNESConvergedStage(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, PetscInt, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);
