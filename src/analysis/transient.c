@@ -399,6 +399,7 @@ typedef struct {
   PetscReal   drift_max, drift_abs_max, balance_rtol, momentum_max, linear_max, angular_max, orth_max, gap_max;
   PetscReal   watch_balance, watch_gap, watch_orth;
   PetscReal   velocity_rtol; /* Newton on the whole state: the velocity rows' tolerance (scenes with discrete unknowns) */
+  PetscBool   velocity_rtol_set;
   PetscViewer monitor;
 } TransientOptions;
 
@@ -412,7 +413,7 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   o->watch_balance                                                                                                       = 1e-6;
   o->watch_gap                                                                                                           = 1e-2;
   o->watch_orth                                                                                                          = 0.1;
-  o->velocity_rtol                                                                                                       = -1; /* auto */
+  o->velocity_rtol                                                                                                       = 1e-10;
   PetscOptionsBegin(comm, NULL, "Transient analysis options", NULL);
   PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", o->drift_max, &o->drift_max, NULL));
   PetscCall(PetscOptionsReal("-expect_energy_drift_abs_max", "Self-check: bound on max |H - H0| [J] (when H0 is no scale: a mechanism starting at rest)", "PhlexSceneSolveTransient", o->drift_abs_max, &o->drift_abs_max, NULL));
@@ -425,10 +426,10 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCall(PetscOptionsReal("-watchdog_balance_rtol", "Watchdog (implicit midpoint rule): stop when a step's power-balance residual exceeds this share of the energy (0: off)", "PhlexSceneSolveTransient", o->watch_balance, &o->watch_balance, NULL));
   PetscCall(PetscOptionsReal("-watchdog_orthogonality", "Watchdog (BDF, alpha: rotations not re-orthonormalised): stop when ||R^T R - I||_F of a frame exceeds this (0: off; a warning past 1e-2)", "PhlexSceneSolveTransient", o->watch_orth, &o->watch_orth, NULL));
   PetscCall(PetscOptionsReal("-watchdog_joint_drift", "Watchdog: stop when a joint opens by more than this times min(L, 1 m) [m or rad] (0: off)", "PhlexSceneSolveTransient", o->watch_gap, &o->watch_gap, NULL));
-  PetscCall(PetscOptionsReal("-snes_velocity_rtol", "Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns converges when also the velocity rows' residual is below this share of its value at the stage's initial guess (0: off; not given: 1e-10 in a scene with joints, off without)", "PhlexSystemSNESConvergedStage", o->velocity_rtol, &o->velocity_rtol, NULL));
+  PetscCall(PetscOptionsReal("-snes_velocity_rtol", "Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns converges when also the velocity rows' residual is below this share of its value at the stage's initial guess (0: off; not given: 1e-10 in a scene with joints, off without)", "PhlexSystemSNESConvergedStage", o->velocity_rtol, &o->velocity_rtol, &o->velocity_rtol_set));
   PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
   PetscOptionsEnd();
-  PetscCheck(o->velocity_rtol == -1 || (o->velocity_rtol >= 0 && o->velocity_rtol < 1), comm, PETSC_ERR_USER_INPUT, "-snes_velocity_rtol must be in [0, 1) (0: off), got %g", (double)o->velocity_rtol);
+  PetscCheck(o->velocity_rtol >= 0 && o->velocity_rtol < 1, comm, PETSC_ERR_USER_INPUT, "-snes_velocity_rtol must be in [0, 1) (0: off), got %g", (double)o->velocity_rtol);
   PetscCheck(o->watch_balance >= 0 && o->watch_gap >= 0 && o->watch_orth >= 0, comm, PETSC_ERR_USER_INPUT, "-watchdog_balance_rtol, -watchdog_joint_drift and -watchdog_orthogonality must be >= 0 (0: off), got %g, %g and %g", (double)o->watch_balance, (double)o->watch_gap, (double)o->watch_orth);
   PetscFunctionReturn(0);
 }
@@ -753,9 +754,10 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
        in a scene with joints, whose forces and power moved by 1e-8 of their scale without it (test
        fieldsplit_velocity_rows), not on a single floating body, whose energies it left at the same distance from
        a fully converged solve with 1.5 x the Newton iterations (floating_stiffening_lossless) */
-    sys->vrtol = o.velocity_rtol >= 0 ? o.velocity_rtol : (sys->njoints ? 1e-10 : 0.0);
+    sys->vrtol = o.velocity_rtol_set ? o.velocity_rtol : (sys->njoints ? o.velocity_rtol : 0.0);
     PetscCall(SNESSetConvergenceTest(snes, m.reduced ? PhlexSystemSNESConverged : PhlexSystemSNESConvergedStage, sys, NULL));
   }
+  PetscCheck(!o.velocity_rtol_set || (!m.reduced && !m.condensed && sys->nq && (sys->nonlinear || sys->inexact_schur)), scene->comm, PETSC_ERR_USER_INPUT, "-snes_velocity_rtol has no effect on this run: it applies to Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns; %s", m.reduced ? "its steps are solved by SNES phlexreduced, whose test is -snes_phlexreduced_velocity_rtol" : (m.condensed ? "its steps are solved by SNES phlexcondensed (no Newton)" : (sys->nq ? "the scene is linear (no Newton)" : "the scene has none")));
   PetscCall(TSGetTimeStep(ts, &dt));
   PetscCheck(dt > 0, scene->comm, PETSC_ERR_USER_INPUT, "transient analysis: set the time step with -ts_dt <s>");
   m.dt_nominal = dt;

@@ -919,11 +919,12 @@ PetscErrorCode PhlexSystemSNESConverged(SNES snes, PetscInt it, PetscReal xnorm,
 
 /*@C
   PhlexSystemSNESConvergedStage - Newton convergence of a stage on the whole state (the generic path: BDF,
-  Crank-Nicolson, generalized-alpha, the consistent start): PhlexSystemSNESConverged, and in a scene with discrete
-  unknowns also the velocity rows, below sys->vrtol of their residual at the stage's initial guess (or stalled at
-  their round-off: no longer halved). The frames' and joints' rows are orders of magnitude larger than the elastic
-  ones (mass-matrix entries times elastic velocities), so the whole residual passes -snes_atol while the elastic
-  fields are converged to about 1e-8 only; SNES phlexreduced applies the same test to the same rows.
+  Crank-Nicolson, generalized-alpha, -snes_type newtonls): PhlexSystemSNESConverged, and in a scene with discrete
+  unknowns also the velocity rows, below sys->vrtol of their residual at the stage's initial guess, or no longer
+  halved by an iteration (stalled: at their round-off, or as far as the linear solves' tolerance takes them). The
+  frames' and joints' rows are orders of magnitude larger than the elastic ones (mass-matrix entries times elastic
+  velocities), so the whole residual passes -snes_atol while the elastic fields are converged to about 1e-8 only;
+  SNES phlexreduced applies the same test to the same rows. An initial guess that passes the whole test is kept.
 
   Collective
 @*/
@@ -942,7 +943,7 @@ PetscErrorCode PhlexSystemSNESConvergedStage(SNES snes, PetscInt it, PetscReal x
   PetscCall(VecRestoreSubVector(F, sys->is[PHLEX_FIELD_VELOCITY], &Fv));
   if (it == 0) sys->fv0 = fv;
   PetscCall(PetscInfo(snes, "Newton iteration %" PetscInt_FMT ": velocity rows' residual %g (%g of their initial value)\n", it, (double)fv, (double)(sys->fv0 > 0 ? fv / sys->fv0 : 0.0)));
-  if (*reason > 0 && fv > sys->vrtol * sys->fv0 && !(it > 0 && fv > 0.5 * sys->fvprev)) *reason = SNES_CONVERGED_ITERATING;
+  if (it > 0 && *reason > 0 && fv > sys->vrtol * sys->fv0 && fv <= 0.5 * sys->fvprev) *reason = SNES_CONVERGED_ITERATING;
   sys->fvprev = fv;
   PetscFunctionReturn(0);
 }

@@ -5,12 +5,16 @@
    streams 8 bytes per entry and one column list per run.
 
    The sums are those of the AIJ products they replace, term by term in the same order: y_i = sum_j a_ij x_j over j
-   ascending for MatMult, and y_j = sum_i a_ij x_i over i ascending for MatMultTranspose (the order of MatMult with
-   the AIJ transpose that MatTranspose makes), each started from zero; where PETSc's product uses inodes (rows of
-   one pattern, as here) it adds the terms two at a time, and so do the blocks (for the transpose when every block
-   has an even number of rows: 24 stress rows per cell). On one process the products are the same bits as the AIJ
-   matrices'. On several, the owned columns are numbered first and the ghost columns after them (as MPIAIJ splits
-   them) and the transpose's ghost sums are added on their owners: the same terms, summed in another order. */
+   ascending for MatMult, and y_j = sum_i a_ij x_i over i ascending for MatMultTranspose (as MatMultTranspose of A
+   adds them, or MatMult of the AIJ transpose that MatTranspose makes), each started from zero. Where PETSc's product
+   uses inodes (rows of one pattern, as here) it adds the terms two at a time, and so do the blocks (for the transpose
+   only when every block has an even number of rows: 24 stress rows per cell, 3 rows per node; otherwise one at a
+   time, and the sums then differ in the last bits). On several processes MatMult pairs the owned columns only and adds
+   the ghost columns' terms one at a time after them, as MPIAIJ does, and the transpose without pairs adds the ghost
+   sums on their owners as MPIAIJ does: the same bits there too; the paired transpose sums in another order.
+   The same bits hold where PETSc was compiled, as Debian's x86-64 build is, without fused multiply-adds (this file
+   is compiled with -ffp-contract=off); on a processor where the compiler fuses them by default (aarch64) they may
+   differ in the last bits. */
 #include <phlex_impl.h>
 
 /* the layout of the blocks: column-major for MatMult (a column of the block times one x, across the rows: the
@@ -20,6 +24,7 @@ typedef struct {
   PetscInt   *rstart;     /* nb + 1: first local row of each run */
   PetscInt   *cstart;     /* nb + 1: start of each run's columns in col */
   PetscInt   *col;        /* local columns: owned 0..n-1, ghosts n..n+nghost-1 */
+  PetscInt   *nown;       /* nb: each run's owned columns (they come first; MatMult pairs only those) */
   size_t     *vstart;     /* nb + 1: start of each run's block in val */
   MatScalar  *val;        /* the blocks */
   PetscBool   transpose;  /* row-major blocks, laid out for MatMultTranspose */
@@ -33,17 +38,18 @@ typedef struct {
   PetscLogDouble nnz;     /* stored entries (flops of a product: 2 nnz) */
 } RowBlocks;
 
-/* y = A x, A column-major blocks; x indexed by the local columns. Pairwise: the terms added two at a time, as
-   PETSc's AIJ product with inodes does (sum += a_ij x_j + a_ij+1 x_j+1). */
+/* y = A x, A column-major blocks; x indexed by the local columns. Pairwise: the owned columns' terms added two at a
+   time, as PETSc's AIJ product with inodes does (sum += a_ij x_j + a_ij+1 x_j+1), the ghost columns' one at a time. */
 PHLEX_KERNEL_CLONES static void MultKernel(const RowBlocks *rb, const PetscScalar *x, PetscScalar *y, PetscScalar *acc)
 {
   const PetscInt step = rb->pairwise ? 2 : 1;
   for (PetscInt b = 0; b < rb->nb; b++) {
     const PetscInt   r0 = rb->rstart[b], nr = rb->rstart[b + 1] - r0, *c = rb->col + rb->cstart[b], nc = rb->cstart[b + 1] - rb->cstart[b];
     const MatScalar *v  = rb->val + rb->vstart[b];
+    const PetscInt   nd = rb->nown[b];
     PetscInt         j  = 0;
     for (PetscInt i = 0; i < nr; i++) acc[i] = 0.0;
-    for (; step == 2 && j + 1 < nc; j += 2) {
+    for (; step == 2 && j + 1 < nd; j += 2) {
       const PetscScalar x0 = x[c[j]], x1 = x[c[j + 1]];
       const MatScalar  *v0 = v + j * nr, *v1 = v0 + nr;
       for (PetscInt i = 0; i < nr; i++) acc[i] += v0[i] * x0 + v1[i] * x1;
@@ -146,7 +152,7 @@ static PetscErrorCode MatDestroy_RowBlocks(Mat A)
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &rb));
   PetscCall(PetscFree(rb->rstart));
-  PetscCall(PetscFree3(rb->cstart, rb->col, rb->vstart));
+  PetscCall(PetscFree4(rb->cstart, rb->col, rb->vstart, rb->nown));
   PetscCall(PetscFree(rb->val));
   PetscCall(PetscFree2(rb->work, rb->acc));
   PetscCall(VecDestroy(&rb->ghost));
@@ -160,14 +166,14 @@ static PetscErrorCode MatView_RowBlocks(Mat A, PetscViewer viewer)
   RowBlocks *rb;
   PetscBool  ascii;
   PetscInt   nb;
-  PetscReal  nnz;
+  PetscLogDouble nnz;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
   if (!ascii) PetscFunctionReturn(0);
   PetscCall(MatShellGetContext(A, &rb));
   PetscCall(MPIU_Allreduce(&rb->nb, &nb, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)A)));
-  PetscCall(MPIU_Allreduce(&rb->nnz, &nnz, 1, MPIU_REAL, MPI_SUM, PetscObjectComm((PetscObject)A)));
+  PetscCall(MPIU_Allreduce(&rb->nnz, &nnz, 1, MPI_DOUBLE, MPI_SUM, PetscObjectComm((PetscObject)A)));
   PetscCall(PetscViewerASCIIPrintf(viewer, "dense blocks of rows sharing their columns (phlex): %" PetscInt_FMT " blocks, %.4g entries, laid out for %s\n", nb, (double)nnz, rb->transpose ? "MatMultTranspose" : "MatMult"));
   PetscFunctionReturn(0);
 }
@@ -191,7 +197,9 @@ static PetscBool SameColumnsAsPrevious(const RowReader *r, PetscInt i)
   return PETSC_TRUE;
 }
 
-/* whether PETSc's MatMult with the AIJ matrix R (its diagonal part on several processes) uses inodes */
+/* whether PETSc's MatMult with the AIJ matrix R (its diagonal part on several processes) uses inodes: its inode
+   sizes exist when the check at assembly found enough inodes (MAT_USE_INODES turned off after the assembly would
+   leave them; phlex never does) */
 static PetscErrorCode UsesInodes(Mat R, PetscBool *inodes)
 {
   Mat       Rd = R;
@@ -223,6 +231,7 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
   const PetscInt *garray = NULL;
   PetscBool       mpi, seq, done;
   PetscInt        m, n, M, N, nrows, ntot = 0, vtot = 0, maxlen = 1;
+  PetscBool       odd = PETSC_FALSE;
   MPI_Comm        comm = PetscObjectComm((PetscObject)A);
 
   PetscFunctionBeginUser;
@@ -240,6 +249,11 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
   rb->n         = n;
   rb->transpose = transpose;
   PetscCheck(same_sums_as == A || (transpose && same_sums_as), comm, PETSC_ERR_ARG_WRONG, "row blocks: MatMult has the sums of A's MatMult");
+  if (same_sums_as != A) {
+    PetscInt tm, tn;
+    PetscCall(MatGetSize(same_sums_as, &tm, &tn));
+    PetscCheck(tm == N && tn == M, comm, PETSC_ERR_ARG_SIZ, "row blocks: the transpose whose sums to reproduce is %" PetscInt_FMT " x %" PetscInt_FMT ", A is %" PetscInt_FMT " x %" PetscInt_FMT, tm, tn, M, N);
+  }
   if (transpose && same_sums_as == A) rb->pairwise = PETSC_FALSE; /* AIJ's MatMultTranspose has no inode variant */
   else PetscCall(UsesInodes(same_sums_as, &rb->pairwise));
   if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(A, &Ad, &Ao, &garray));
@@ -266,7 +280,7 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
   }
   rb->rstart[rb->nb] = m;
   PetscCall(PetscRealloc((rb->nb + 1) * sizeof(PetscInt), &rb->rstart));
-  PetscCall(PetscMalloc3(rb->nb + 1, &rb->cstart, PetscMax(ntot, 1), &rb->col, rb->nb + 1, &rb->vstart));
+  PetscCall(PetscMalloc4(rb->nb + 1, &rb->cstart, PetscMax(ntot, 1), &rb->col, rb->nb + 1, &rb->vstart, rb->nb + 1, &rb->nown));
   PetscCall(PetscMalloc1(PetscMax(vtot, 1), &rb->val));
   rb->nnz       = (PetscLogDouble)vtot;
   rb->cstart[0] = 0;
@@ -280,6 +294,8 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
     rb->cstart[b + 1] = rb->cstart[b] + nc;
     rb->vstart[b + 1] = rb->vstart[b] + (size_t)nr * (size_t)nc;
     maxlen            = PetscMax(maxlen, transpose ? nc : nr);
+    rb->nown[b]       = nd;
+    if (transpose && nr % 2 && nc) odd = PETSC_TRUE;
     for (PetscInt k = 0; k < nd; k++) c[k] = rr.ja[rr.ia[r0] + k];
     for (PetscInt k = 0; k < no; k++) c[nd + k] = n + rr.jb[rr.ib[r0] + k];
     for (PetscInt i = 0; i < nr; i++) {
@@ -292,6 +308,11 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
         for (PetscInt k = 0; k < no; k++) v[(nd + k) * nr + i] = ao[k];
       }
     }
+  }
+  if (odd && rb->pairwise) {
+    /* the AIJ transpose's pairs would straddle two runs: its sums cannot be reproduced run by run */
+    rb->pairwise = PETSC_FALSE;
+    PetscCall(PetscInfo(A, "row blocks: a run with an odd number of rows; the transpose's terms are added one at a time (the last bits may differ from the AIJ product's)\n"));
   }
   PetscCall(MatSeqAIJRestoreArrayRead(Ad, &rr.a));
   PetscCall(MatRestoreRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &rr.ia, &rr.ja, &done));
@@ -312,7 +333,8 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
   PetscCall(PetscMalloc2(mpi ? n + rb->nghost : 0, &rb->work, maxlen, &rb->acc));
   PetscCall(MatCreateShell(comm, m, n, M, N, rb, C));
   PetscCall(MatShellSetOperation(*C, transpose ? MATOP_MULT_TRANSPOSE : MATOP_MULT, transpose ? (void (*)(void))MatMultTranspose_RowBlocks : (void (*)(void))MatMult_RowBlocks));
-  PetscCall(MatShellSetOperation(*C, MATOP_MULT_TRANSPOSE_ADD, NULL)); /* no transpose advertised unless offered */
+  /* only the product offered is advertised (the shell's defaults of the Add variants call it) */
+  PetscCall(MatShellSetOperation(*C, transpose ? MATOP_MULT_ADD : MATOP_MULT_TRANSPOSE_ADD, NULL));
   PetscCall(MatShellSetOperation(*C, MATOP_DESTROY, (void (*)(void))MatDestroy_RowBlocks));
   PetscCall(MatShellSetOperation(*C, MATOP_VIEW, (void (*)(void))MatView_RowBlocks));
   PetscFunctionReturn(0);
