@@ -169,6 +169,25 @@ PetscErrorCode PhlexSystemCreateStressMaps(PhlexSystem sys, Mat **B)
   PetscFunctionReturn(0);
 }
 
+/* per body, between the velocity and the stress field vectors: y_i = A_i x_i (velocity to stress), or with
+   transpose y_i = A_i^T x_i (stress to velocity) */
+static PetscErrorCode BodyMapsApply(PhlexSystem sys, Mat *A, PetscBool transpose, Vec x, Vec y)
+{
+  const PhlexField fx = transpose ? PHLEX_FIELD_STRESS : PHLEX_FIELD_VELOCITY, fy = transpose ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_STRESS;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    Vec xi, yi;
+    PetscCall(VecGetSubVector(x, sys->fis[fx][i], &xi));
+    PetscCall(VecGetSubVector(y, sys->fis[fy][i], &yi));
+    if (transpose) PetscCall(MatMultTranspose(A[i], xi, yi));
+    else PetscCall(MatMult(A[i], xi, yi));
+    PetscCall(VecRestoreSubVector(y, sys->fis[fy][i], &yi));
+    PetscCall(VecRestoreSubVector(x, sys->fis[fx][i], &xi));
+  }
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSystemStressMapsMult - y = B v over the bodies (v a velocity field vector, y a stress field vector)
 
@@ -177,14 +196,7 @@ PetscErrorCode PhlexSystemCreateStressMaps(PhlexSystem sys, Mat **B)
 PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem sys, Mat *B, Vec v, Vec y)
 {
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    Vec vi, yi;
-    PetscCall(VecGetSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
-    PetscCall(VecGetSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
-    PetscCall(MatMult(B[i], vi, yi));
-    PetscCall(VecRestoreSubVector(y, sys->fis[PHLEX_FIELD_STRESS][i], &yi));
-    PetscCall(VecRestoreSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
-  }
+  PetscCall(BodyMapsApply(sys, B, PETSC_FALSE, v, y));
   PetscFunctionReturn(0);
 }
 
@@ -233,14 +245,7 @@ PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem sys, PetscBool like_gt
 PetscErrorCode PhlexSystemResultantMult(PhlexSystem sys, Mat *Gt, Vec sigma, Vec y)
 {
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    Vec yi, si;
-    PetscCall(VecGetSubVector(y, sys->fis[PHLEX_FIELD_VELOCITY][i], &yi));
-    PetscCall(VecGetSubVector(sigma, sys->fis[PHLEX_FIELD_STRESS][i], &si));
-    PetscCall(MatMultTranspose(Gt[i], si, yi));
-    PetscCall(VecRestoreSubVector(sigma, sys->fis[PHLEX_FIELD_STRESS][i], &si));
-    PetscCall(VecRestoreSubVector(y, sys->fis[PHLEX_FIELD_VELOCITY][i], &yi));
-  }
+  PetscCall(BodyMapsApply(sys, Gt, PETSC_TRUE, sigma, y));
   PetscFunctionReturn(0);
 }
 

@@ -29,7 +29,7 @@ typedef struct {
   MatScalar  *val;        /* the blocks */
   PetscBool   transpose;  /* row-major blocks, laid out for MatMultTranspose */
   PetscBool   pairwise;   /* terms added in pairs, as the AIJ product with inodes that the blocks replace */
-  PetscInt    m, n;       /* local rows and owned columns */
+  PetscInt    n;          /* owned columns */
   PetscInt    nghost;     /* ghost columns (several processes) */
   Vec         ghost;      /* the ghost columns' values (several processes) */
   VecScatter  toghost;    /* owned vector -> ghost (several processes, NULL on one) */
@@ -245,7 +245,6 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
   PetscCall(MatGetLocalSize(A, &m, &n));
   PetscCall(MatGetSize(A, &M, &N));
   PetscCall(PetscNew(&rb));
-  rb->m         = m;
   rb->n         = n;
   rb->transpose = transpose;
   PetscCheck(same_sums_as == A || (transpose && same_sums_as), comm, PETSC_ERR_ARG_WRONG, "row blocks: MatMult has the sums of A's MatMult");
