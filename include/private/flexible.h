@@ -197,6 +197,8 @@ struct _p_PhlexFlexible {
   Mat K;       /* condensed stiffness G^T Ms^{-1} G (SBAIJ) */
   Mat G;       /* coupling int Sigma : Grad(v), stress rows x velocity columns */
   Mat Ms;      /* compliance mass, block diagonal (BAIJ, one block per cell) */
+  PetscReal compliance[PHLEX_MAX_MATERIALS][36]; /* each material's compliance A (non-dimensional): Ms's block of a cell
+                                                    is detJ (smass (x) A), PhlexElementComplianceMass */
   Vec fvol[3]; /* int phi e_c dOmega (uniform body forces) */
 
   /* Jacobian pieces (transient), updated by the part */
@@ -209,7 +211,7 @@ struct _p_PhlexFlexible {
   PetscInt *port_basis_col;   /* first column of each port's distribution in W (-1: not in W) */
   Vec       load, work;       /* velocity-space work vectors */
   Vec       ud, vd;           /* non-dimensional rates (floating) */
-  Vec       ewv, ews;         /* the energy's work vectors (velocity, stress), made at its first call */
+  Vec       ewv;              /* the kinetic energy's work vector, made at its first call */
   PetscReal (*port_ext)[6];   /* external port wrenches at the evaluated time (body frame) */
   PetscReal (*port_y)[6];     /* port outputs at the evaluated state */
   PetscReal (*port_ubar)[3];  /* full model: mean displacement of each port (the arm of its force beyond the drawn point) */

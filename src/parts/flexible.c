@@ -403,7 +403,6 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(VecDestroy(&b->work));
   PetscCall(VecDestroy(&b->ud));
   PetscCall(VecDestroy(&b->ewv));
-  PetscCall(VecDestroy(&b->ews));
   PetscCall(VecDestroy(&b->vd));
   PetscCall(VecDestroy(&b->bgrav));
   PetscCall(PetscFree3(b->port_ext, b->port_y, b->port_ubar));

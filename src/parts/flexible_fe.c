@@ -407,7 +407,7 @@ PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible b, const PhlexUnits *u)
 {
   const PhlexElementReferenceIntegrals *R = &b->ref;
   const PetscInt                        nv = b->nb_v, ns = b->nb_s;
-  PetscReal                            *Ge, *Mse, *work, A[36];
+  PetscReal                            *Ge, *Mse, *work;
   PetscInt                              perm[3 * PHLEX_MAX_NODES], sidx[3 * PHLEX_MAX_NODES];
 
   PetscFunctionBeginUser;
@@ -417,15 +417,14 @@ PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible b, const PhlexUnits *u)
   PetscCall(MatCreateBAIJ(b->comm, ns, b->ns_local, b->ns_local, b->ns_global, b->ns_global, 1, NULL, 0, NULL, &b->Ms));
   PetscCall(MatSetOption(b->Ms, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   PetscCall(PetscMalloc3(ns * nv, &Ge, ns * ns, &Mse, ns * nv, &work));
+  for (PetscInt m = 0; m < b->nmaterials; m++) PhlexElementCompliance(b->materials[m].youngs_modulus / u->modulus, b->materials[m].poissons_ratio, b->compliance[m]);
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
-    const PetscReal     *g   = &b->cell_geom[10 * c];
-    const PhlexMaterial *mat = &b->materials[b->cell_material[c]];
-    const PetscInt      *idx = &b->cell_vdofs[c * nv];
-    PetscInt             rows[6 * 4], brow = b->cell_soff[c] / ns;
+    const PetscReal *g   = &b->cell_geom[10 * c];
+    const PetscInt  *idx = &b->cell_vdofs[c * nv];
+    PetscInt         rows[6 * 4], brow = b->cell_soff[c] / ns;
 
     PhlexElementCoupling(R, g[0], &g[1], work, Ge);
-    PhlexElementCompliance(mat->youngs_modulus / u->modulus, mat->poissons_ratio, A);
-    PhlexElementComplianceMass(R, g[0], A, Mse);
+    PhlexElementComplianceMass(R, g[0], b->compliance[b->cell_material[c]], Mse);
     /* G rows belong to this cell only: inserting sorted columns appends to empty rows */
     for (PetscInt a = 0; a < nv; a++) {
       perm[a] = a;
@@ -530,6 +529,48 @@ PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible b, const PhlexUnits *units)
   PetscFunctionReturn(0);
 }
 
+/* 1/2 s^T Ms s from Ms's structure: the block of cell c is detJ_c (smass (x) A_m) (PhlexElementComplianceMass), smass
+   the reference mass of the stress basis, A_m the compliance of the cell's material, so a cell's energy is
+   1/2 detJ_c sum_ij smass_ij s_i . A_m s_j over its stress nodes i, j (6 components each). The monitor needs it every
+   step: a product with the assembled Ms streamed its 224 MB at 2.2e5 velocity DOFs (22-40 ms, one BLAS dgemv call per
+   cell), this reads the stresses and the cells' volumes only (BENCHMARKS.md section 18). The sums are not dgemv's:
+   the energy differs from 1/2 s^T (Ms s) in its last bits. */
+static PetscErrorCode StrainEnergy(PhlexFlexible b, Vec s, PetscReal *strain)
+{
+  const PetscInt     nn = b->ref.ns; /* stress nodes per cell */
+  const PetscReal   *smass = b->ref.smass;
+  const PetscScalar *sa;
+  PetscInt           rstart;
+  PetscReal          local = 0, global;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetOwnershipRange(s, &rstart, NULL));
+  PetscCall(VecGetArrayRead(s, &sa));
+  for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
+    const PetscScalar *sc = sa + (b->cell_soff[c] - rstart);
+    const PetscReal   *A  = b->compliance[b->cell_material[c]];
+    PetscReal          e  = 0;
+
+    for (PetscInt i = 0; i < nn; i++) {
+      const PetscScalar *si = sc + 6 * i;
+      PetscReal          t[6] = {0, 0, 0, 0, 0, 0}; /* sum_j smass_ij s_j */
+      for (PetscInt j = 0; j < nn; j++)
+        for (PetscInt k = 0; k < 6; k++) t[k] += smass[i * nn + j] * PetscRealPart(sc[6 * j + k]);
+      for (PetscInt k = 0; k < 6; k++) {
+        PetscReal Asi = 0;
+        for (PetscInt l = 0; l < 6; l++) Asi += A[k * 6 + l] * PetscRealPart(si[l]);
+        e += t[k] * Asi;
+      }
+    }
+    local += b->cell_geom[10 * c] * e;
+  }
+  PetscCall(VecRestoreArrayRead(s, &sa));
+  PetscCall(PetscLogFlops((2.0 * 6 * nn * nn + 2.0 * 42 * nn + 1) * (b->cEnd - b->cStart)));
+  PetscCall(MPIU_Allreduce(&local, &global, 1, MPIU_REAL, MPIU_SUM, b->comm));
+  *strain = 0.5 * global;
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexFlexibleEnergy - kinetic and strain energy 1/2 v^T Mv v, 1/2 s^T Ms s (non-dimensional)
 
@@ -537,21 +578,15 @@ PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible b, const PhlexUnits *units)
 @*/
 PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible b, Vec v, Vec s, PetscReal *kinetic, PetscReal *strain)
 {
-  Vec         wv, ws;
   PetscScalar e;
 
   PetscFunctionBeginUser;
-  /* kept: the monitor calls this every step, and a fresh stress-sized vector costs its page faults each time */
+  /* kept: the monitor calls this every step, and a fresh vector costs its page faults each time */
   if (!b->ewv) PetscCall(VecDuplicate(v, &b->ewv));
-  if (!b->ews) PetscCall(VecDuplicate(s, &b->ews));
-  wv = b->ewv;
-  ws = b->ews;
-  PetscCall(MatMult(b->Mvp ? b->Mvp : b->Mv, v, wv));
-  PetscCall(VecDot(wv, v, &e));
+  PetscCall(MatMult(b->Mvp ? b->Mvp : b->Mv, v, b->ewv));
+  PetscCall(VecDot(b->ewv, v, &e));
   *kinetic = 0.5 * PetscRealPart(e);
-  PetscCall(MatMult(b->Ms, s, ws));
-  PetscCall(VecDot(ws, s, &e));
-  *strain = 0.5 * PetscRealPart(e);
+  PetscCall(StrainEnergy(b, s, strain));
   PetscFunctionReturn(0);
 }
 
