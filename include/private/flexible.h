@@ -199,6 +199,13 @@ struct _p_PhlexFlexible {
   Mat Ms;      /* compliance mass, block diagonal (BAIJ, one block per cell) */
   PetscReal compliance[PHLEX_MAX_MATERIALS][36]; /* each material's compliance A (non-dimensional): Ms's block of a cell
                                                     is detJ (smass (x) A), PhlexElementComplianceMass */
+
+  /* the stress maps B = Ms^{-1} G and G^T cell by cell (flexible_stress_maps.c), set up at their first product */
+  Mat       smap_B, smap_Res;                   /* the shells handed out as PhlexFieldOperators' B and Res */
+  PetscBool smap_ready;
+  PetscReal stiffness[PHLEX_MAX_MATERIALS][36]; /* each material's A^{-1} */
+  PetscReal smass_inv[16];                      /* the stress basis's reference mass, inverted */
+  Vec       smap_vloc, smap_floc;               /* local (ghosted) velocity field: the product's input, G^T's sums */
   Vec fvol[3]; /* int phi e_c dOmega (uniform body forces) */
 
   /* Jacobian pieces (transient), updated by the part */
@@ -231,7 +238,7 @@ struct _p_PhlexFlexible {
   Mat               Mvs;       /* Mv on Sv's pattern (stiffening or spin: Sv is rebuilt every Jacobian by fast same-pattern sums) */
   MatStructure      kpattern;  /* SAME_NONZERO_PATTERN if Kaij (and Ksig, Nsu) have Sv's pattern, else SUBSET */
   Vec               uloc, vloc; /* local (ghosted) displacement and velocity */
-  PetscInt         *cell_vloc;  /* per local cell: local-vector offsets of its velocity closure */
+  PetscInt         *cell_vloc;  /* per local cell: local-vector offsets of its velocity closure (PhlexFlexibleSetUpLocalDofs) */
   PhlexElementBasis basis_v, basis_s;
   PetscBool         have_basis;
 
@@ -290,6 +297,11 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleCouplingUpdate(PhlexFlexible, Vec);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible, Vec, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStressOfDisplacement(PhlexFlexible, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStiffeningDestroy(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
+
+/* flexible_stress_maps.c */
+PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible, Mat *, Mat *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinSetUp(PhlexFlexible, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinEnergy(PhlexFlexible, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart, PhlexPartVec *);

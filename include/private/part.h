@@ -56,6 +56,8 @@ typedef struct {
 typedef struct {
   Mat      G, Gt;    /* coupling (stress rows x velocity columns) and its transpose */
   Mat      Ms;       /* compliance mass, block diagonal per cell */
+  Mat      B, Res;   /* stress rate B = Ms^{-1} G (stress rows) and stress resultant G^T (velocity rows) as products
+                        cell by cell (shells, nothing stored), or NULL (geometric stiffening: G(u) is assembled) */
   PetscInt stress_bs; /* stress unknowns per cell (block size of Ms) */
   Mat      Jvv, Jvu; /* velocity rows: d/dv (shift Mv [+ node-wise terms]) and d/du (node-wise terms, or NULL) */
   Mat      Jvc;      /* Jvv + Jvu / shift: the velocity rows' own block once u = u0 + v / shift is eliminated (one product) */

@@ -407,6 +407,7 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(VecDestroy(&b->bgrav));
   PetscCall(PetscFree3(b->port_ext, b->port_y, b->port_ubar));
   PetscCall(PetscFree(b->port_basis_col));
+  PetscCall(PhlexFlexibleStressMapsDestroy(b));
   PetscCall(PhlexFlexibleStiffeningDestroy(b));
   PetscCall(PhlexFlexibleSpinDestroy(b));
   PetscCall(PhlexFlexibleDestroyFE(b));

@@ -398,6 +398,31 @@ static PetscErrorCode AssembleVelocityOperators(PhlexFlexible b, const PhlexUnit
 }
 
 /*@C
+  PhlexFlexibleSetUpLocalDofs - the local-vector offsets of every local cell's velocity closure (the order of
+  cell_vdofs; a constrained dof's offset is that of its place in the local vector), once
+
+  Not collective
+@*/
+PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible b)
+{
+  PetscSection section;
+  PetscInt     ncells = b->cEnd - b->cStart;
+
+  PetscFunctionBeginUser;
+  if (b->cell_vloc) PetscFunctionReturn(0);
+  PetscCall(DMGetLocalSection(b->dm, &section));
+  PetscCall(PetscMalloc1(ncells * b->nb_v, &b->cell_vloc));
+  for (PetscInt c = b->cStart; c < b->cEnd; c++) {
+    PetscInt nidx, *idx = NULL;
+    PetscCall(DMPlexGetClosureIndices(b->dm, section, section, c, PETSC_TRUE, &nidx, &idx, NULL, NULL));
+    PetscCheck(nidx == b->nb_v, PETSC_COMM_SELF, PETSC_ERR_PLIB, "closure of cell %" PetscInt_FMT " has %" PetscInt_FMT " dofs, expected %" PetscInt_FMT, c, nidx, b->nb_v);
+    for (PetscInt i = 0; i < nidx; i++) b->cell_vloc[(c - b->cStart) * b->nb_v + i] = idx[i] >= 0 ? idx[i] : -(idx[i] + 1);
+    PetscCall(DMPlexRestoreClosureIndices(b->dm, section, section, c, PETSC_TRUE, &nidx, &idx, NULL, NULL));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexFlexibleSetUpMixed - assembles the stress operators (compliance mass Ms, coupling G) needed by the time
   integration of the mixed system; modal analyses use the condensed velocity operators only and skip them
 

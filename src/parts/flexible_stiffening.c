@@ -31,25 +31,6 @@
    iterations as a bending cantilever's velocity gradient grew (a 1 m steel bar, 5 cm tip deflection, 15 steps). */
 #include <phlex_impl.h>
 
-/* local-vector offsets of every cell's velocity closure (the order of cell_vdofs), once */
-static PetscErrorCode SetUpLocalDofs(PhlexFlexible b)
-{
-  PetscSection section;
-  PetscInt     ncells = b->cEnd - b->cStart;
-
-  PetscFunctionBeginUser;
-  PetscCall(DMGetLocalSection(b->dm, &section));
-  PetscCall(PetscMalloc1(ncells * b->nb_v, &b->cell_vloc));
-  for (PetscInt c = b->cStart; c < b->cEnd; c++) {
-    PetscInt nidx, *idx = NULL;
-    PetscCall(DMPlexGetClosureIndices(b->dm, section, section, c, PETSC_TRUE, &nidx, &idx, NULL, NULL));
-    PetscCheck(nidx == b->nb_v, PETSC_COMM_SELF, PETSC_ERR_PLIB, "closure of cell %" PetscInt_FMT " has %" PetscInt_FMT " dofs, expected %" PetscInt_FMT, c, nidx, b->nb_v);
-    for (PetscInt i = 0; i < nidx; i++) b->cell_vloc[(c - b->cStart) * b->nb_v + i] = idx[i] >= 0 ? idx[i] : -(idx[i] + 1);
-    PetscCall(DMPlexRestoreClosureIndices(b->dm, section, section, c, PETSC_TRUE, &nidx, &idx, NULL, NULL));
-  }
-  PetscFunctionReturn(0);
-}
-
 /* the element bases, the cells' local dof offsets and a local displacement vector, once */
 static PetscErrorCode SetUpWorkspace(PhlexFlexible b)
 {
@@ -59,7 +40,7 @@ static PetscErrorCode SetUpWorkspace(PhlexFlexible b)
     PetscCall(PhlexFlexibleGetBasis(b, PETSC_TRUE, &b->basis_s));
     b->have_basis = PETSC_TRUE;
   }
-  if (!b->cell_vloc) PetscCall(SetUpLocalDofs(b));
+  PetscCall(PhlexFlexibleSetUpLocalDofs(b));
   if (!b->uloc) PetscCall(DMCreateLocalVector(b->dm, &b->uloc));
   PetscFunctionReturn(0);
 }

@@ -5,7 +5,7 @@
        T u' = v,    T Ms Sigma' = G v,    T Mv v' = -G^T Sigma + b(t),
    and TSTHETA's stage X = X0 + theta dt X' (shift a = 1 / (theta dt), s = a T) solves
        s (u - u0) = v,   s Ms (Sigma - Sigma0) = G v,   s Mv (v - v0) + G^T Sigma = b(t0 + theta dt).
-   With B = Ms^{-1} G (formed once by a sparse product; it has G's pattern, Ms being block diagonal per cell) and the
+   With B = Ms^{-1} G (applied cell by cell: Ms is block diagonal per cell) and the
    predicted stress Sigma_p = Sigma0 + B v0 / s, eliminating u and Sigma and solving for the increment dv = v - v0:
        (s Mv + K / s) dv = b - G^T Sigma_p,                                             (the condensed right-hand side)
        Sigma = Sigma_p + B dv / s  (= Sigma0 + B v / s),   u = u0 + v / s.
@@ -21,7 +21,7 @@
        product): the tip velocities moved by 1e-12 to 2e-11 of their scale.
    A step costs one solve, two products with B and one with G^T, against a residual (G, G^T, Ms, Mv) and a
    field-split Newton step (Ms^{-1} twice, G, G^T, copies of the five-times-larger stress field) on the generic path.
-   B and G^T are applied as dense blocks per cell (mat_row_blocks.c), with the sums of the AIJ products they replace.
+   B and G^T are applied cell by cell from the element structure (flexible_stress_maps.c): nothing assembled.
 
    Used when every part is a fixed flexible body with constant operators (no frame, joint, spin or stiffening) and
    the integrator is the theta method without endpoint (the default implicit midpoint, backward Euler). The presets
@@ -35,8 +35,8 @@ typedef struct {
   PhlexSystem sys;
   TS          ts;
   KSP         ksp;   /* the condensed velocity operator s Mv + K / s (the bodies' Sv, block diagonal) */
-  Mat        *B;    /* per body: Ms^{-1} G, as dense blocks per cell (MatMult) */
-  Mat        *Gt;   /* per body: G as dense blocks per cell (MatMultTranspose: G^T) */
+  Mat        *B;    /* per body: Ms^{-1} G, cell by cell (the part's shell, PhlexFieldOperators B) */
+  Mat        *Res;  /* per body: G^T, cell by cell (the part's shell, PhlexFieldOperators Res) */
   Vec         r;     /* the condensed right-hand side */
   Vec         bv, sp; /* stress field: B v0, then B dv; Sigma_p */
   PetscReal   shift; /* non-dimensional shift of the operator last handed to the KSP (0: none) */
@@ -274,10 +274,17 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
     PetscCall(PCSetType(pc, PCCHOLESKY));
   }
   PetscCall(KSPSetFromOptions(c->ksp));
-  PetscCall(PhlexSystemCreateStressMaps(sys, &c->B));
-  /* the three products of a step as dense blocks per cell: the same sums as the AIJ products before */
-  PetscCall(PhlexSystemStressMapsToRowBlocks(sys, c->B));
-  PetscCall(PhlexSystemCreateResultantMaps(sys, PETSC_TRUE, &c->Gt));
+  /* the three products of a step, cell by cell from the element structure: nothing assembled */
+  PetscCall(PetscMalloc2(sys->nfparts, &c->B, sys->nfparts, &c->Res));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCheck(ops.B && ops.Res, sys->comm, PETSC_ERR_PLIB, "SNES phlexcondensed: part %" PetscInt_FMT " has no cell-by-cell stress maps", i);
+    PetscCall(PetscObjectReference((PetscObject)ops.B));
+    PetscCall(PetscObjectReference((PetscObject)ops.Res));
+    c->B[i]   = ops.B;
+    c->Res[i] = ops.Res;
+  }
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
   PetscCall(VecDuplicate(c->sp, &c->bv));
   PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
@@ -327,7 +334,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
     PetscCall(VecGetSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
     PetscCall(VecGetSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
-    PetscCall(MatMultTranspose(c->Gt[i], si, ri));
+    PetscCall(MatMult(c->Res[i], si, ri));
     PetscCall(VecAYPX(ri, -1.0, ops.load));
     PetscCall(VecRestoreSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
     PetscCall(VecRestoreSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
@@ -365,12 +372,11 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   PetscFunctionBeginUser;
   PetscCall(KSPDestroy(&c->ksp));
   if (c->B) {
-    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->B[i]));
-    PetscCall(PetscFree(c->B));
-  }
-  if (c->Gt) {
-    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->Gt[i]));
-    PetscCall(PetscFree(c->Gt));
+    for (PetscInt i = 0; i < c->sys->nfparts; i++) {
+      PetscCall(MatDestroy(&c->B[i]));
+      PetscCall(MatDestroy(&c->Res[i]));
+    }
+    PetscCall(PetscFree2(c->B, c->Res));
   }
   PetscCall(VecDestroy(&c->r));
   PetscCall(VecDestroy(&c->sp));

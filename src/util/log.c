@@ -2,7 +2,7 @@
 #include <phlex.h>
 
 PetscClassId  PHLEX_CLASSID;
-PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult, PHLEX_MatMultBlock;
+PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult, PHLEX_MatMultBlock, PHLEX_StressMaps;
 PetscLogStage PHLEX_StageSetup = -1, PHLEX_StageTransient = -1, PHLEX_StageModes = -1;
 
 /*@C
@@ -23,6 +23,7 @@ PetscErrorCode PhlexLogRegister(void)
   PetscCall(PetscLogEventRegister("PhlexRedSetUp", PHLEX_CLASSID, &PHLEX_ReducedSetUp));
   PetscCall(PetscLogEventRegister("PhlexRedJacMult", PHLEX_CLASSID, &PHLEX_ReducedJacobianMult));
   PetscCall(PetscLogEventRegister("PhlexMatMultBlk", PHLEX_CLASSID, &PHLEX_MatMultBlock));
+  PetscCall(PetscLogEventRegister("PhlexStressMaps", PHLEX_CLASSID, &PHLEX_StressMaps));
   PetscCall(PetscLogEventRegister("PhlexSysIJac", PHLEX_CLASSID, &PHLEX_SysIJacobian));
   PetscCall(PetscLogEventRegister("PhlexMonEnergy", PHLEX_CLASSID, &PHLEX_MonitorEnergy));
   PetscCall(PetscLogEventRegister("PhlexModesSolve", PHLEX_CLASSID, &PHLEX_ModesSolve));

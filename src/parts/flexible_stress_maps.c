@@ -1,0 +1,261 @@
+/* The maps between a body's velocity and stress fields that a linear step applies, cell by cell from the element
+   structure instead of assembled matrices:
+
+     B v      = Ms^{-1} G v   the stress rate of a velocity (SNES phlexcondensed: Sigma = Sigma_p + B dv / s),
+     G^T Sigma                the stress resultant in the momentum rows.
+
+   On an affine cell the coupling is G_c[(i,s)][(b,c)] = detJ_c int psi_i E_s : Grad(phi_b e_c) (PhlexElementCoupling),
+   the physical gradient moments detJ coup[i][b] invJ, and the compliance mass is Ms_c = detJ_c (smass (x) A_m)
+   (PhlexElementComplianceMass). So for the stress node i of a cell
+     (G v)_i = detJ e_i,  e_i = the symmetric part of H_i = sum_b v_b (x) (invJ^T coup[i][b]) in Voigt order
+                          (xx, yy, zz, yz, xz, xy; a shear row is H_pq + H_qp),
+     (B v)_i = sum_j smass^{-1}_ij D_m e_j   (D_m = A_m^{-1}, detJ cancels),
+     (G^T Sigma)_b = detJ sum_i S_i invJ^T coup[i][b]   (S_i the symmetric tensor of Sigma_i).
+   A product reads the velocities, the cells' geometry and the stresses (about 25 MB at 2.2e5 velocity DOFs) instead
+   of the 280 MB of B's or G's entries, and nothing is assembled or stored beyond two work vectors. The sums are not
+   those of the assembled products: results differ from them in the last bits (BENCHMARKS.md section 18). For the
+   body's undeformed geometry only: geometric stiffening's G(u) is assembled (flexible_stiffening.c). */
+#include <phlex_impl.h>
+#include <petscblaslapack.h>
+
+/* A^{-1} of a small dense matrix (row-major n x n), in place, by LAPACK */
+static PetscErrorCode InvertSmall(PetscInt n, PetscReal *A, const char *what, const char *body)
+{
+  PetscBLASInt bn = (PetscBLASInt)n, info, ipiv[36], lwork = 36;
+  PetscReal    work[36];
+
+  PetscFunctionBeginUser;
+  PetscCheck(n <= 6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "body %s: %s of size %" PetscInt_FMT " > 6", body, what, n);
+  PetscCallBLAS("LAPACKgetrf", LAPACKgetrf_(&bn, &bn, A, &bn, ipiv, &info));
+  PetscCheck(info == 0, PETSC_COMM_SELF, PETSC_ERR_LIB, "body %s: %s is singular (LAPACK getrf info %d)", body, what, (int)info);
+  PetscCallBLAS("LAPACKgetri", LAPACKgetri_(&bn, A, &bn, ipiv, work, &lwork, &info));
+  PetscCheck(info == 0, PETSC_COMM_SELF, PETSC_ERR_LIB, "body %s: %s could not be inverted (LAPACK getri info %d)", body, what, (int)info);
+  PetscFunctionReturn(0);
+}
+
+/* the stiffness of every material, smass^{-1}, the cells' local velocity offsets and the local work vectors, once */
+static PetscErrorCode StressMapsSetUp(PhlexFlexible b)
+{
+  const PetscInt nn = b->ref.ns;
+
+  PetscFunctionBeginUser;
+  if (b->smap_ready) PetscFunctionReturn(0);
+  /* a transposed inverse is the inverse of the transpose: A and smass are symmetric, so row- or column-major alike */
+  for (PetscInt m = 0; m < b->nmaterials; m++) {
+    PetscCall(PetscArraycpy(b->stiffness[m], b->compliance[m], 36));
+    PetscCall(InvertSmall(6, b->stiffness[m], "a material's compliance", b->name));
+  }
+  PetscCall(PetscArraycpy(b->smass_inv, b->ref.smass, nn * nn));
+  PetscCall(InvertSmall(nn, b->smass_inv, "the stress basis's mass", b->name));
+  PetscCall(PhlexFlexibleSetUpLocalDofs(b));
+  PetscCall(DMCreateLocalVector(b->dm, &b->smap_vloc)); /* zero: its constrained entries stay so */
+  PetscCall(VecDuplicate(b->smap_vloc, &b->smap_floc));
+  b->smap_ready = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/* y = B v for the cells' stress blocks: ve the cell's velocities (3 per node), y its stresses (6 per stress node) */
+static inline void CellStressRate(PetscInt nv, PetscInt nn, const PetscReal *coup, const PetscReal *invJ, const PetscReal *D, const PetscReal *smass_inv, const PetscReal *ve, PetscScalar *y)
+{
+  PetscReal e[4][6], De[4][6];
+
+  for (PetscInt i = 0; i < nn; i++) {
+    PetscReal Hh[3][3] = {{0}}, H[3][3];
+    for (PetscInt bnode = 0; bnode < nv; bnode++) {
+      const PetscReal *cb = &coup[(i * nv + bnode) * 3];
+      for (PetscInt a = 0; a < 3; a++) {
+        const PetscReal va = ve[3 * bnode + a];
+        Hh[a][0] += va * cb[0];
+        Hh[a][1] += va * cb[1];
+        Hh[a][2] += va * cb[2];
+      }
+    }
+    for (PetscInt a = 0; a < 3; a++)
+      for (PetscInt x = 0; x < 3; x++) H[a][x] = Hh[a][0] * invJ[0 * 3 + x] + Hh[a][1] * invJ[1 * 3 + x] + Hh[a][2] * invJ[2 * 3 + x];
+    e[i][0] = H[0][0];
+    e[i][1] = H[1][1];
+    e[i][2] = H[2][2];
+    e[i][3] = H[1][2] + H[2][1];
+    e[i][4] = H[0][2] + H[2][0];
+    e[i][5] = H[0][1] + H[1][0];
+    for (PetscInt s = 0; s < 6; s++) De[i][s] = D[s * 6 + 0] * e[i][0] + D[s * 6 + 1] * e[i][1] + D[s * 6 + 2] * e[i][2] + D[s * 6 + 3] * e[i][3] + D[s * 6 + 4] * e[i][4] + D[s * 6 + 5] * e[i][5];
+  }
+  for (PetscInt i = 0; i < nn; i++)
+    for (PetscInt s = 0; s < 6; s++) {
+      PetscReal sum = 0;
+      for (PetscInt j = 0; j < nn; j++) sum += smass_inv[i * nn + j] * De[j][s];
+      y[6 * i + s] = sum;
+    }
+}
+
+/* fe = G_c^T Sigma_c for one cell: sigma its stresses (6 per stress node), fe its velocity rows (3 per node) */
+static inline void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup, PetscReal detJ, const PetscReal *invJ, const PetscScalar *sigma, PetscReal *fe)
+{
+  for (PetscInt k = 0; k < 3 * nv; k++) fe[k] = 0;
+  for (PetscInt i = 0; i < nn; i++) {
+    const PetscScalar *si = sigma + 6 * i;
+    const PetscReal    S[3][3] = {
+      {PetscRealPart(si[0]), PetscRealPart(si[5]), PetscRealPart(si[4])},
+      {PetscRealPart(si[5]), PetscRealPart(si[1]), PetscRealPart(si[3])},
+      {PetscRealPart(si[4]), PetscRealPart(si[3]), PetscRealPart(si[2])}
+    };
+    PetscReal T[3][3]; /* detJ S invJ^T */
+    for (PetscInt a = 0; a < 3; a++)
+      for (PetscInt y = 0; y < 3; y++) T[a][y] = detJ * (S[a][0] * invJ[y * 3 + 0] + S[a][1] * invJ[y * 3 + 1] + S[a][2] * invJ[y * 3 + 2]);
+    for (PetscInt bnode = 0; bnode < nv; bnode++) {
+      const PetscReal *cb = &coup[(i * nv + bnode) * 3];
+      for (PetscInt a = 0; a < 3; a++) fe[3 * bnode + a] += T[a][0] * cb[0] + T[a][1] * cb[1] + T[a][2] * cb[2];
+    }
+  }
+}
+
+/* MatMult of the shell B: y (stress field) = Ms^{-1} G v (v velocity field) */
+static PetscErrorCode MatMult_StressRate(Mat A, Vec v, Vec y)
+{
+  PhlexFlexible      b;
+  PetscInt           nv, nn, rstart;
+  const PetscScalar *va;
+  PetscScalar       *ya;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &b));
+  PetscCall(StressMapsSetUp(b));
+  PetscCall(PetscLogEventBegin(PHLEX_StressMaps, A, 0, 0, 0));
+  nv = b->ref.nv;
+  nn = b->ref.ns;
+  PetscCall(DMGlobalToLocalBegin(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscCall(DMGlobalToLocalEnd(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscCall(VecGetOwnershipRange(y, &rstart, NULL));
+  PetscCall(VecGetArrayRead(b->smap_vloc, &va));
+  PetscCall(VecGetArrayWrite(y, &ya));
+  for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
+    const PetscInt *loc = &b->cell_vloc[c * 3 * nv];
+    PetscReal       ve[3 * PHLEX_MAX_NODES];
+    for (PetscInt k = 0; k < 3 * nv; k++) ve[k] = PetscRealPart(va[loc[k]]);
+    CellStressRate(nv, nn, b->ref.coup, &b->cell_geom[10 * c + 1], b->stiffness[b->cell_material[c]], b->smass_inv, ve, ya + (b->cell_soff[c] - rstart));
+  }
+  PetscCall(VecRestoreArrayWrite(y, &ya));
+  PetscCall(VecRestoreArrayRead(b->smap_vloc, &va));
+  PetscCall(PetscLogFlops((2.0 * 9 * nv + 2.0 * 27 + 3 + 2.0 * 36 + 2.0 * 6 * nn) * nn * (b->cEnd - b->cStart)));
+  PetscCall(PetscLogEventEnd(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* MatMult of the shell G^T: f (velocity field) = G^T Sigma (Sigma stress field) */
+static PetscErrorCode MatMult_Resultant(Mat A, Vec sigma, Vec f)
+{
+  PhlexFlexible      b;
+  PetscInt           nv, nn, rstart;
+  const PetscScalar *sa;
+  PetscScalar       *fa;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &b));
+  PetscCall(StressMapsSetUp(b));
+  PetscCall(PetscLogEventBegin(PHLEX_StressMaps, A, 0, 0, 0));
+  nv = b->ref.nv;
+  nn = b->ref.ns;
+  PetscCall(VecSet(b->smap_floc, 0.0));
+  PetscCall(VecGetOwnershipRange(sigma, &rstart, NULL));
+  PetscCall(VecGetArrayRead(sigma, &sa));
+  PetscCall(VecGetArray(b->smap_floc, &fa));
+  for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
+    const PetscInt  *loc = &b->cell_vloc[c * 3 * nv];
+    const PetscReal *g   = &b->cell_geom[10 * c];
+    PetscReal        fe[3 * PHLEX_MAX_NODES];
+    CellResultant(nv, nn, b->ref.coup, g[0], &g[1], sa + (b->cell_soff[c] - rstart), fe);
+    for (PetscInt k = 0; k < 3 * nv; k++) fa[loc[k]] += fe[k];
+  }
+  PetscCall(VecRestoreArray(b->smap_floc, &fa));
+  PetscCall(VecRestoreArrayRead(sigma, &sa));
+  /* the cells' sums on the owners; the constrained rows of the local vector are not in f */
+  PetscCall(VecSet(f, 0.0));
+  PetscCall(DMLocalToGlobalBegin(b->dm, b->smap_floc, ADD_VALUES, f));
+  PetscCall(DMLocalToGlobalEnd(b->dm, b->smap_floc, ADD_VALUES, f));
+  PetscCall(PetscLogFlops((2.0 * 27 + 2.0 * 9 * nv) * nn * (b->cEnd - b->cStart)));
+  PetscCall(PetscLogEventEnd(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* -phlex_check_stress_maps: the products cell by cell against the assembled operators, for a random velocity v and
+   stress Sigma: |Ms (B v) - G v| / |G v| and |Res Sigma - G^T Sigma| / |G^T Sigma| (infinity norms), printed */
+static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res)
+{
+  PetscBool   check = PETSC_FALSE;
+  Vec         v, s, Bv, MsBv, Gv, f, Gts;
+  PetscRandom rnd;
+  PetscReal   nref, ndiff, worst_b, worst_r;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
+  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G and G^T with the assembled G and Ms, for random fields", "PhlexFlexibleCreateStressMaps", check, &check, NULL));
+  PetscOptionsEnd();
+  if (!check) PetscFunctionReturn(0);
+  PetscCall(PetscRandomCreate(b->comm, &rnd));
+  PetscCall(PetscRandomSetInterval(rnd, -1.0, 1.0));
+  PetscCall(MatCreateVecs(b->G, &v, &s));
+  PetscCall(VecDuplicate(s, &Bv));
+  PetscCall(VecDuplicate(s, &MsBv));
+  PetscCall(VecDuplicate(s, &Gv));
+  PetscCall(VecDuplicate(v, &f));
+  PetscCall(VecDuplicate(v, &Gts));
+  PetscCall(VecSetRandom(v, rnd));
+  PetscCall(VecSetRandom(s, rnd));
+  /* B: Ms (B v) = G v */
+  PetscCall(MatMult(B, v, Bv));
+  PetscCall(MatMult(b->Ms, Bv, MsBv));
+  PetscCall(MatMult(b->G, v, Gv));
+  PetscCall(VecNorm(Gv, NORM_INFINITY, &nref));
+  PetscCall(VecAXPY(MsBv, -1.0, Gv));
+  PetscCall(VecNorm(MsBv, NORM_INFINITY, &ndiff));
+  worst_b = ndiff / nref;
+  /* G^T */
+  PetscCall(MatMult(Res, s, f));
+  PetscCall(MatMultTranspose(b->G, s, Gts));
+  PetscCall(VecNorm(Gts, NORM_INFINITY, &nref));
+  PetscCall(VecAXPY(f, -1.0, Gts));
+  PetscCall(VecNorm(f, NORM_INFINITY, &ndiff));
+  worst_r = ndiff / nref;
+  PetscCall(PetscPrintf(b->comm, "body %s: stress maps cell by cell vs assembled G, Ms: Ms B - G %s, G^T %s (relative, infinity norm)\n", b->name, worst_b < 1e-13 ? "< 1e-13" : "LARGE", worst_r < 1e-13 ? "< 1e-13" : "LARGE"));
+  if (worst_b >= 1e-13 || worst_r >= 1e-13) PetscCall(PetscPrintf(b->comm, "body %s: stress maps: Ms B - G %.3e, G^T %.3e\n", b->name, (double)worst_b, (double)worst_r));
+  PetscCall(VecDestroy(&v));
+  PetscCall(VecDestroy(&s));
+  PetscCall(VecDestroy(&Bv));
+  PetscCall(VecDestroy(&MsBv));
+  PetscCall(VecDestroy(&Gv));
+  PetscCall(VecDestroy(&f));
+  PetscCall(VecDestroy(&Gts));
+  PetscCall(PetscRandomDestroy(&rnd));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleCreateStressMaps - shell matrices of a body's B = Ms^{-1} G (stress rows, velocity columns) and G^T
+  (velocity rows, stress columns), applied cell by cell; the body's undeformed geometry (no geometric stiffening)
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible b, Mat *B, Mat *Gt)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(!b->stiffening, b->comm, PETSC_ERR_PLIB, "body %s: the cell-by-cell stress maps are those of the undeformed geometry; geometric stiffening assembles G(u)", b->name);
+  PetscCheck(b->Ms, b->comm, PETSC_ERR_ORDER, "body %s: the stress maps need the mixed operators (PhlexFlexibleSetUpMixed)", b->name);
+  PetscCall(PhlexMatCreateShell(b->comm, b->ns_local, b->nv_local, b->ns_global, b->nv_global, b, MatMult_StressRate, B));
+  PetscCall(PhlexMatCreateShell(b->comm, b->nv_local, b->ns_local, b->nv_global, b->ns_global, b, MatMult_Resultant, Gt));
+  PetscCall(PetscObjectSetName((PetscObject)*B, "stress rate map Ms^-1 G (cell by cell)"));
+  PetscCall(PetscObjectSetName((PetscObject)*Gt, "stress resultant map G^T (cell by cell)"));
+  PetscCall(CheckStressMaps(b, *B, *Gt));
+  PetscFunctionReturn(0);
+}
+
+/* the stress maps' shells and work vectors */
+PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible b)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&b->smap_B));
+  PetscCall(MatDestroy(&b->smap_Res));
+  PetscCall(VecDestroy(&b->smap_vloc));
+  PetscCall(VecDestroy(&b->smap_floc));
+  b->smap_ready = PETSC_FALSE;
+  PetscFunctionReturn(0);
+}
