@@ -278,6 +278,11 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleRestoreBasis(PhlexElementBasis *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible, Vec, Vec, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexiblePlacement(PhlexFlexible, uint64_t *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
+
+/* flexible_stress_maps.c: B = Ms^{-1} G and G^T cell by cell */
+PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible);
 
 /* flexible_port.c */
 typedef PetscErrorCode (*PhlexSurfaceFunc)(void *, PetscInt, const PetscReal *, const PetscReal *, const PetscReal *, const PetscInt *, const PetscInt *, PetscInt);
@@ -297,11 +302,6 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleCouplingUpdate(PhlexFlexible, Vec);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible, Vec, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStressOfDisplacement(PhlexFlexible, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStiffeningDestroy(PhlexFlexible);
-PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
-
-/* flexible_stress_maps.c */
-PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible, Mat *, Mat *);
-PETSC_INTERN PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinSetUp(PhlexFlexible, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinEnergy(PhlexFlexible, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart, PhlexPartVec *);

@@ -114,7 +114,7 @@ PETSC_INTERN PetscErrorCode PhlexSNESCondensedSetSystem(SNES, PhlexSystem, TS);
 PETSC_INTERN PetscErrorCode PhlexSystemCreateStressMaps(PhlexSystem, Mat **);
 PETSC_INTERN PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem, Mat *, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemStressMapsToRowBlocks(PhlexSystem, Mat *);
-PETSC_INTERN PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem, PetscBool, Mat **);
+PETSC_INTERN PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem, Mat **);
 PETSC_INTERN PetscErrorCode PhlexSystemResultantMult(PhlexSystem, Mat *, Vec, Vec);
 /* snes_reduced.c: SNES phlexreduced, Newton on the velocities and discrete unknowns of a theta-method stage */
 PETSC_INTERN PetscErrorCode PhlexSNESReducedRegister(void);

@@ -595,9 +595,8 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->Gyro      = b->spinning ? b->Cor : NULL;
   ops->inexact_schur = (PetscBool)(b->stiffening || b->spinning);
   ops->Ms        = b->Ms;
-  if (!b->stiffening && !b->smap_B) PetscCall(PhlexFlexibleCreateStressMaps(b, &b->smap_B, &b->smap_Res));
-  ops->B         = b->stiffening ? NULL : b->smap_B;
-  ops->Res       = b->stiffening ? NULL : b->smap_Res;
+  ops->B         = b->smap_B; /* NULL with geometric stiffening */
+  ops->Res       = b->smap_Res;
   ops->stress_bs = b->nb_s;
   ops->Jvv       = b->Jvv;
   ops->Jvu       = b->Jvu;

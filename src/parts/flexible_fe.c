@@ -471,6 +471,8 @@ PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible b, const PhlexUnits *u)
   PetscCall(PetscObjectSetName((PetscObject)b->G, "coupling"));
   PetscCall(PetscObjectSetName((PetscObject)b->Ms, "compliance mass"));
   PetscCall(PetscLogEventEnd(PHLEX_BodyAssemble, 0, 0, 0, 0));
+  /* the step's maps between velocity and stress, cell by cell (shells: nothing is stored until their first product) */
+  PetscCall(PhlexFlexibleCreateStressMaps(b));
   PetscFunctionReturn(0);
 }
 
@@ -792,6 +794,7 @@ PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible b)
   PetscCall(DMDestroy(&b->dm));
   PetscCall(PetscFree(b->cell_material));
   PetscCall(PetscFree2(b->cell_vdofs, b->cell_soff));
+  PetscCall(PetscFree(b->cell_vloc));
   PetscCall(PetscFree(b->cell_geom));
   PetscCall(PetscFree(b->groups));
   PetscFunctionReturn(0);

@@ -273,7 +273,6 @@ PetscErrorCode PhlexFlexibleStiffeningDestroy(PhlexFlexible b)
   PetscCall(MatDestroy(&b->Mvs));
   PetscCall(VecDestroy(&b->uloc));
   PetscCall(VecDestroy(&b->vloc));
-  PetscCall(PetscFree(b->cell_vloc));
   if (b->have_basis) {
     PetscCall(PhlexFlexibleRestoreBasis(&b->basis_v));
     PetscCall(PhlexFlexibleRestoreBasis(&b->basis_s));

@@ -7,12 +7,13 @@
    On an affine cell the coupling is G_c[(i,s)][(b,c)] = detJ_c int psi_i E_s : Grad(phi_b e_c) (PhlexElementCoupling),
    the physical gradient moments detJ coup[i][b] invJ, and the compliance mass is Ms_c = detJ_c (smass (x) A_m)
    (PhlexElementComplianceMass). So for the stress node i of a cell
-     (G v)_i = detJ e_i,  e_i = the symmetric part of H_i = sum_b v_b (x) (invJ^T coup[i][b]) in Voigt order
+     (G v)_i = detJ e_i,  e_i = H_i = sum_b v_b (x) (invJ^T coup[i][b]) in Voigt order, symmetrized
                           (xx, yy, zz, yz, xz, xy; a shear row is H_pq + H_qp),
      (B v)_i = sum_j smass^{-1}_ij D_m e_j   (D_m = A_m^{-1}, detJ cancels),
      (G^T Sigma)_b = detJ sum_i S_i invJ^T coup[i][b]   (S_i the symmetric tensor of Sigma_i).
    A product reads the velocities, the cells' geometry and the stresses (about 25 MB at 2.2e5 velocity DOFs) instead
-   of the 280 MB of B's or G's entries, and nothing is assembled or stored beyond two work vectors. The sums are not
+   of the 280 MB of B's or G's entries, and nothing is assembled or stored beyond two work vectors and the cells'
+   local offsets. The sums are not
    those of the assembled products: results differ from them in the last bits (BENCHMARKS.md section 18). For the
    body's undeformed geometry only: geometric stiffening's G(u) is assembled (flexible_stiffening.c). */
 #include <phlex_impl.h>
@@ -21,11 +22,12 @@
 /* A^{-1} of a small dense matrix (row-major n x n), in place, by LAPACK */
 static PetscErrorCode InvertSmall(PetscInt n, PetscReal *A, const char *what, const char *body)
 {
-  PetscBLASInt bn = (PetscBLASInt)n, info, ipiv[36], lwork = 36;
+  PetscBLASInt bn, info, ipiv[6], lwork = 36;
   PetscReal    work[36];
 
   PetscFunctionBeginUser;
   PetscCheck(n <= 6, PETSC_COMM_SELF, PETSC_ERR_PLIB, "body %s: %s of size %" PetscInt_FMT " > 6", body, what, n);
+  PetscCall(PetscBLASIntCast(n, &bn));
   PetscCallBLAS("LAPACKgetrf", LAPACKgetrf_(&bn, &bn, A, &bn, ipiv, &info));
   PetscCheck(info == 0, PETSC_COMM_SELF, PETSC_ERR_LIB, "body %s: %s is singular (LAPACK getrf info %d)", body, what, (int)info);
   PetscCallBLAS("LAPACKgetri", LAPACKgetri_(&bn, A, &bn, ipiv, work, &lwork, &info));
@@ -40,6 +42,7 @@ static PetscErrorCode StressMapsSetUp(PhlexFlexible b)
 
   PetscFunctionBeginUser;
   if (b->smap_ready) PetscFunctionReturn(0);
+  PetscCheck(nn <= 4 && b->ref.nv <= PHLEX_MAX_NODES, b->comm, PETSC_ERR_SUP, "body %s: the cell-by-cell stress maps take at most 4 stress nodes per cell (P1 stress), not %" PetscInt_FMT, b->name, nn);
   /* a transposed inverse is the inverse of the transpose: A and smass are symmetric, so row- or column-major alike */
   for (PetscInt m = 0; m < b->nmaterials; m++) {
     PetscCall(PetscArraycpy(b->stiffness[m], b->compliance[m], 36));
@@ -181,16 +184,11 @@ static PetscErrorCode MatMult_Resultant(Mat A, Vec sigma, Vec f)
    stress Sigma: |Ms (B v) - G v| / |G v| and |Res Sigma - G^T Sigma| / |G^T Sigma| (infinity norms), printed */
 static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res)
 {
-  PetscBool   check = PETSC_FALSE;
   Vec         v, s, Bv, MsBv, Gv, f, Gts;
   PetscRandom rnd;
   PetscReal   nref, ndiff, worst_b, worst_r;
 
   PetscFunctionBeginUser;
-  PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
-  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G and G^T with the assembled G and Ms, for random fields", "PhlexFlexibleCreateStressMaps", check, &check, NULL));
-  PetscOptionsEnd();
-  if (!check) PetscFunctionReturn(0);
   PetscCall(PetscRandomCreate(b->comm, &rnd));
   PetscCall(PetscRandomSetInterval(rnd, -1.0, 1.0));
   PetscCall(MatCreateVecs(b->G, &v, &s));
@@ -230,21 +228,30 @@ static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res)
 }
 
 /*@C
-  PhlexFlexibleCreateStressMaps - shell matrices of a body's B = Ms^{-1} G (stress rows, velocity columns) and G^T
-  (velocity rows, stress columns), applied cell by cell; the body's undeformed geometry (no geometric stiffening)
+  PhlexFlexibleCreateStressMaps - the body's shells of B = Ms^{-1} G (stress rows, velocity columns) and G^T (velocity
+  rows, stress columns), applied cell by cell (b->smap_B, b->smap_Res); none for a body with geometric stiffening,
+  whose G(u) is assembled. -phlex_check_stress_maps compares them with the assembled operators.
 
   Collective
 @*/
-PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible b, Mat *B, Mat *Gt)
+PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible b)
 {
+  PetscBool check = PETSC_FALSE;
+
   PetscFunctionBeginUser;
-  PetscCheck(!b->stiffening, b->comm, PETSC_ERR_PLIB, "body %s: the cell-by-cell stress maps are those of the undeformed geometry; geometric stiffening assembles G(u)", b->name);
-  PetscCheck(b->Ms, b->comm, PETSC_ERR_ORDER, "body %s: the stress maps need the mixed operators (PhlexFlexibleSetUpMixed)", b->name);
-  PetscCall(PhlexMatCreateShell(b->comm, b->ns_local, b->nv_local, b->ns_global, b->nv_global, b, MatMult_StressRate, B));
-  PetscCall(PhlexMatCreateShell(b->comm, b->nv_local, b->ns_local, b->nv_global, b->ns_global, b, MatMult_Resultant, Gt));
-  PetscCall(PetscObjectSetName((PetscObject)*B, "stress rate map Ms^-1 G (cell by cell)"));
-  PetscCall(PetscObjectSetName((PetscObject)*Gt, "stress resultant map G^T (cell by cell)"));
-  PetscCall(CheckStressMaps(b, *B, *Gt));
+  PetscCheck(b->Ms && b->G, b->comm, PETSC_ERR_ORDER, "body %s: the stress maps need the mixed operators (PhlexFlexibleSetUpMixed)", b->name);
+  PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
+  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G and G^T with the assembled G and Ms, for random fields", "PhlexFlexibleCreateStressMaps", check, &check, NULL));
+  PetscOptionsEnd();
+  if (b->stiffening) {
+    if (check) PetscCall(PetscPrintf(b->comm, "body %s: stress maps cell by cell: not used (geometric stiffening assembles G(u))\n", b->name));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PhlexMatCreateShell(b->comm, b->ns_local, b->nv_local, b->ns_global, b->nv_global, b, MatMult_StressRate, &b->smap_B));
+  PetscCall(PhlexMatCreateShell(b->comm, b->nv_local, b->ns_local, b->nv_global, b->ns_global, b, MatMult_Resultant, &b->smap_Res));
+  PetscCall(PetscObjectSetName((PetscObject)b->smap_B, "stress rate map Ms^-1 G (cell by cell)"));
+  PetscCall(PetscObjectSetName((PetscObject)b->smap_Res, "stress resultant map G^T (cell by cell)"));
+  if (check) PetscCall(CheckStressMaps(b, b->smap_B, b->smap_Res));
   PetscFunctionReturn(0);
 }
 

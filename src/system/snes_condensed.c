@@ -220,19 +220,19 @@ PetscErrorCode PhlexSystemStressMapsToRowBlocks(PhlexSystem sys, Mat *B)
 
 /*@C
   PhlexSystemCreateResultantMaps - per body G as dense blocks per cell, for the stress resultant G^T Sigma by
-  MatMultTranspose; its sums are those of MatMult with the body's G^T (like_gt) or of MatMultTranspose with its G
-  (the path it replaces); freed by the caller (MatDestroy each, PetscFree the array)
+  MatMultTranspose (SNES phlexreduced), with the sums of MatMultTranspose with the body's AIJ G (the path it
+  replaced); freed by the caller (MatDestroy each, PetscFree the array)
 
   Collective
 @*/
-PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem sys, PetscBool like_gt, Mat **Gt)
+PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem sys, Mat **Gt)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(sys->nfparts, Gt));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    PetscCall(PhlexMatCreateRowBlocks(ops.G, PETSC_TRUE, like_gt ? ops.Gt : ops.G, &(*Gt)[i]));
+    PetscCall(PhlexMatCreateRowBlocks(ops.G, PETSC_TRUE, ops.G, &(*Gt)[i]));
   }
   PetscFunctionReturn(0);
 }
@@ -275,7 +275,7 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
   }
   PetscCall(KSPSetFromOptions(c->ksp));
   /* the three products of a step, cell by cell from the element structure: nothing assembled */
-  PetscCall(PetscMalloc2(sys->nfparts, &c->B, sys->nfparts, &c->Res));
+  PetscCall(PetscCalloc2(sys->nfparts, &c->B, sys->nfparts, &c->Res));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));

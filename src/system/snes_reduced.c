@@ -181,7 +181,7 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
   }
   /* the step's passes over the stress field as dense blocks per cell: the same sums as the AIJ products */
   PetscCall(PhlexSystemStressMapsToRowBlocks(sys, c->B));
-  PetscCall(PhlexSystemCreateResultantMaps(sys, PETSC_FALSE, &c->Gt));
+  PetscCall(PhlexSystemCreateResultantMaps(sys, &c->Gt));
   PetscCall(VecDuplicate(snes->vec_sol, &c->Xd));
   PetscCall(VecDuplicate(snes->vec_sol, &c->F));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->P)); /* stress columns, velocity rows */
