@@ -559,7 +559,7 @@ PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible b, const PhlexUnits *units)
 /* 1/2 s^T Ms s from Ms's structure: the block of cell c is detJ_c (smass (x) A_m) (PhlexElementComplianceMass), smass
    the reference mass of the stress basis, A_m the compliance of the cell's material, so a cell's energy is
    1/2 detJ_c sum_ij smass_ij s_i . A_m s_j over its stress nodes i, j (6 components each). The monitor needs it every
-   step: a product with the assembled Ms streamed its 224 MB at 2.2e5 velocity DOFs (22-40 ms, one BLAS dgemv call per
+   step: a product with the assembled Ms streamed its 224 MB at 2.2e5 velocity DOFs (30-47 ms, one BLAS dgemv call per
    cell), this reads the stresses and the cells' volumes only (BENCHMARKS.md section 18). The sums are not dgemv's:
    the energy differs from 1/2 s^T (Ms s) in its last bits. */
 static PetscErrorCode StrainEnergy(PhlexFlexible b, Vec s, PetscReal *strain)

@@ -13,9 +13,9 @@
      (G^T Sigma)_b = detJ sum_i S_i invJ^T coup[i][b]   (S_i the symmetric tensor of Sigma_i).
    A product reads the velocities, the cells' geometry and the stresses (about 25 MB at 2.2e5 velocity DOFs) instead
    of the 280 MB of B's or G's entries, and nothing is assembled or stored beyond two work vectors and the cells'
-   local offsets. The sums are not
-   those of the assembled products: results differ from them in the last bits (BENCHMARKS.md section 18). For the
-   body's undeformed geometry only: geometric stiffening's G(u) is assembled (flexible_stiffening.c). */
+   local offsets. The sums are not those of the assembled products: results differ from them in the last bits
+   (BENCHMARKS.md section 18). For the body's undeformed geometry only: geometric stiffening's G(u) is assembled
+   (flexible_stiffening.c). */
 #include <phlex_impl.h>
 #include <petscblaslapack.h>
 
