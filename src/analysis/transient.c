@@ -659,8 +659,13 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
         PetscCall(KSPSetFromOptions(ksp));
         if (sys->nonlinear || sys->inexact_schur) {
           SNESLineSearch ls;
+          PetscBool      preonly;
           PetscCall(SNESGetLineSearch(snes, &ls));
           PetscCall(SNESLineSearchSetFromOptions(ls));
+          /* the preset for linear bodies (exact.opts) applies its field split once: with spin or stiffening its
+             condensed operator is not the Schur complement, and Newton converges slowly or stops off the balance */
+          PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &preonly));
+          if (preonly && sys->inexact_schur) PetscCall(PetscFPrintf(scene->comm, PETSC_STDERR, "phlex: note: a body has geometric stiffening or spin, and the solver preset applies its field split once (-ksp_type preonly, as options/solver/exact.opts does): its condensed operator is then not the exact Schur complement, and Newton may converge slowly or stop off the power balance; options/solver/exact_krylov.opts is the preset for such bodies (the default without -solver_options_file)\n"));
         }
         m.condensed = PETSC_FALSE;
       }
