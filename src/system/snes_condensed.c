@@ -211,7 +211,7 @@ PetscErrorCode PhlexSystemStressMapsToRowBlocks(PhlexSystem sys, Mat *B)
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     Mat Bb;
-    PetscCall(PhlexMatCreateRowBlocks(B[i], PETSC_FALSE, B[i], &Bb));
+    PetscCall(PhlexMatCreateRowBlocks(B[i], PETSC_FALSE, &Bb));
     PetscCall(MatDestroy(&B[i]));
     B[i] = Bb;
   }
@@ -232,7 +232,7 @@ PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem sys, Mat **Gt)
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    PetscCall(PhlexMatCreateRowBlocks(ops.G, PETSC_TRUE, ops.G, &(*Gt)[i]));
+    PetscCall(PhlexMatCreateRowBlocks(ops.G, PETSC_TRUE, &(*Gt)[i]));
   }
   PetscFunctionReturn(0);
 }

@@ -172,7 +172,7 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
       PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
       PetscCall(MatTransposeMatMult(ops.G, c->B[i], MAT_INITIAL_MATRIX, PETSC_DEFAULT, &K));
       /* as dense blocks of rows (a node's three rows share their columns): K is only multiplied, with the same sums */
-      PetscCall(PhlexMatCreateRowBlocks(K, PETSC_FALSE, K, &Kb[i]));
+      PetscCall(PhlexMatCreateRowBlocks(K, PETSC_FALSE, &Kb[i]));
       PetscCall(MatDestroy(&K));
     }
     PetscCall(PhlexSystemBlockDiagonal(sys, Kb, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &c->K));

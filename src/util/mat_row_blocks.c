@@ -6,12 +6,10 @@
 
    The sums are those of the AIJ products they replace, term by term in the same order: y_i = sum_j a_ij x_j over j
    ascending for MatMult, and y_j = sum_i a_ij x_i over i ascending for MatMultTranspose (as MatMultTranspose of A
-   adds them, or MatMult of the AIJ transpose that MatTranspose makes), each started from zero. Where PETSc's product
-   uses inodes (rows of one pattern, as here) it adds the terms two at a time, and so do the blocks (for the transpose
-   only when every block has an even number of rows: 24 stress rows per cell, 3 rows per node; otherwise one at a
-   time, and the sums then differ in the last bits). On several processes MatMult pairs the owned columns only and adds
-   the ghost columns' terms one at a time after them, as MPIAIJ does, and the transpose without pairs adds the ghost
-   sums on their owners as MPIAIJ does: the same bits there too; the paired transpose sums in another order.
+   adds them), each started from zero. Where PETSc's MatMult uses inodes (rows of one pattern, as here) it adds the
+   terms two at a time, and so do the blocks; MatMultTranspose has no inode variant and adds them one at a time. On
+   several processes MatMult pairs the owned columns only and adds the ghost columns' terms one at a time after them,
+   as MPIAIJ does, and the transpose adds the ghost sums on their owners as MPIAIJ does: the same bits there too.
    The same bits hold where PETSc was compiled, as Debian's x86-64 build is, without fused multiply-adds (this file
    is compiled with -ffp-contract=off); on a processor where the compiler fuses them by default (aarch64) they may
    differ in the last bits. */
@@ -28,7 +26,7 @@ typedef struct {
   size_t     *vstart;     /* nb + 1: start of each run's block in val */
   MatScalar  *val;        /* the blocks */
   PetscBool   transpose;  /* row-major blocks, laid out for MatMultTranspose */
-  PetscBool   pairwise;   /* terms added in pairs, as the AIJ product with inodes that the blocks replace */
+  PetscBool   pairwise;   /* MatMult: terms added in pairs, as AIJ's MatMult with inodes (never for the transpose) */
   PetscInt    n;          /* owned columns */
   PetscInt    nghost;     /* ghost columns (several processes) */
   Vec         ghost;      /* the ghost columns' values (several processes) */
@@ -63,22 +61,15 @@ PHLEX_KERNEL_CLONES static void MultKernel(const RowBlocks *rb, const PetscScala
   }
 }
 
-/* y += A^T x, A row-major blocks; y indexed by the local columns. Pairwise: two rows' terms added at a time, as the
-   AIJ transpose's product with inodes adds them when every block has an even number of rows. */
+/* y += A^T x, A row-major blocks; y indexed by the local columns; one row's terms at a time, as AIJ's
+   MatMultTranspose adds them */
 PHLEX_KERNEL_CLONES static void MultTransposeKernel(const RowBlocks *rb, const PetscScalar *x, PetscScalar *y, PetscScalar *acc)
 {
-  const PetscInt step = rb->pairwise ? 2 : 1;
   for (PetscInt b = 0; b < rb->nb; b++) {
     const PetscInt   r0 = rb->rstart[b], nr = rb->rstart[b + 1] - r0, *c = rb->col + rb->cstart[b], nc = rb->cstart[b + 1] - rb->cstart[b];
     const MatScalar *v  = rb->val + rb->vstart[b];
-    PetscInt         i  = 0;
     for (PetscInt j = 0; j < nc; j++) acc[j] = y[c[j]];
-    for (; step == 2 && i + 1 < nr; i += 2) {
-      const PetscScalar x0 = x[r0 + i], x1 = x[r0 + i + 1];
-      const MatScalar  *v0 = v + i * nc, *v1 = v0 + nc;
-      for (PetscInt j = 0; j < nc; j++) acc[j] += v0[j] * x0 + v1[j] * x1;
-    }
-    for (; i < nr; i++) {
+    for (PetscInt i = 0; i < nr; i++) {
       const PetscScalar x0 = x[r0 + i];
       const MatScalar  *v0 = v + i * nc;
       for (PetscInt j = 0; j < nc; j++) acc[j] += v0[j] * x0;
@@ -216,14 +207,12 @@ static PetscErrorCode UsesInodes(Mat R, PetscBool *inodes)
 
 /*@C
   PhlexMatCreateRowBlocks - the matrix A (AIJ, sequential or MPI) stored as dense blocks, one per run of consecutive
-  rows with the same columns, for one product: MatMult, or MatMultTranspose (transpose). Its sums are those of the
-  AIJ product of same_sums_as (see the top of the file): for MatMult, A itself; for MatMultTranspose, A (whose
-  MatMultTranspose adds the terms one at a time) or A's AIJ transpose as MatTranspose makes it (whose MatMult may
-  add them in pairs). Neither matrix is referenced afterwards.
+  rows with the same columns, for one product: MatMult, or MatMultTranspose (transpose), with the sums of A's own
+  AIJ product (see the top of the file). A is not referenced afterwards.
 
   Collective
 @*/
-PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums_as, Mat *C)
+PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat *C)
 {
   RowBlocks      *rb;
   RowReader       rr = {0};
@@ -231,7 +220,6 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
   const PetscInt *garray = NULL;
   PetscBool       mpi, seq, done;
   PetscInt        m, n, M, N, nrows, ntot = 0, vtot = 0, maxlen = 1;
-  PetscBool       odd = PETSC_FALSE;
   MPI_Comm        comm = PetscObjectComm((PetscObject)A);
 
   PetscFunctionBeginUser;
@@ -247,14 +235,8 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
   PetscCall(PetscNew(&rb));
   rb->n         = n;
   rb->transpose = transpose;
-  PetscCheck(same_sums_as == A || (transpose && same_sums_as), comm, PETSC_ERR_ARG_WRONG, "row blocks: MatMult has the sums of A's MatMult");
-  if (same_sums_as != A) {
-    PetscInt tm, tn;
-    PetscCall(MatGetSize(same_sums_as, &tm, &tn));
-    PetscCheck(tm == N && tn == M, comm, PETSC_ERR_ARG_SIZ, "row blocks: the transpose whose sums to reproduce is %" PetscInt_FMT " x %" PetscInt_FMT ", A is %" PetscInt_FMT " x %" PetscInt_FMT, tm, tn, M, N);
-  }
-  if (transpose && same_sums_as == A) rb->pairwise = PETSC_FALSE; /* AIJ's MatMultTranspose has no inode variant */
-  else PetscCall(UsesInodes(same_sums_as, &rb->pairwise));
+  if (transpose) rb->pairwise = PETSC_FALSE; /* AIJ's MatMultTranspose has no inode variant */
+  else PetscCall(UsesInodes(A, &rb->pairwise));
   if (mpi) PetscCall(MatMPIAIJGetSeqAIJ(A, &Ad, &Ao, &garray));
   PetscCall(MatGetRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &rr.ia, &rr.ja, &done));
   PetscCheck(done, comm, PETSC_ERR_PLIB, "MatGetRowIJ failed");
@@ -294,7 +276,6 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
     rb->vstart[b + 1] = rb->vstart[b] + (size_t)nr * (size_t)nc;
     maxlen            = PetscMax(maxlen, transpose ? nc : nr);
     rb->nown[b]       = nd;
-    if (transpose && nr % 2 && nc) odd = PETSC_TRUE;
     for (PetscInt k = 0; k < nd; k++) c[k] = rr.ja[rr.ia[r0] + k];
     for (PetscInt k = 0; k < no; k++) c[nd + k] = n + rr.jb[rr.ib[r0] + k];
     for (PetscInt i = 0; i < nr; i++) {
@@ -307,11 +288,6 @@ PetscErrorCode PhlexMatCreateRowBlocks(Mat A, PetscBool transpose, Mat same_sums
         for (PetscInt k = 0; k < no; k++) v[(nd + k) * nr + i] = ao[k];
       }
     }
-  }
-  if (odd && rb->pairwise) {
-    /* the AIJ transpose's pairs would straddle two runs: its sums cannot be reproduced run by run */
-    rb->pairwise = PETSC_FALSE;
-    PetscCall(PetscInfo(A, "row blocks: a run with an odd number of rows; the transpose's terms are added one at a time (the last bits may differ from the AIJ product's)\n"));
   }
   PetscCall(MatSeqAIJRestoreArrayRead(Ad, &rr.a));
   PetscCall(MatRestoreRowIJ(Ad, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &rr.ia, &rr.ja, &done));
