@@ -40,9 +40,8 @@ build/%.o: src/%.c
 	$(CC) $(CPPFLAGS) $(CFLAGS) $(STDFLAGS) $(VECFLAGS) -c $< -o $@
 
 # the block kernels' loops vectorize only with GCC's dynamic cost model (-O2's leaves them scalar); no fused
-# multiply-add there (with -march flags that have it), so that their clones give the same bits, and the row blocks
-# those of the AIJ products they replace
-build/util/mat_block_mult.o build/util/mat_row_blocks.o: VECFLAGS = -fvect-cost-model=dynamic -ffp-contract=off
+# multiply-add there (with -march flags that have it), so that their clones give the same bits
+build/util/mat_block_mult.o: VECFLAGS = -fvect-cost-model=dynamic -ffp-contract=off
 
 bin:
 	@mkdir -p $@

@@ -162,9 +162,6 @@ PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, Pe
 /* mat_block_mult.c: a matrix times a block of vectors */
 PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
 
-/* mat_row_blocks.c: an AIJ matrix as dense blocks of rows sharing their columns (the cells' rows of G and B) */
-PETSC_INTERN PetscErrorCode PhlexMatCreateRowBlocks(Mat, PetscBool, Mat *);
-
 /* format.c: numbers echoed to the user at full precision */
 PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);
 

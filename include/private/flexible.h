@@ -200,8 +200,8 @@ struct _p_PhlexFlexible {
   PetscReal compliance[PHLEX_MAX_MATERIALS][36]; /* each material's compliance A (non-dimensional): Ms's block of a cell
                                                     is detJ (smass (x) A), PhlexElementComplianceMass */
 
-  /* the stress maps B = Ms^{-1} G and G^T cell by cell (flexible_stress_maps.c), set up at their first product */
-  Mat       smap_B, smap_Res;                   /* the shells handed out as PhlexFieldOperators' B and Res */
+  /* the stress maps B = Ms^{-1} G, G^T and G^T Ms^{-1} G cell by cell (flexible_stress_maps.c), set up at their first product */
+  Mat       smap_B, smap_Res, smap_K;           /* the shells handed out as PhlexFieldOperators' B, Res and Kc */
   PetscBool smap_ready;
   PetscReal stiffness[PHLEX_MAX_MATERIALS][36]; /* each material's A^{-1} */
   PetscReal smass_inv[16];                      /* the stress basis's reference mass, inverted */

@@ -58,6 +58,7 @@ typedef struct {
   Mat      Ms;       /* compliance mass, block diagonal per cell */
   Mat      B, Res;   /* stress rate B = Ms^{-1} G (stress rows) and stress resultant G^T (velocity rows) as products
                         cell by cell (shells, nothing stored), or NULL (geometric stiffening: G(u) is assembled) */
+  Mat      Kc;       /* the condensed stiffness G^T Ms^{-1} G as a product cell by cell (shell), or NULL like B */
   PetscInt stress_bs; /* stress unknowns per cell (block size of Ms) */
   Mat      Jvv, Jvu; /* velocity rows: d/dv (shift Mv [+ node-wise terms]) and d/du (node-wise terms, or NULL) */
   Mat      Jvc;      /* Jvv + Jvu / shift: the velocity rows' own block once u = u0 + v / shift is eliminated (one product) */

@@ -111,11 +111,14 @@ PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSNESRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESCondensedApplicable(PhlexSystem, TS, PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexSNESCondensedSetSystem(SNES, PhlexSystem, TS);
-PETSC_INTERN PetscErrorCode PhlexSystemCreateStressMaps(PhlexSystem, Mat **);
-PETSC_INTERN PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem, Mat *, Vec, Vec);
-PETSC_INTERN PetscErrorCode PhlexSystemStressMapsToRowBlocks(PhlexSystem, Mat *);
-PETSC_INTERN PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem, Mat **);
-PETSC_INTERN PetscErrorCode PhlexSystemResultantMult(PhlexSystem, Mat *, Vec, Vec);
+/* the bodies' cell-by-cell products (PhlexFieldOperators B, Res, Kc), referenced per body */
+typedef struct {
+  Mat *B, *Res, *K;
+} PhlexStressMaps;
+PETSC_INTERN PetscErrorCode PhlexSystemGetStressMaps(PhlexSystem, const char *, PhlexStressMaps *);
+PETSC_INTERN PetscErrorCode PhlexSystemStressMapsDestroy(PhlexSystem, PhlexStressMaps *);
+PETSC_INTERN PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem, PhlexStressMaps *, Vec, Vec);
+PETSC_INTERN PetscErrorCode PhlexSystemResultantMult(PhlexSystem, PhlexStressMaps *, Vec, Vec);
 /* snes_reduced.c: SNES phlexreduced, Newton on the velocities and discrete unknowns of a theta-method stage */
 PETSC_INTERN PetscErrorCode PhlexSNESReducedRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedApplicable(PhlexSystem, TS, PetscBool *);

@@ -597,6 +597,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->Ms        = b->Ms;
   ops->B         = b->smap_B; /* NULL with geometric stiffening */
   ops->Res       = b->smap_Res;
+  ops->Kc        = b->smap_K;
   ops->stress_bs = b->nb_s;
   ops->Jvv       = b->Jvv;
   ops->Jvu       = b->Jvu;

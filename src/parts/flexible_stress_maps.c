@@ -13,7 +13,8 @@
      (G^T Sigma)_b = detJ sum_i S_i invJ^T coup[i][b]   (S_i the symmetric tensor of Sigma_i).
    A product reads the velocities, the cells' geometry and the stresses (about 25 MB at 2.2e5 velocity DOFs) instead
    of the 280 MB of B's or G's entries, and nothing is assembled or stored beyond two work vectors and the cells'
-   local offsets. The sums are not those of the assembled products: results differ from them in the last bits
+   local offsets. The condensed stiffness K = G^T Ms^{-1} G (SNES phlexreduced's residual and Jacobian) is the two in
+   one pass per cell, the stress kept in the cell. The sums are not those of the assembled products: results differ from them in the last bits
    (BENCHMARKS.md section 18). For the body's undeformed geometry only: geometric stiffening's G(u) is assembled
    (flexible_stiffening.c). */
 #include <phlex_impl.h>
@@ -180,13 +181,55 @@ static PetscErrorCode MatMult_Resultant(Mat A, Vec sigma, Vec f)
   PetscFunctionReturn(0);
 }
 
+/* MatMult of the shell K: y (velocity field) = G^T Ms^{-1} G v, the condensed stiffness, cell by cell (Ms is block
+   diagonal per cell, so K v sums G_c^T (B v)_c over the cells): the arithmetic of B then G^T, without the stress
+   field in between */
+static PetscErrorCode MatMult_CondensedStiffness(Mat A, Vec v, Vec y)
+{
+  PhlexFlexible      b;
+  PetscInt           nv, nn;
+  const PetscScalar *va;
+  PetscScalar       *fa;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, &b));
+  PetscCall(StressMapsSetUp(b));
+  PetscCall(PetscLogEventBegin(PHLEX_StressMaps, A, 0, 0, 0));
+  nv = b->ref.nv;
+  nn = b->ref.ns;
+  PetscCall(DMGlobalToLocalBegin(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscCall(DMGlobalToLocalEnd(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscCall(VecSet(b->smap_floc, 0.0));
+  PetscCall(VecGetArrayRead(b->smap_vloc, &va));
+  PetscCall(VecGetArray(b->smap_floc, &fa));
+  for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
+    const PetscInt  *loc = &b->cell_vloc[c * 3 * nv];
+    const PetscReal *g   = &b->cell_geom[10 * c];
+    PetscReal        ve[3 * PHLEX_MAX_NODES], fe[3 * PHLEX_MAX_NODES];
+    PetscScalar      sigma[24];
+    for (PetscInt k = 0; k < 3 * nv; k++) ve[k] = PetscRealPart(va[loc[k]]);
+    CellStressRate(nv, nn, b->ref.coup, &g[1], b->stiffness[b->cell_material[c]], b->smass_inv, ve, sigma);
+    CellResultant(nv, nn, b->ref.coup, g[0], &g[1], sigma, fe);
+    for (PetscInt k = 0; k < 3 * nv; k++) fa[loc[k]] += fe[k];
+  }
+  PetscCall(VecRestoreArray(b->smap_floc, &fa));
+  PetscCall(VecRestoreArrayRead(b->smap_vloc, &va));
+  PetscCall(VecSet(y, 0.0));
+  PetscCall(DMLocalToGlobalBegin(b->dm, b->smap_floc, ADD_VALUES, y));
+  PetscCall(DMLocalToGlobalEnd(b->dm, b->smap_floc, ADD_VALUES, y));
+  PetscCall(PetscLogFlops((2.0 * 9 * nv + 2.0 * 27 + 3 + 2.0 * 36 + 2.0 * 6 * nn + 2.0 * 27 + 2.0 * 9 * nv) * nn * (b->cEnd - b->cStart)));
+  PetscCall(PetscLogEventEnd(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
 /* -phlex_check_stress_maps: the products cell by cell against the assembled operators, for a random velocity v and
-   stress Sigma: |Ms (B v) - G v| / |G v| and |Res Sigma - G^T Sigma| / |G^T Sigma| (infinity norms), printed */
-static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res)
+   stress Sigma: |Ms (B v) - G v| / |G v|, |Res Sigma - G^T Sigma| / |G^T Sigma| and |Kc v - G^T (B v)| / |G^T (B v)|
+   (infinity norms), printed */
+static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res, Mat Kc)
 {
   Vec         v, s, Bv, MsBv, Gv, f, Gts;
   PetscRandom rnd;
-  PetscReal   nref, ndiff, worst_b, worst_r;
+  PetscReal   nref, ndiff, worst_b, worst_r, worst_k;
 
   PetscFunctionBeginUser;
   PetscCall(PetscRandomCreate(b->comm, &rnd));
@@ -214,8 +257,16 @@ static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res)
   PetscCall(VecAXPY(f, -1.0, Gts));
   PetscCall(VecNorm(f, NORM_INFINITY, &ndiff));
   worst_r = ndiff / nref;
-  PetscCall(PetscPrintf(b->comm, "body %s: stress maps cell by cell vs assembled G, Ms: Ms B - G %s, G^T %s (relative, infinity norm)\n", b->name, worst_b < 1e-13 ? "< 1e-13" : "LARGE", worst_r < 1e-13 ? "< 1e-13" : "LARGE"));
-  if (worst_b >= 1e-13 || worst_r >= 1e-13) PetscCall(PetscPrintf(b->comm, "body %s: stress maps: Ms B - G %.3e, G^T %.3e\n", b->name, (double)worst_b, (double)worst_r));
+  /* K: G^T (B v) with the assembled G (B checked above) */
+  PetscCall(MatMult(Kc, v, f));
+  PetscCall(MatMultTranspose(b->G, Bv, Gts));
+  PetscCall(VecNorm(Gts, NORM_INFINITY, &nref));
+  PetscCall(VecAXPY(f, -1.0, Gts));
+  PetscCall(VecNorm(f, NORM_INFINITY, &ndiff));
+  worst_k = ndiff / nref;
+  PetscCall(PetscPrintf(b->comm, "body %s: stress maps cell by cell vs assembled G, Ms: Ms B - G %s, G^T %s, K - G^T B %s (relative, infinity norm)\n", b->name, worst_b < 1e-13 ? "< 1e-13" : "LARGE", worst_r < 1e-13 ? "< 1e-13" : "LARGE", worst_k < 1e-13 ? "< 1e-13" : "LARGE"));
+  PetscCall(PetscInfo(NULL, "body %s: stress maps: Ms B - G %.3e, G^T %.3e, K - G^T B %.3e\n", b->name, (double)worst_b, (double)worst_r, (double)worst_k));
+  if (worst_b >= 1e-13 || worst_r >= 1e-13 || worst_k >= 1e-13) PetscCall(PetscPrintf(b->comm, "body %s: stress maps: Ms B - G %.3e, G^T %.3e, K - G^T B %.3e\n", b->name, (double)worst_b, (double)worst_r, (double)worst_k));
   PetscCall(VecDestroy(&v));
   PetscCall(VecDestroy(&s));
   PetscCall(VecDestroy(&Bv));
@@ -228,9 +279,10 @@ static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res)
 }
 
 /*@C
-  PhlexFlexibleCreateStressMaps - the body's shells of B = Ms^{-1} G (stress rows, velocity columns) and G^T (velocity
-  rows, stress columns), applied cell by cell (b->smap_B, b->smap_Res); none for a body with geometric stiffening,
-  whose G(u) is assembled. -phlex_check_stress_maps compares them with the assembled operators.
+  PhlexFlexibleCreateStressMaps - the body's shells of B = Ms^{-1} G (stress rows, velocity columns), G^T (velocity
+  rows, stress columns) and the condensed stiffness K = G^T Ms^{-1} G (velocity rows and columns), applied cell by
+  cell (b->smap_B, b->smap_Res, b->smap_K); none for a body with geometric stiffening, whose G(u) is assembled.
+  -phlex_check_stress_maps compares them with the assembled operators.
 
   Collective
 @*/
@@ -241,7 +293,7 @@ PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible b)
   PetscFunctionBeginUser;
   PetscCheck(b->Ms && b->G, b->comm, PETSC_ERR_ORDER, "body %s: the stress maps need the mixed operators (PhlexFlexibleSetUpMixed)", b->name);
   PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
-  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G and G^T with the assembled G and Ms, for random fields", "PhlexFlexibleCreateStressMaps", check, &check, NULL));
+  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G, G^T and G^T Ms^-1 G with the assembled G and Ms, for random fields", "PhlexFlexibleCreateStressMaps", check, &check, NULL));
   PetscOptionsEnd();
   if (b->stiffening) {
     if (check) PetscCall(PetscPrintf(b->comm, "body %s: stress maps cell by cell: not used (geometric stiffening assembles G(u))\n", b->name));
@@ -249,9 +301,11 @@ PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible b)
   }
   PetscCall(PhlexMatCreateShell(b->comm, b->ns_local, b->nv_local, b->ns_global, b->nv_global, b, MatMult_StressRate, &b->smap_B));
   PetscCall(PhlexMatCreateShell(b->comm, b->nv_local, b->ns_local, b->nv_global, b->ns_global, b, MatMult_Resultant, &b->smap_Res));
+  PetscCall(PhlexMatCreateShell(b->comm, b->nv_local, b->nv_local, b->nv_global, b->nv_global, b, MatMult_CondensedStiffness, &b->smap_K));
   PetscCall(PetscObjectSetName((PetscObject)b->smap_B, "stress rate map Ms^-1 G (cell by cell)"));
   PetscCall(PetscObjectSetName((PetscObject)b->smap_Res, "stress resultant map G^T (cell by cell)"));
-  if (check) PetscCall(CheckStressMaps(b, b->smap_B, b->smap_Res));
+  PetscCall(PetscObjectSetName((PetscObject)b->smap_K, "condensed stiffness map G^T Ms^-1 G (cell by cell)"));
+  if (check) PetscCall(CheckStressMaps(b, b->smap_B, b->smap_Res, b->smap_K));
   PetscFunctionReturn(0);
 }
 
@@ -261,6 +315,7 @@ PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible b)
   PetscFunctionBeginUser;
   PetscCall(MatDestroy(&b->smap_B));
   PetscCall(MatDestroy(&b->smap_Res));
+  PetscCall(MatDestroy(&b->smap_K));
   PetscCall(VecDestroy(&b->smap_vloc));
   PetscCall(VecDestroy(&b->smap_floc));
   b->smap_ready = PETSC_FALSE;

@@ -35,8 +35,7 @@ typedef struct {
   PhlexSystem sys;
   TS          ts;
   KSP         ksp;   /* the condensed velocity operator s Mv + K / s (the bodies' Sv, block diagonal) */
-  Mat        *B;    /* per body: Ms^{-1} G, cell by cell (the part's shell, PhlexFieldOperators B) */
-  Mat        *Res;  /* per body: G^T, cell by cell (the part's shell, PhlexFieldOperators Res) */
+  PhlexStressMaps maps; /* per body B = Ms^{-1} G and G^T, cell by cell (the parts' shells) */
   Vec         r;     /* the condensed right-hand side */
   Vec         bv, sp; /* stress field: B v0, then B dv; Sigma_p */
   PetscReal   shift; /* non-dimensional shift of the operator last handed to the KSP (0: none) */
@@ -97,91 +96,56 @@ PetscErrorCode PhlexSNESCondensedSetSystem(SNES snes, PhlexSystem sys, TS ts)
   PetscFunctionReturn(0);
 }
 
-/* Ms^{-1}, block diagonal, from the inverses of Ms's per-cell blocks (its variable block sizes) */
-static PetscErrorCode InverseStressMass(PhlexSystem sys, Mat *Minv)
-{
-  PetscInt           nb, rstart, row, bmax = 1, ntot = 0, *idx, *nnz, m, r = 0;
-  const PetscInt    *bsz;
-  PetscScalar       *diag, *blk;
-  const PetscScalar *d;
+/*@C
+  PhlexSystemGetStressMaps - references each body's cell-by-cell products (PhlexFieldOperators B, Res and Kc) in
+  arrays the caller frees with PhlexSystemStressMapsDestroy(); an error names the SNES type (who) if a body has none
+  (geometric stiffening assembles G(u): the stages that use these maps are not chosen for it)
 
+  Collective
+@*/
+PetscErrorCode PhlexSystemGetStressMaps(PhlexSystem sys, const char *who, PhlexStressMaps *maps)
+{
   PetscFunctionBeginUser;
-  PetscCall(MatGetVariableBlockSizes(sys->Ms, &nb, &bsz));
-  for (PetscInt k = 0; k < nb; k++) {
-    bmax = PetscMax(bmax, bsz[k]);
-    ntot += bsz[k] * bsz[k];
+  PetscCall(PetscCalloc3(sys->nfparts, &maps->B, sys->nfparts, &maps->Res, sys->nfparts, &maps->K));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCheck(ops.B && ops.Res && ops.Kc, sys->comm, PETSC_ERR_PLIB, "SNES %s: part %" PetscInt_FMT " has no cell-by-cell stress maps", who, i);
+    PetscCall(PetscObjectReference((PetscObject)ops.B));
+    PetscCall(PetscObjectReference((PetscObject)ops.Res));
+    PetscCall(PetscObjectReference((PetscObject)ops.Kc));
+    maps->B[i]   = ops.B;
+    maps->Res[i] = ops.Res;
+    maps->K[i]   = ops.Kc;
   }
-  PetscCall(PetscMalloc3(PetscMax(ntot, 1), &diag, bmax * bmax, &blk, bmax, &idx));
-  PetscCall(MatInvertVariableBlockDiagonal(sys->Ms, nb, bsz, diag));
-  /* full blocks (Ms may have dropped zero entries; its inverse has none) */
-  PetscCall(MatGetLocalSize(sys->Ms, &m, NULL));
-  PetscCall(PetscMalloc1(PetscMax(m, 1), &nnz));
-  for (PetscInt k = 0; k < nb; k++)
-    for (PetscInt i = 0; i < bsz[k]; i++) nnz[r++] = bsz[k];
-  PetscCall(MatCreate(sys->comm, Minv));
-  PetscCall(MatSetSizes(*Minv, m, m, PETSC_DETERMINE, PETSC_DETERMINE));
-  PetscCall(MatSetType(*Minv, MATAIJ));
-  PetscCall(MatSeqAIJSetPreallocation(*Minv, 0, nnz));
-  PetscCall(MatMPIAIJSetPreallocation(*Minv, 0, nnz, 0, NULL));
-  PetscCall(PetscFree(nnz));
-  PetscCall(MatGetOwnershipRange(*Minv, &rstart, NULL));
-  row = rstart;
-  d   = diag;
-  for (PetscInt k = 0; k < nb; k++) {
-    const PetscInt bs = bsz[k];
-    for (PetscInt i = 0; i < bs; i++) {
-      idx[i] = row + i;
-      for (PetscInt j = 0; j < bs; j++) blk[i * bs + j] = d[j * bs + i]; /* column-major to row-major */
-    }
-    PetscCall(MatSetValues(*Minv, bs, idx, bs, idx, blk, INSERT_VALUES));
-    row += bs;
-    d += bs * bs;
-  }
-  PetscCall(MatAssemblyBegin(*Minv, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(*Minv, MAT_FINAL_ASSEMBLY));
-  PetscCall(PetscFree3(diag, blk, idx));
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexSystemCreateStressMaps - per body B = Ms^{-1} G (G's pattern: Ms is block diagonal per cell), the map from a
-  velocity increment to the stress increment of a theta-method stage (Sigma = Sigma0 + B v / s); freed by the caller
-  (MatDestroy each, PetscFree the array)
-
-  Collective
+  PhlexSystemStressMapsDestroy - releases the references of PhlexSystemGetStressMaps()
 @*/
-PetscErrorCode PhlexSystemCreateStressMaps(PhlexSystem sys, Mat **B)
+PetscErrorCode PhlexSystemStressMapsDestroy(PhlexSystem sys, PhlexStressMaps *maps)
 {
-  Mat Minv;
-
   PetscFunctionBeginUser;
-  PetscCall(InverseStressMass(sys, &Minv));
-  PetscCall(PetscMalloc1(sys->nfparts, B));
+  if (!maps->B) PetscFunctionReturn(0);
   for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexFieldOperators ops;
-    Mat                 Mi;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    PetscCall(MatCreateSubMatrix(Minv, sys->fis[PHLEX_FIELD_STRESS][i], sys->fis[PHLEX_FIELD_STRESS][i], MAT_INITIAL_MATRIX, &Mi));
-    PetscCall(MatMatMult(Mi, ops.G, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &(*B)[i]));
-    PetscCall(MatDestroy(&Mi));
+    PetscCall(MatDestroy(&maps->B[i]));
+    PetscCall(MatDestroy(&maps->Res[i]));
+    PetscCall(MatDestroy(&maps->K[i]));
   }
-  PetscCall(MatDestroy(&Minv));
+  PetscCall(PetscFree3(maps->B, maps->Res, maps->K));
   PetscFunctionReturn(0);
 }
 
-/* per body, between the velocity and the stress field vectors: y_i = A_i x_i (velocity to stress), or with
-   transpose y_i = A_i^T x_i (stress to velocity) */
-static PetscErrorCode BodyMapsApply(PhlexSystem sys, Mat *A, PetscBool transpose, Vec x, Vec y)
+/* per body y_i = A_i x_i, x a vector of field fx and y one of field fy */
+static PetscErrorCode BodyMapsApply(PhlexSystem sys, Mat *A, PhlexField fx, PhlexField fy, Vec x, Vec y)
 {
-  const PhlexField fx = transpose ? PHLEX_FIELD_STRESS : PHLEX_FIELD_VELOCITY, fy = transpose ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_STRESS;
-
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     Vec xi, yi;
     PetscCall(VecGetSubVector(x, sys->fis[fx][i], &xi));
     PetscCall(VecGetSubVector(y, sys->fis[fy][i], &yi));
-    if (transpose) PetscCall(MatMultTranspose(A[i], xi, yi));
-    else PetscCall(MatMult(A[i], xi, yi));
+    PetscCall(MatMult(A[i], xi, yi));
     PetscCall(VecRestoreSubVector(y, sys->fis[fy][i], &yi));
     PetscCall(VecRestoreSubVector(x, sys->fis[fx][i], &xi));
   }
@@ -193,47 +157,10 @@ static PetscErrorCode BodyMapsApply(PhlexSystem sys, Mat *A, PetscBool transpose
 
   Collective
 @*/
-PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem sys, Mat *B, Vec v, Vec y)
+PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem sys, PhlexStressMaps *maps, Vec v, Vec y)
 {
   PetscFunctionBeginUser;
-  PetscCall(BodyMapsApply(sys, B, PETSC_FALSE, v, y));
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexSystemStressMapsToRowBlocks - each body's B as dense blocks per cell (mat_row_blocks.c: the same sums as the
-  AIJ product, 1.5 x fewer bytes to stream), in place
-
-  Collective
-@*/
-PetscErrorCode PhlexSystemStressMapsToRowBlocks(PhlexSystem sys, Mat *B)
-{
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    Mat Bb;
-    PetscCall(PhlexMatCreateRowBlocks(B[i], PETSC_FALSE, &Bb));
-    PetscCall(MatDestroy(&B[i]));
-    B[i] = Bb;
-  }
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexSystemCreateResultantMaps - per body G as dense blocks per cell, for the stress resultant G^T Sigma by
-  MatMultTranspose (SNES phlexreduced), with the sums of MatMultTranspose with the body's AIJ G (the path it
-  replaced); freed by the caller (MatDestroy each, PetscFree the array)
-
-  Collective
-@*/
-PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem sys, Mat **Gt)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(sys->nfparts, Gt));
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexFieldOperators ops;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    PetscCall(PhlexMatCreateRowBlocks(ops.G, PETSC_TRUE, &(*Gt)[i]));
-  }
+  PetscCall(BodyMapsApply(sys, maps->B, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, v, y));
   PetscFunctionReturn(0);
 }
 
@@ -242,10 +169,10 @@ PetscErrorCode PhlexSystemCreateResultantMaps(PhlexSystem sys, Mat **Gt)
 
   Collective
 @*/
-PetscErrorCode PhlexSystemResultantMult(PhlexSystem sys, Mat *Gt, Vec sigma, Vec y)
+PetscErrorCode PhlexSystemResultantMult(PhlexSystem sys, PhlexStressMaps *maps, Vec sigma, Vec y)
 {
   PetscFunctionBeginUser;
-  PetscCall(BodyMapsApply(sys, Gt, PETSC_TRUE, sigma, y));
+  PetscCall(BodyMapsApply(sys, maps->Res, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, sigma, y));
   PetscFunctionReturn(0);
 }
 
@@ -275,16 +202,7 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
   }
   PetscCall(KSPSetFromOptions(c->ksp));
   /* the three products of a step, cell by cell from the element structure: nothing assembled */
-  PetscCall(PetscCalloc2(sys->nfparts, &c->B, sys->nfparts, &c->Res));
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexFieldOperators ops;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    PetscCheck(ops.B && ops.Res, sys->comm, PETSC_ERR_PLIB, "SNES phlexcondensed: part %" PetscInt_FMT " has no cell-by-cell stress maps", i);
-    PetscCall(PetscObjectReference((PetscObject)ops.B));
-    PetscCall(PetscObjectReference((PetscObject)ops.Res));
-    c->B[i]   = ops.B;
-    c->Res[i] = ops.Res;
-  }
+  PetscCall(PhlexSystemGetStressMaps(sys, "phlexcondensed", &c->maps));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
   PetscCall(VecDuplicate(c->sp, &c->bv));
   PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
@@ -326,7 +244,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
   /* Sigma_p = Sigma0 + B v0 / s; per body r = b - G^T Sigma_p */
-  PetscCall(PhlexSystemStressMapsMult(sys, c->B, v0, c->bv));
+  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, v0, c->bv));
   PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
@@ -334,7 +252,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
     PetscCall(VecGetSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
     PetscCall(VecGetSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
-    PetscCall(MatMult(c->Res[i], si, ri));
+    PetscCall(MatMult(c->maps.Res[i], si, ri));
     PetscCall(VecAYPX(ri, -1.0, ops.load));
     PetscCall(VecRestoreSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
     PetscCall(VecRestoreSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
@@ -346,7 +264,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
   PetscCall(KSPGetConvergedReason(c->ksp, &kreason));
   snes->linear_its += its;
   /* Sigma = Sigma_p + B dv / s (not Sigma0 + B v / s: the momentum rows saw G^T Sigma_p); v = v0 + dv; u = u0 + v / s */
-  PetscCall(PhlexSystemStressMapsMult(sys, c->B, xv, c->bv));
+  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, xv, c->bv));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(VecWAXPY(xs, 1.0 / s, c->bv, c->sp));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
@@ -371,13 +289,7 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
 
   PetscFunctionBeginUser;
   PetscCall(KSPDestroy(&c->ksp));
-  if (c->B) {
-    for (PetscInt i = 0; i < c->sys->nfparts; i++) {
-      PetscCall(MatDestroy(&c->B[i]));
-      PetscCall(MatDestroy(&c->Res[i]));
-    }
-    PetscCall(PetscFree2(c->B, c->Res));
-  }
+  if (c->sys) PetscCall(PhlexSystemStressMapsDestroy(c->sys, &c->maps));
   PetscCall(VecDestroy(&c->r));
   PetscCall(VecDestroy(&c->sp));
   PetscCall(VecDestroy(&c->bv));

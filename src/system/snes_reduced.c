@@ -9,9 +9,9 @@
        u = u0 + v / s,    Sigma = Sigma_p + B (v - v0) / s,    Sigma_p = Sigma0 + B v0 / s,    B = Ms^{-1} G,
    so Newton runs on the rows of v and of the discrete unknowns q (frames, impulses) alone, with
        G^T Sigma = G^T Sigma_p + K (v - v0) / s
-   (K = G^T B, formed once by a sparse product, so that the residual's stress term is that of the final Sigma; the
-   element-assembled condensed stiffness differs from it by about 1e-11 relative, which the velocity rows, held to
-   1e-10 of their scale, would see). The Jacobian of these rows is
+   (K = G^T B applied cell by cell, G^T (B v) summed in each cell, so that the residual's stress term is that of the
+   final Sigma; the element-assembled condensed stiffness differs from it by about 1e-11 relative, which the velocity
+   rows, held to 1e-10 of their scale, would see). The Jacobian of these rows is
        [ Jvv + Jvu / s + K / s    Bvq ]      Jvv, Jvu  the velocity rows' own blocks (shift Mv + node-wise inertia),
        [ Cqv + Cqu / s            D   ]      Bvq, Cq*  the borders (frames, joints' port maps), D the discrete block,
    applied as a shell, and its preconditioner is PC phlexbordered on [[shift Mv + K/shift, B], [C, D]]: the factored
@@ -37,9 +37,8 @@ typedef struct {
   TS          ts;
   KSP         ksp;      /* reduced_: Krylov on Jred, PC phlexbordered on the system's {velocity, discrete} operator */
   Mat         Jred;     /* shell: the Jacobian of the velocity and discrete rows, u and Sigma eliminated */
-  Mat         K;        /* the bodies' condensed stiffnesses (block diagonal, velocity field numbering) */
-  Mat        *B;        /* per body Ms^{-1} G, as dense blocks per cell (MatMult) */
-  Mat        *Gt;       /* per body G as dense blocks per cell (MatMultTranspose: G^T) */
+  Mat         K;        /* the bodies' condensed stiffnesses G^T Ms^{-1} G cell by cell (block diagonal, velocity field) */
+  PhlexStressMaps maps; /* per body B = Ms^{-1} G, G^T and K, cell by cell (the parts' shells) */
   Vec         Xd, F;    /* whole state: rate, residual */
   Vec         sp, bv;   /* stress field: Sigma_p, B v */
   Vec         P, Pp, dv, wv; /* velocity field: G^T Sigma at the iterate and at Sigma_p, v - v0, work */
@@ -159,29 +158,12 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
   PetscCall(KSPGetPC(c->ksp, &pc));
   PetscCall(PCSetType(pc, "phlexbordered"));
   PetscCall(KSPSetFromOptions(c->ksp));
-  PetscCall(PhlexSystemCreateStressMaps(sys, &c->B));
-  {
-    /* K = G^T B per body: the stress rows' elimination as the final Sigma = Sigma_p + B (v - v0) / s sees it (the
-       element-assembled condensed stiffness differs from it by about 1e-11 relative, which the velocity rows, held
-       to 1e-10 of their scale, would see) */
-    Mat *Kb;
-    PetscCall(PetscMalloc1(sys->nfparts, &Kb));
-    for (PetscInt i = 0; i < sys->nfparts; i++) {
-      PhlexFieldOperators ops;
-      Mat                 K;
-      PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-      PetscCall(MatTransposeMatMult(ops.G, c->B[i], MAT_INITIAL_MATRIX, PETSC_DEFAULT, &K));
-      /* as dense blocks of rows (a node's three rows share their columns): K is only multiplied, with the same sums */
-      PetscCall(PhlexMatCreateRowBlocks(K, PETSC_FALSE, &Kb[i]));
-      PetscCall(MatDestroy(&K));
-    }
-    PetscCall(PhlexSystemBlockDiagonal(sys, Kb, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &c->K));
-    for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(MatDestroy(&Kb[i]));
-    PetscCall(PetscFree(Kb));
-  }
-  /* the step's passes over the stress field as dense blocks per cell: the same sums as the AIJ products */
-  PetscCall(PhlexSystemStressMapsToRowBlocks(sys, c->B));
-  PetscCall(PhlexSystemCreateResultantMaps(sys, &c->Gt));
+  /* B, G^T and K = G^T B per body, cell by cell from the element structure (nothing assembled). K is the stress rows'
+     elimination as the final Sigma = Sigma_p + B (v - v0) / s sees it: the same cell sums as G^T (B v) (the
+     element-assembled condensed stiffness differs from it by about 1e-11 relative, which the velocity rows, held to
+     1e-10 of their scale, would see) */
+  PetscCall(PhlexSystemGetStressMaps(sys, "phlexreduced", &c->maps));
+  PetscCall(PhlexSystemBlockDiagonal(sys, c->maps.K, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &c->K));
   PetscCall(VecDuplicate(snes->vec_sol, &c->Xd));
   PetscCall(VecDuplicate(snes->vec_sol, &c->F));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->P)); /* stress columns, velocity rows */
@@ -291,10 +273,10 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
      (the residual does not read it; the norm of the state does) */
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
-  PetscCall(PhlexSystemStressMapsMult(sys, c->B, v0, c->bv));
+  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, v0, c->bv));
   PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
   PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
-  PetscCall(PhlexSystemResultantMult(sys, c->Gt, c->sp, c->Pp));
+  PetscCall(PhlexSystemResultantMult(sys, &c->maps, c->sp, c->Pp));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(VecCopy(c->sp, xs));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
@@ -367,7 +349,7 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   }
   PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
   /* Sigma = Sigma_p + B (v - v0) / s: the stress whose resultant the momentum rows saw (through K) */
-  PetscCall(PhlexSystemStressMapsMult(sys, c->B, c->dv, c->bv));
+  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, c->dv, c->bv));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(VecWAXPY(xs, 1.0 / s, c->bv, c->sp));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
@@ -383,14 +365,7 @@ static PetscErrorCode SNESReset_Reduced(SNES snes)
   PetscCall(KSPDestroy(&c->ksp));
   PetscCall(MatDestroy(&c->Jred));
   PetscCall(MatDestroy(&c->K));
-  if (c->Gt) {
-    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->Gt[i]));
-    PetscCall(PetscFree(c->Gt));
-  }
-  if (c->B) {
-    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(MatDestroy(&c->B[i]));
-    PetscCall(PetscFree(c->B));
-  }
+  if (c->sys) PetscCall(PhlexSystemStressMapsDestroy(c->sys, &c->maps));
   PetscCall(VecDestroy(&c->Xd));
   PetscCall(VecDestroy(&c->F));
   PetscCall(VecDestroy(&c->sp));
