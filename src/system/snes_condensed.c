@@ -209,6 +209,30 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
   PetscFunctionReturn(0);
 }
 
+/* a factorization preconditioner of the condensed KSP needs a solver package that factors the operator's matrix type:
+   a sequential package (CHOLMOD, UMFPACK, ...) on several processes is named with the option that chose it */
+static PetscErrorCode CheckFactorPackage(KSP ksp, Mat A)
+{
+  PC            pc;
+  PetscBool     factor, lu, available = PETSC_TRUE;
+  MatSolverType package;
+  MatType       type;
+  const char   *prefix;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCCHOLESKY, PCLU, ""));
+  if (!factor) PetscFunctionReturn(0);
+  PetscCall(PCFactorGetMatSolverType(pc, &package));
+  if (!package) PetscFunctionReturn(0);
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCLU, &lu));
+  PetscCall(MatGetFactorAvailable(A, package, lu ? MAT_FACTOR_LU : MAT_FACTOR_CHOLESKY, &available));
+  if (available) PetscFunctionReturn(0);
+  PetscCall(MatGetType(A, &type));
+  PetscCall(KSPGetOptionsPrefix(ksp, &prefix));
+  SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_USER_INPUT, "-%spc_factor_mat_solver_type %s: that package does not factor the condensed operator's matrix type %s%s", prefix ? prefix : "", package, type, strstr(type, "mpi") ? " (it runs on one process: options/solver/exact_serial.opts is for one process; use exact.opts with mpiexec)" : "");
+}
+
 static PetscErrorCode SNESSolve_Condensed(SNES snes)
 {
   SNES_Condensed    *c   = (SNES_Condensed *)snes->data;
@@ -235,6 +259,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     Mat Sv;
     PetscCall(PhlexSystemIJacobian(c->ts, tstage, X0, NULL, a, sys->J, sys->J, sys));
     PetscCall(PhlexSystemVelocityOperator(sys, &Sv));
+    PetscCall(CheckFactorPackage(c->ksp, Sv));
     PetscCall(KSPSetOperators(c->ksp, Sv, Sv));
     c->shift = s;
   }
