@@ -153,6 +153,12 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   }
   if (PhlexHelpGetMode() != PHLEX_HELP_NONE) PetscFunctionReturn(0);
   PetscCall(PhlexOptionsCheckUnused(scene->comm, ModesRereadOptions, &scene->comm));
+  {
+    /* read with the bodies' options (so that -help lists it), but the stress maps belong to the mixed operators */
+    PetscBool check = PETSC_FALSE;
+    PetscCall(PetscOptionsGetBool(NULL, NULL, "-phlex_check_stress_maps", &check, NULL));
+    PetscCheck(!check, scene->comm, PETSC_ERR_USER_INPUT, "-phlex_check_stress_maps checks the stress maps of a transient or linearised analysis; a modal analysis (stiffness and mass only) does not build them");
+  }
   for (PetscInt k = 0; k < scene->nparts; k++)
     if (scene->parts[k]->ops.modes) nbodies++;
   PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible body)");

@@ -98,6 +98,11 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCall(PetscOptionsReal("-preconditioner_rate_tol", "Floating body: once the Coriolis and centrifugal terms of the frame's angular velocity exceed this share of the step's shift (about w dt), the preconditioner factors them with the condensed operator (not symmetric: LU instead of Cholesky), and again whenever they drift by as much; 0: never (the symmetric operator without them)", "PhlexFlexibleSetFromOptions", b->pc_rate_tol, &b->pc_rate_tol, &rate_given));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin_center", "Fixed body with -spin: a point of the spin axis (mesh coordinates) [m]", "PhlexFlexibleSetFromOptions", 3, b->spin_center, &center_given));
   PetscOptionsEnd();
+  /* the self-checks of the element structure (flexible_fe.c, flexible_stress_maps.c), read here so that -help lists them */
+  PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
+  PetscCall(PetscOptionsBool("-phlex_check_condensation", "Compare the element-wise stress elimination G^T Ms^-1 G with the stiffness, every cell", "PhlexFlexibleSetFromOptions", b->check_condensation, &b->check_condensation, NULL));
+  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G, G^T and G^T Ms^-1 G with the assembled G and Ms, for random fields", "PhlexFlexibleSetFromOptions", b->check_stress_maps, &b->check_stress_maps, NULL));
+  PetscOptionsEnd();
   b->spinning = (PetscBool)(spin_given && (b->spin[0] != 0 || b->spin[1] != 0 || b->spin[2] != 0));
   if (b->spinning) {
     const PetscReal w = PetscSqrtReal(b->spin[0] * b->spin[0] + b->spin[1] * b->spin[1] + b->spin[2] * b->spin[2]);

@@ -483,13 +483,9 @@ static PetscErrorCode CheckCondensation(PhlexFlexible b, const PhlexUnits *u)
   const PhlexElementReferenceIntegrals *R = &b->ref;
   const PetscInt                        nv = b->nb_v, ns = b->nb_s;
   PetscReal                            *Ge, *Mse, *Ke, *Kc, *work, A[36], worst = 0, gworst;
-  PetscBool                             check = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
-  PetscCall(PetscOptionsBool("-phlex_check_condensation", "Compare the element-wise stress elimination G^T Ms^-1 G with the stiffness, every cell", "PhlexFlexibleSetUpMixed", check, &check, NULL));
-  PetscOptionsEnd();
-  if (!check) PetscFunctionReturn(0);
+  if (!b->check_condensation) PetscFunctionReturn(0);
   PetscCall(PetscMalloc5(ns * nv, &Ge, ns * ns, &Mse, nv * nv, &Ke, nv * nv, &Kc, ns * nv, &work));
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
     const PetscReal     *g   = &b->cell_geom[10 * c];

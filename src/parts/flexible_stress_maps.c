@@ -288,13 +288,10 @@ static PetscErrorCode CheckStressMaps(PhlexFlexible b, Mat B, Mat Res, Mat Kc)
 @*/
 PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible b)
 {
-  PetscBool check = PETSC_FALSE;
+  const PetscBool check = b->check_stress_maps;
 
   PetscFunctionBeginUser;
   PetscCheck(b->Ms && b->G, b->comm, PETSC_ERR_ORDER, "body %s: the stress maps need the mixed operators (PhlexFlexibleSetUpMixed)", b->name);
-  PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
-  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G, G^T and G^T Ms^-1 G with the assembled G and Ms, for random fields", "PhlexFlexibleCreateStressMaps", check, &check, NULL));
-  PetscOptionsEnd();
   if (b->stiffening) {
     if (check) PetscCall(PetscPrintf(b->comm, "body %s: stress maps cell by cell: not used (geometric stiffening assembles G(u))\n", b->name));
     PetscFunctionReturn(0);
