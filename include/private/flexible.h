@@ -211,7 +211,7 @@ struct _p_PhlexFlexible {
 
   /* Jacobian pieces (transient), updated by the part */
   PetscReal shift;          /* non-dimensional shift of the assembled blocks (0: none yet) */
-  Mat       Gt, Mvaij, Kaij, Jvv, Jvu, Jvc, Sv;
+  Mat       Mvaij, Kaij, Jvv, Jvu, Jvc, Sv;
   Mat       Mvp; /* the products with Mv: the scalar mass times I_3 (MAIJ), a ninth of Mv's entries */
   PetscScalar *Bc, *Cu, *Cv, *Cpre; /* floating: dense borders of its own discrete unknowns (n_local x nq, column-major) */
   PetscReal Bvv[9], Bvu[9];   /* floating: node-wise blocks applied after Mv */

@@ -54,7 +54,8 @@ typedef struct {
 
 /* Matrices of a part's field blocks, referenced by the system's Jacobian (owned and updated by the part). */
 typedef struct {
-  Mat      G, Gt;    /* coupling (stress rows x velocity columns) and its transpose */
+  Mat      G, Gt;    /* coupling (stress rows x velocity columns) and its transpose, or NULL when constant (the system
+                        transposes G if it needs G^T assembled) */
   Mat      Ms;       /* compliance mass, block diagonal per cell */
   Mat      B, Res;   /* stress rate B = Ms^{-1} G (stress rows) and stress resultant G^T (velocity rows) as products
                         cell by cell (shells, nothing stored), or NULL (geometric stiffening: G(u) is assembled) */

@@ -98,6 +98,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConvergedStage(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
+PETSC_INTERN PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, PetscInt, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);
 

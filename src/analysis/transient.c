@@ -692,6 +692,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
         m.reduced = PETSC_FALSE;
       }
     }
+    /* Newton on the whole state multiplies the Jacobian's stress blocks (the stages of phlexcondensed and phlexreduced
+       do not; the consistent start of a scene with joints builds them itself) */
+    if (!m.condensed && !m.reduced) PetscCall(PhlexSystemCompleteJacobian(sys));
     if ((m.condensed || m.reduced) && PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
       /* what the stage's own solve will read (it is made at the first step) */
       KSP ksp;

@@ -413,6 +413,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     zmax = PetscMax(zmax, vmax);
   }
 
+  PetscCall(PhlexSystemCompleteJacobian(sys));
   PetscCall(SNESCreate(sys->comm, &snes));
   PetscCall(SNESSetDM(snes, sys->dm_aux));
   PetscCall(SNESSetFunction(snes, F, ShortStepFunction, &c));

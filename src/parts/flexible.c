@@ -393,7 +393,6 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(PhlexProfileDestroy(&b->body_force_profile));
   PetscCall(PhlexProfileDestroy(&b->frame_profile));
   PetscCall(PhlexFrameStateDestroy(&b->fs));
-  PetscCall(MatDestroy(&b->Gt));
   PetscCall(MatDestroy(&b->Mvaij));
   PetscCall(MatDestroy(&b->Mvp));
   PetscCall(MatDestroy(&b->Kaij));

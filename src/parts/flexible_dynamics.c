@@ -536,7 +536,6 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
     MatNullSpace   nsp;
     const PetscInt n = b->nv_local, N = b->nv_global;
     PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
-    PetscCall(MatTranspose(b->G, MAT_INITIAL_MATRIX, &b->Gt));
     PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
     PetscCall(MassProductSetUp(b));
     /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv */
@@ -589,7 +588,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
     }
   }
   ops->G         = b->stiffening ? b->Gu : b->G;
-  ops->Gt        = b->stiffening ? b->Gut : b->Gt;
+  ops->Gt        = b->stiffening ? b->Gut : NULL; /* NULL: the system transposes G if the generic path needs G^T */
   ops->Jsu       = b->stiffening ? b->Jsu : NULL;
   ops->Kstate    = b->floating ? (b->stiffening ? b->Ksig : NULL) : ((b->stiffening || b->spinning) ? b->Jvu : NULL);
   ops->Gyro      = b->spinning ? b->Cor : NULL;

@@ -117,6 +117,60 @@ static PetscErrorCode AssembleStressBlock(PhlexSystem sys, PhlexFieldOperators *
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode MatMult_NotAssembled(Mat A, Vec x, Vec y)
+{
+  PetscFunctionBeginUser;
+  SETERRQ(PetscObjectComm((PetscObject)A), PETSC_ERR_PLIB, "internal: a product with the whole-state Jacobian's stress blocks, which PhlexSystemCompleteJacobian() has not built");
+}
+
+/*@C
+  PhlexSystemCompleteJacobian - builds the whole-state Jacobian's blocks that only the generic path multiplies: the
+  stress block -shift Ms (all bodies' compliance masses in one AIJ, the cells' blocks as variable block sizes) and the
+  resultant block G^T (a body's own, state-dependent one with geometric stiffening, else the transpose of its G);
+  once, for Newton on the whole state, the consistent start of a scene with joints and the linearised analysis
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem sys)
+{
+  PhlexFieldOperators *ops;
+  Mat                 *m, Jvs;
+  const PetscInt       S = sys->field[PHLEX_FIELD_STRESS], V = sys->field[PHLEX_FIELD_VELOCITY];
+
+  PetscFunctionBeginUser;
+  if (!sys->nfparts || sys->Ms) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc2(sys->nfparts, &ops, sys->nfparts, &m));
+  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops[i]));
+  PetscCall(AssembleStressBlock(sys, ops, &sys->Ms));
+  PetscCall(MatDestroy(&sys->Jss));
+  PetscCall(MatDuplicate(sys->Ms, MAT_COPY_VALUES, &sys->Jss));
+  {
+    PetscInt        nb;
+    const PetscInt *bsz;
+    PetscCall(MatGetVariableBlockSizes(sys->Ms, &nb, &bsz));
+    PetscCall(MatSetVariableBlockSizes(sys->Jss, nb, (PetscInt *)bsz));
+  }
+  if (sys->shift > 0) {
+    /* a Jacobian was evaluated already (PhlexSystemIJacobian scales the block at a new shift only) */
+    PetscCall(MatScale(sys->Jss, -sys->shift));
+    PetscCall(MatAssemblyBegin(sys->Jss, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(sys->Jss, MAT_FINAL_ASSEMBLY));
+  }
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    if (ops[i].Gt) PetscCall(PetscObjectReference((PetscObject)ops[i].Gt));
+    else PetscCall(MatTranspose(ops[i].G, MAT_INITIAL_MATRIX, &ops[i].Gt));
+    m[i] = ops[i].Gt;
+  }
+  PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, &Jvs));
+  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(MatDestroy(&m[i]));
+  PetscCall(MatDestroy(&sys->Jvs));
+  sys->Jvs = Jvs;
+  PetscCall(MatNestSetSubMat(sys->J, S, S, sys->Jss));
+  PetscCall(MatNestSetSubMat(sys->J, V, S, sys->Jvs));
+  PetscCall(PetscFree2(ops, m));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSystemCreate - the global unknowns, the Jacobian structure and the border data of a scene
 
@@ -241,18 +295,14 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(PetscMalloc1(sys->nfparts, &m));
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], 1.0, &sys->Juu));
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], -1.0, &sys->Juv));
-    PetscCall(AssembleStressBlock(sys, ops, &sys->Ms));
-    PetscCall(MatDuplicate(sys->Ms, MAT_COPY_VALUES, &sys->Jss));
-    {
-      PetscInt        nb;
-      const PetscInt *bsz;
-      PetscCall(MatGetVariableBlockSizes(sys->Ms, &nb, &bsz));
-      PetscCall(MatSetVariableBlockSizes(sys->Jss, nb, (PetscInt *)bsz));
-    }
+    /* the stress block -shift Ms and the resultant block G^T are multiplied by the generic path only (Newton on the
+       whole state, the consistent start, the linearised analysis): until PhlexSystemCompleteJacobian() builds them
+       they are placeholders that stop any product (the stages of SNES phlexcondensed and phlexreduced never need
+       them: at 2.2e5 velocity DOFs they would hold 1.1 GB) */
+    PetscCall(PhlexMatCreateShell(sys->comm, nlocal[PHLEX_FIELD_STRESS], nlocal[PHLEX_FIELD_STRESS], PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, &sys->Jss));
+    PetscCall(PhlexMatCreateShell(sys->comm, nlocal[PHLEX_FIELD_VELOCITY], nlocal[PHLEX_FIELD_STRESS], PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, &sys->Jvs));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
-    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Gt;
-    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, &sys->Jvs));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvv;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvu;
@@ -612,14 +662,16 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
     if (sys->nfparts) {
       PetscCall(MatScale(sys->Juu, 0.0));
       PetscCall(MatShift(sys->Juu, s));
-      PetscCall(MatCopy(sys->Ms, sys->Jss, SAME_NONZERO_PATTERN));
-      PetscCall(MatScale(sys->Jss, -s));
       /* assembling resets the matrices' cached diagonal (block) inverses (point-block Jacobi on the stress block
          would otherwise keep the inverse of the previous shift's block) */
       PetscCall(MatAssemblyBegin(sys->Juu, MAT_FINAL_ASSEMBLY));
       PetscCall(MatAssemblyEnd(sys->Juu, MAT_FINAL_ASSEMBLY));
-      PetscCall(MatAssemblyBegin(sys->Jss, MAT_FINAL_ASSEMBLY));
-      PetscCall(MatAssemblyEnd(sys->Jss, MAT_FINAL_ASSEMBLY));
+      if (sys->Ms) {
+        PetscCall(MatCopy(sys->Ms, sys->Jss, SAME_NONZERO_PATTERN));
+        PetscCall(MatScale(sys->Jss, -s));
+        PetscCall(MatAssemblyBegin(sys->Jss, MAT_FINAL_ASSEMBLY));
+        PetscCall(MatAssemblyEnd(sys->Jss, MAT_FINAL_ASSEMBLY));
+      }
     }
   }
   PetscCall(PetscMalloc2(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd));
@@ -685,6 +737,7 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
   if (sys->Pvq) PetscCall(PetscObjectStateIncrease((PetscObject)sys->Pvq));
   if (sys->use_aij) {
     Mat Jaij;
+    PetscCall(PhlexSystemCompleteJacobian(sys));
     /* shells and virtual blocks: build the operator column by column (small test meshes) */
     PetscCall(MatComputeOperator(sys->J, MATAIJ, &Jaij));
     if (!sys->Jaij) sys->Jaij = Jaij;
