@@ -113,6 +113,45 @@ static inline void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup
   }
 }
 
+/* the flops of one cell's stress rate and of one cell's resultant (PetscLogFlops) */
+static inline PetscLogDouble RateFlops(PetscInt nv, PetscInt nn)
+{
+  return (2.0 * 9 * nv + 2.0 * 27 + 3 + 2.0 * 36 + 2.0 * 6 * nn) * nn;
+}
+static inline PetscLogDouble ResultantFlops(PetscInt nv, PetscInt nn)
+{
+  return (2.0 * 27 + 2.0 * 9 * nv) * nn;
+}
+
+/* a product's start: the body behind the shell, set up, the log event begun */
+static PetscErrorCode MapBegin(Mat A, PhlexFlexible *b)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatShellGetContext(A, b));
+  PetscCall(StressMapsSetUp(*b));
+  PetscCall(PetscLogEventBegin(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* the velocities of the rank's cells, ghosts included, into b->smap_vloc */
+static PetscErrorCode VelocitiesToLocal(PhlexFlexible b, Vec v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(DMGlobalToLocalBegin(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscCall(DMGlobalToLocalEnd(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscFunctionReturn(0);
+}
+
+/* f = the cells' sums in b->smap_floc, added on their owners (the constrained rows of the local vector are not in f) */
+static PetscErrorCode ResultantsToGlobal(PhlexFlexible b, Vec f)
+{
+  PetscFunctionBeginUser;
+  PetscCall(VecSet(f, 0.0));
+  PetscCall(DMLocalToGlobalBegin(b->dm, b->smap_floc, ADD_VALUES, f));
+  PetscCall(DMLocalToGlobalEnd(b->dm, b->smap_floc, ADD_VALUES, f));
+  PetscFunctionReturn(0);
+}
+
 /* MatMult of the shell B: y (stress field) = Ms^{-1} G v (v velocity field) */
 static PetscErrorCode MatMult_StressRate(Mat A, Vec v, Vec y)
 {
@@ -122,13 +161,10 @@ static PetscErrorCode MatMult_StressRate(Mat A, Vec v, Vec y)
   PetscScalar       *ya;
 
   PetscFunctionBeginUser;
-  PetscCall(MatShellGetContext(A, &b));
-  PetscCall(StressMapsSetUp(b));
-  PetscCall(PetscLogEventBegin(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscCall(MapBegin(A, &b));
   nv = b->ref.nv;
   nn = b->ref.ns;
-  PetscCall(DMGlobalToLocalBegin(b->dm, v, INSERT_VALUES, b->smap_vloc));
-  PetscCall(DMGlobalToLocalEnd(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscCall(VelocitiesToLocal(b, v));
   PetscCall(VecGetOwnershipRange(y, &rstart, NULL));
   PetscCall(VecGetArrayRead(b->smap_vloc, &va));
   PetscCall(VecGetArrayWrite(y, &ya));
@@ -140,7 +176,7 @@ static PetscErrorCode MatMult_StressRate(Mat A, Vec v, Vec y)
   }
   PetscCall(VecRestoreArrayWrite(y, &ya));
   PetscCall(VecRestoreArrayRead(b->smap_vloc, &va));
-  PetscCall(PetscLogFlops((2.0 * 9 * nv + 2.0 * 27 + 3 + 2.0 * 36 + 2.0 * 6 * nn) * nn * (b->cEnd - b->cStart)));
+  PetscCall(PetscLogFlops(RateFlops(nv, nn) * (b->cEnd - b->cStart)));
   PetscCall(PetscLogEventEnd(PHLEX_StressMaps, A, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -154,9 +190,7 @@ static PetscErrorCode MatMult_Resultant(Mat A, Vec sigma, Vec f)
   PetscScalar       *fa;
 
   PetscFunctionBeginUser;
-  PetscCall(MatShellGetContext(A, &b));
-  PetscCall(StressMapsSetUp(b));
-  PetscCall(PetscLogEventBegin(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscCall(MapBegin(A, &b));
   nv = b->ref.nv;
   nn = b->ref.ns;
   PetscCall(VecSet(b->smap_floc, 0.0));
@@ -172,11 +206,8 @@ static PetscErrorCode MatMult_Resultant(Mat A, Vec sigma, Vec f)
   }
   PetscCall(VecRestoreArray(b->smap_floc, &fa));
   PetscCall(VecRestoreArrayRead(sigma, &sa));
-  /* the cells' sums on the owners; the constrained rows of the local vector are not in f */
-  PetscCall(VecSet(f, 0.0));
-  PetscCall(DMLocalToGlobalBegin(b->dm, b->smap_floc, ADD_VALUES, f));
-  PetscCall(DMLocalToGlobalEnd(b->dm, b->smap_floc, ADD_VALUES, f));
-  PetscCall(PetscLogFlops((2.0 * 27 + 2.0 * 9 * nv) * nn * (b->cEnd - b->cStart)));
+  PetscCall(ResultantsToGlobal(b, f));
+  PetscCall(PetscLogFlops(ResultantFlops(nv, nn) * (b->cEnd - b->cStart)));
   PetscCall(PetscLogEventEnd(PHLEX_StressMaps, A, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -192,13 +223,10 @@ static PetscErrorCode MatMult_CondensedStiffness(Mat A, Vec v, Vec y)
   PetscScalar       *fa;
 
   PetscFunctionBeginUser;
-  PetscCall(MatShellGetContext(A, &b));
-  PetscCall(StressMapsSetUp(b));
-  PetscCall(PetscLogEventBegin(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscCall(MapBegin(A, &b));
   nv = b->ref.nv;
   nn = b->ref.ns;
-  PetscCall(DMGlobalToLocalBegin(b->dm, v, INSERT_VALUES, b->smap_vloc));
-  PetscCall(DMGlobalToLocalEnd(b->dm, v, INSERT_VALUES, b->smap_vloc));
+  PetscCall(VelocitiesToLocal(b, v));
   PetscCall(VecSet(b->smap_floc, 0.0));
   PetscCall(VecGetArrayRead(b->smap_vloc, &va));
   PetscCall(VecGetArray(b->smap_floc, &fa));
@@ -214,10 +242,8 @@ static PetscErrorCode MatMult_CondensedStiffness(Mat A, Vec v, Vec y)
   }
   PetscCall(VecRestoreArray(b->smap_floc, &fa));
   PetscCall(VecRestoreArrayRead(b->smap_vloc, &va));
-  PetscCall(VecSet(y, 0.0));
-  PetscCall(DMLocalToGlobalBegin(b->dm, b->smap_floc, ADD_VALUES, y));
-  PetscCall(DMLocalToGlobalEnd(b->dm, b->smap_floc, ADD_VALUES, y));
-  PetscCall(PetscLogFlops((2.0 * 9 * nv + 2.0 * 27 + 3 + 2.0 * 36 + 2.0 * 6 * nn + 2.0 * 27 + 2.0 * 9 * nv) * nn * (b->cEnd - b->cStart)));
+  PetscCall(ResultantsToGlobal(b, y));
+  PetscCall(PetscLogFlops((RateFlops(nv, nn) + ResultantFlops(nv, nn)) * (b->cEnd - b->cStart)));
   PetscCall(PetscLogEventEnd(PHLEX_StressMaps, A, 0, 0, 0));
   PetscFunctionReturn(0);
 }
