@@ -99,6 +99,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, 
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConvergedStage(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem);
+PETSC_INTERN PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, PetscInt, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);
 

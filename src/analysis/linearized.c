@@ -233,7 +233,6 @@ static PetscErrorCode RootValues(MPI_Comm comm, Vec x, PetscInt n, PetscReal *ou
 static PetscErrorCode EvaluateJacobian(Pencil *p, PetscReal s)
 {
   PetscFunctionBeginUser;
-  PetscCall(PhlexSystemCompleteJacobian(p->sys));
   PetscCall(PhlexSystemIJacobian(NULL, 0.0, p->X, p->Xdot, s / p->sys->units->time, p->sys->J, p->sys->J, p->sys));
   PetscFunctionReturn(0);
 }

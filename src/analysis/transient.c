@@ -791,6 +791,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
      continues a consistent state) */
   if (sys->njoints && !restarting) PetscCall(PhlexAssemblyClose(sys, 0.0, X, PETSC_TRUE, NULL));
   if (sys->nq && !restarting) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
+  /* the consistent start's Newton on the whole state needed the stress blocks; the reduced stage does not */
+  if (m.reduced || m.condensed) PetscCall(PhlexSystemReleaseJacobian(sys));
   checkpointing = (m.ck_interval > 0 || m.ck_wall > 0) ? PETSC_TRUE : PETSC_FALSE;
 
   /* monitor and outputs */

@@ -101,7 +101,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   /* the self-checks of the element structure (flexible_fe.c, flexible_stress_maps.c), read here so that -help lists them */
   PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
   PetscCall(PetscOptionsBool("-phlex_check_condensation", "Compare the element-wise stress elimination G^T Ms^-1 G with the stiffness, every cell", "PhlexFlexibleSetFromOptions", b->check_condensation, &b->check_condensation, NULL));
-  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G, G^T and G^T Ms^-1 G with the assembled G and Ms, for random fields", "PhlexFlexibleSetFromOptions", b->check_stress_maps, &b->check_stress_maps, NULL));
+  PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G, G^T and G^T Ms^-1 G with the assembled G and Ms, for random fields (transient and linearised analyses)", "PhlexFlexibleSetFromOptions", b->check_stress_maps, &b->check_stress_maps, NULL));
   PetscOptionsEnd();
   b->spinning = (PetscBool)(spin_given && (b->spin[0] != 0 || b->spin[1] != 0 || b->spin[2] != 0));
   if (b->spinning) {

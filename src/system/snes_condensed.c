@@ -230,7 +230,7 @@ static PetscErrorCode CheckFactorPackage(KSP ksp, Mat A)
   if (available) PetscFunctionReturn(0);
   PetscCall(MatGetType(A, &type));
   PetscCall(KSPGetOptionsPrefix(ksp, &prefix));
-  SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_USER_INPUT, "-%spc_factor_mat_solver_type %s: that package does not factor the condensed operator's matrix type %s%s", prefix ? prefix : "", package, type, strstr(type, "mpi") ? " (it runs on one process: options/solver/exact_serial.opts is for one process; use exact.opts with mpiexec)" : "");
+  SETERRQ(PetscObjectComm((PetscObject)ksp), PETSC_ERR_USER_INPUT, "-%spc_factor_mat_solver_type %s: the package has no %s factorization of the condensed operator's matrix type %s (-%spc_type %s)%s", prefix ? prefix : "", package, lu ? "LU" : "Cholesky", type, prefix ? prefix : "", lu ? "lu" : "cholesky", strstr(type, "mpi") ? "; on several processes use mumps (options/solver/exact.opts; exact_serial.opts is for one process)" : "");
 }
 
 static PetscErrorCode SNESSolve_Condensed(SNES snes)

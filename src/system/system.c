@@ -123,11 +123,45 @@ static PetscErrorCode MatMult_NotAssembled(Mat A, Vec x, Vec y)
   SETERRQ(PetscObjectComm((PetscObject)A), PETSC_ERR_PLIB, "internal: a product with the whole-state Jacobian's stress blocks, which PhlexSystemCompleteJacobian() has not built");
 }
 
+/* the placeholders of the stress block and the resultant block (velocity rows, stress columns) */
+static PetscErrorCode CreatePlaceholders(PhlexSystem sys, Mat *Jss, Mat *Jvs)
+{
+  PetscInt ns, nv;
+
+  PetscFunctionBeginUser;
+  PetscCall(ISGetLocalSize(sys->is[PHLEX_FIELD_STRESS], &ns));
+  PetscCall(ISGetLocalSize(sys->is[PHLEX_FIELD_VELOCITY], &nv));
+  PetscCall(PhlexMatCreateShell(sys->comm, ns, ns, PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, Jss));
+  PetscCall(PhlexMatCreateShell(sys->comm, nv, ns, PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, Jvs));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemReleaseJacobian - frees what PhlexSystemCompleteJacobian() built once the run no longer multiplies it
+  (the consistent start of a scene whose steps SNES phlexreduced solves), placeholders again in their place
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem sys)
+{
+  const PetscInt S = sys->field[PHLEX_FIELD_STRESS], V = sys->field[PHLEX_FIELD_VELOCITY];
+
+  PetscFunctionBeginUser;
+  if (!sys->Ms) PetscFunctionReturn(0);
+  PetscCall(MatDestroy(&sys->Ms));
+  PetscCall(MatDestroy(&sys->Jss));
+  PetscCall(MatDestroy(&sys->Jvs));
+  PetscCall(CreatePlaceholders(sys, &sys->Jss, &sys->Jvs));
+  PetscCall(MatNestSetSubMat(sys->J, S, S, sys->Jss));
+  PetscCall(MatNestSetSubMat(sys->J, V, S, sys->Jvs));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSystemCompleteJacobian - builds the whole-state Jacobian's blocks that only the generic path multiplies: the
   stress block -shift Ms (all bodies' compliance masses in one AIJ, the cells' blocks as variable block sizes) and the
   resultant block G^T (a body's own, state-dependent one with geometric stiffening, else the transpose of its G);
-  once, for Newton on the whole state, the consistent start of a scene with joints and the linearised analysis
+  once, for Newton on the whole state and the consistent start of a scene with discrete unknowns
 
   Collective
 @*/
@@ -296,11 +330,10 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], 1.0, &sys->Juu));
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], -1.0, &sys->Juv));
     /* the stress block -shift Ms and the resultant block G^T are multiplied by the generic path only (Newton on the
-       whole state, the consistent start, the linearised analysis): until PhlexSystemCompleteJacobian() builds them
+       whole state, the consistent start): until PhlexSystemCompleteJacobian() builds them
        they are placeholders that stop any product (the stages of SNES phlexcondensed and phlexreduced never need
        them: at 2.2e5 velocity DOFs they would hold 1.1 GB) */
-    PetscCall(PhlexMatCreateShell(sys->comm, nlocal[PHLEX_FIELD_STRESS], nlocal[PHLEX_FIELD_STRESS], PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, &sys->Jss));
-    PetscCall(PhlexMatCreateShell(sys->comm, nlocal[PHLEX_FIELD_VELOCITY], nlocal[PHLEX_FIELD_STRESS], PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, &sys->Jvs));
+    PetscCall(CreatePlaceholders(sys, &sys->Jss, &sys->Jvs));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvv;
