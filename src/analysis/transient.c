@@ -693,7 +693,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       }
     }
     /* Newton on the whole state multiplies the Jacobian's stress blocks (the stages of phlexcondensed and phlexreduced
-       do not; the consistent start of a scene with joints builds them itself) */
+       do not; the consistent start of a scene with discrete unknowns builds them for itself and frees them below) */
     if (!m.condensed && !m.reduced) PetscCall(PhlexSystemCompleteJacobian(sys));
     if ((m.condensed || m.reduced) && PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
       /* what the stage's own solve will read (it is made at the first step) */

@@ -330,9 +330,9 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], 1.0, &sys->Juu));
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], -1.0, &sys->Juv));
     /* the stress block -shift Ms and the resultant block G^T are multiplied by the generic path only (Newton on the
-       whole state, the consistent start): until PhlexSystemCompleteJacobian() builds them
-       they are placeholders that stop any product (the stages of SNES phlexcondensed and phlexreduced never need
-       them: at 2.2e5 velocity DOFs they would hold 1.1 GB) */
+       whole state, the consistent start): until PhlexSystemCompleteJacobian() builds them they are placeholders that
+       stop any product (the stages of SNES phlexcondensed and phlexreduced never need them: at 2.2e5 velocity DOFs
+       they would hold 1.1 GB) */
     PetscCall(CreatePlaceholders(sys, &sys->Jss, &sys->Jvs));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
