@@ -785,7 +785,19 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(VecSet(Xdot, 0.0));
     PetscCall(PhlexSystemIJacobian(ts, 0.0, X, Xdot, 1.0 / dt, sys->J, sys->J, sys));
     PetscCall(VecDestroy(&Xdot));
-    PetscCall(TSSetIJacobian(ts, sys->Jaij, sys->Jaij, PhlexSystemIJacobian, sys));
+    {
+      /* a field split (the presets' generic path) takes its blocks, and their point-block sizes, from the system's
+         nested operator; the assembled one is then the Krylov operator (and -snes_test_jacobian's) */
+      SNES      snes;
+      KSP       ksp;
+      PC        pc;
+      PetscBool split;
+      PetscCall(TSGetSNES(ts, &snes));
+      PetscCall(SNESGetKSP(snes, &ksp));
+      PetscCall(KSPGetPC(ksp, &pc));
+      PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCFIELDSPLIT, &split));
+      PetscCall(TSSetIJacobian(ts, sys->Jaij, split ? sys->J : sys->Jaij, PhlexSystemIJacobian, sys));
+    }
   }
   /* a mechanism starts consistent: loops closed, velocities on the constraints, multipliers solved (a restart
      continues a consistent state) */
