@@ -66,8 +66,14 @@ def stepping_time(log):
     return stage_time(log, st) - event_time(log, st, "PCSetUp") - event_time(log, st, "PhlexCondSetUp")
 
 
-def mpi(np_, cmd):
-    return (["mpiexec", "-n", str(np_)] if np_ > 1 else []) + cmd
+def mpi(np_, cmd, launcher="mpiexec"):
+    return ([launcher, "-n", str(np_)] if np_ > 1 else []) + cmd
+
+
+def peer_launcher(python):
+    """the peer's own MPI launcher: its wheels bring MPICH, which Open MPI's mpiexec cannot start"""
+    own = os.path.join(os.path.dirname(python), "mpiexec")
+    return own if os.path.exists(own) else "mpiexec"
 
 
 def phlex_transient(a, steps):
@@ -121,7 +127,7 @@ def main():
                 ph = (t2 - t1) / (a.long - a.short)
                 w.writerow([stamp, case, a.mesh, a.np, "phlex", r, dofs, "%.4f" % ph, "%.2f" % wall, "%.3f" % rss, load, a.extra])
                 cmd = mpi(a.np, [a.peer_python, os.path.join(peer, "transient_bar.py"), mesh, "--degree", "2",
-                                 "--solver", "mumps", "--steps", "20"])
+                                 "--solver", "mumps", "--steps", "20"], peer_launcher(a.peer_python))
                 log, wall, rss = timed(cmd, peer_env())
                 j = json.loads([l for l in log.splitlines() if l.startswith("{")][-1])
                 pe = j["per_step_ms"] / 1e3
@@ -139,7 +145,7 @@ def main():
                 w.writerow([stamp, case, a.mesh, a.np, "phlex", r, dofs, "", "%.2f" % wph, "%.3f" % rph, load,
                             (a.extra + " -modes_eps_tol " + a.phlex_tol).strip() if a.phlex_tol else a.extra])
                 cmd = mpi(a.np, [a.peer_python, os.path.join(peer, "modal_bar.py"), mesh, "--degree", "2", "--bc",
-                                 "free", "--nev", "26", "--tol", a.tol])
+                                 "free", "--nev", "26", "--tol", a.tol], peer_launcher(a.peer_python))
                 log, wpe, rpe = timed(cmd, peer_env())
                 j = json.loads([l for l in log.splitlines() if l.startswith("{")][-1])
                 ndofs = j.get("ndofs", 0)
