@@ -165,6 +165,9 @@ PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
 /* format.c: numbers echoed to the user at full precision */
 PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);
 
+/* memory.c: freed heap memory returned to the operating system */
+PETSC_INTERN PetscErrorCode PhlexReturnFreedMemory(void);
+
 /* progress.c: progress lines of long runs (and the interrupt check) */
 typedef struct {
   PetscLogDouble start, last; /* wall clock: start of the run, last line */

@@ -203,6 +203,7 @@ struct _p_PhlexFlexible {
   /* the stress maps B = Ms^{-1} G, G^T and G^T Ms^{-1} G cell by cell (flexible_stress_maps.c), set up at their first product */
   Mat       smap_B, smap_Res, smap_K;           /* the shells handed out as PhlexFieldOperators' B, Res and Kc */
   PetscBool smap_ready;
+  PetscBool smap_created;                       /* PhlexFlexibleCreateStressMaps was called (the shells, or none with stiffening) */
   PetscBool check_stress_maps, check_condensation; /* -phlex_check_stress_maps, -phlex_check_condensation */
   PetscReal stiffness[PHLEX_MAX_MATERIALS][36]; /* each material's A^{-1} */
   PetscReal smass_inv[16];                      /* the stress basis's reference mass, inverted */

@@ -61,6 +61,7 @@ struct _p_PhlexSystem {
   Mat       Juu, Juv, Ms, Jss, Jsv, Jvs, Jvv, Jvu, Jsu, Bvq, Cqu, Cqv, Dq;
   Mat       Jvc; /* Jvv + Jvu / shift (block diagonal over the bodies): the velocity block with the displacement eliminated */
   PetscBool state_dependent_fields, inexact_schur; /* a body with geometric stiffening: G(u) and its blocks change with the state */
+  PetscBool mixed_released; /* Jsv is a placeholder and the bodies' assembled G and Ms are freed (PhlexSystemReleaseJacobian) */
 
   Mat       Sv, Pvq, Ssv, Abd, Cpre;
   IS       *fis[3]; /* per field part: its block in the numbering of the displacement, stress, velocity fields */

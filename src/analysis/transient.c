@@ -805,6 +805,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   if (sys->nq && !restarting) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
   /* the consistent start's Newton on the whole state needed the stress blocks; the reduced stage does not */
   if (m.reduced || m.condensed) PetscCall(PhlexSystemReleaseJacobian(sys));
+  /* what the set-up freed (the initial condition's eigensolve, the operators released above) back to the system
+     before the first factorization: else the resident size keeps it, and the factor comes on top */
+  PetscCall(PhlexReturnFreedMemory());
   checkpointing = (m.ck_interval > 0 || m.ck_wall > 0) ? PETSC_TRUE : PETSC_FALSE;
 
   /* monitor and outputs */

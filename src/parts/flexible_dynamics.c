@@ -526,6 +526,15 @@ static PetscErrorCode MatMult_Avu(Mat A, Vec x, Vec y)
   PetscFunctionReturn(0);
 }
 
+/* the AIJ copies of Mv and K (from the SBAIJ ones), if absent */
+static PetscErrorCode AIJCopies(PhlexFlexible b)
+{
+  PetscFunctionBeginUser;
+  if (!b->Mvaij) PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+  if (!b->Kaij) PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
+  PetscFunctionReturn(0);
+}
+
 /* the matrices of the field blocks, built at the first request (a modal analysis never needs them) */
 static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *ops)
 {
@@ -536,10 +545,9 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
     MatNullSpace   nsp;
     const PetscInt n = b->nv_local, N = b->nv_global;
     PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
-    PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
-    PetscCall(MassProductSetUp(b));
     /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv */
-    PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
+    PetscCall(AIJCopies(b));
+    PetscCall(MassProductSetUp(b));
     PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
     PetscCall(MatAXPY(b->Sv, 1.0, b->Mvaij, DIFFERENT_NONZERO_PATTERN));
     PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_TRUE));
@@ -605,6 +613,33 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->M         = b->Mvaij;
   ops->K         = b->Kaij;
   ops->load      = b->floating ? NULL : b->load;
+  PetscFunctionReturn(0);
+}
+
+/* the assembled coupling G and compliance mass Ms multiply only the generic path (Newton on the whole state: its
+   residual and Jacobian) and the initial stress; the stages of SNES phlexcondensed and phlexreduced apply B, G^T and
+   K cell by cell. Freed once those stages solve the steps (at 2.2e5 velocity DOFs they hold 0.9 GB), assembled again
+   from the element structure if the generic path is asked for later. A body with geometric stiffening or a
+   prescribed spin keeps them (its G(u), and the generic path it always takes, build on G). */
+static PetscErrorCode FlexMixedOperators(PhlexPart part, PetscBool keep)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  if (b->stiffening || b->spinning) PetscFunctionReturn(0);
+  if (keep) {
+    PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
+    PetscCall(AIJCopies(b));
+  } else {
+    PetscCall(MatDestroy(&b->G));
+    PetscCall(MatDestroy(&b->Ms));
+    /* a fixed body's AIJ copies of Mv and K serve the rebuild of Sv and Jvv at a new step size only (FlexJacobian
+       converts them for that and frees them again); a floating body's also the preconditioner's rate terms */
+    if (!b->floating) {
+      PetscCall(MatDestroy(&b->Mvaij));
+      PetscCall(MatDestroy(&b->Kaij));
+    }
+  }
   PetscFunctionReturn(0);
 }
 
@@ -676,9 +711,14 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   const PetscInt n = b->nv_local, nq = part->nq;
   PetscReal      Arr[324];
 
-  PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift);
+  PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift), converted = PETSC_FALSE;
 
   PetscFunctionBeginUser;
+  if (new_shift && !b->Mvaij) {
+    /* released (FlexMixedOperators): converted for this rebuild only */
+    PetscCall(AIJCopies(b));
+    converted = PETSC_TRUE;
+  }
   if (new_shift) {
     b->shift = shift;
     if (!b->floating) {
@@ -703,6 +743,10 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
     PetscCall(MatScale(b->Sv, 1.0 / shift));
     PetscCall(MatAXPY(b->Sv, shift, b->Mvs ? b->Mvs : b->Mvaij, b->Mvs ? SAME_NONZERO_PATTERN : SUBSET_NONZERO_PATTERN));
     if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cor, SAME_NONZERO_PATTERN));
+  }
+  if (converted) {
+    PetscCall(MatDestroy(&b->Mvaij));
+    PetscCall(MatDestroy(&b->Kaij));
   }
   if (!b->floating) {
     /* the displacement columns K_sigma + Cen: K_sigma changes with the state, Cen with the spin rate (which resets
@@ -968,6 +1012,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->ops.jacobian            = FlexJacobian;
   part->ops.poststep            = FlexPostStep;
   part->ops.fieldoperators      = FlexFieldOperators;
+  part->ops.mixedoperators      = FlexMixedOperators;
   part->ops.bordermult          = FlexBorderMult;
   part->ops.bordermulttranspose = FlexBorderMultTranspose;
   part->ops.borderbasis         = FlexBorderBasis;

@@ -471,8 +471,10 @@ PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible b, const PhlexUnits *u)
   PetscCall(PetscObjectSetName((PetscObject)b->G, "coupling"));
   PetscCall(PetscObjectSetName((PetscObject)b->Ms, "compliance mass"));
   PetscCall(PetscLogEventEnd(PHLEX_BodyAssemble, 0, 0, 0, 0));
-  /* the step's maps between velocity and stress, cell by cell (shells: nothing is stored until their first product) */
-  PetscCall(PhlexFlexibleCreateStressMaps(b));
+  /* the step's maps between velocity and stress, cell by cell (shells: nothing is stored until their first product);
+     once: G and Ms may be assembled again after FlexMixedOperators freed them, the maps live on */
+  if (!b->smap_created) PetscCall(PhlexFlexibleCreateStressMaps(b));
+  b->smap_created = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
 

@@ -341,6 +341,7 @@ PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible b)
   PetscCall(MatDestroy(&b->smap_K));
   PetscCall(VecDestroy(&b->smap_vloc));
   PetscCall(VecDestroy(&b->smap_floc));
-  b->smap_ready = PETSC_FALSE;
+  b->smap_ready   = PETSC_FALSE;
+  b->smap_created = PETSC_FALSE;
   PetscFunctionReturn(0);
 }

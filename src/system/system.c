@@ -120,25 +120,27 @@ static PetscErrorCode AssembleStressBlock(PhlexSystem sys, PhlexFieldOperators *
 static PetscErrorCode MatMult_NotAssembled(Mat A, Vec x, Vec y)
 {
   PetscFunctionBeginUser;
-  SETERRQ(PetscObjectComm((PetscObject)A), PETSC_ERR_PLIB, "internal: a product with the whole-state Jacobian's stress blocks, which PhlexSystemCompleteJacobian() has not built");
+  SETERRQ(PetscObjectComm((PetscObject)A), PETSC_ERR_PLIB, "internal: a product with a block of the whole-state Jacobian (stress, resultant or coupling) that PhlexSystemCompleteJacobian() has not built");
 }
 
-/* the placeholders of the stress block and the resultant block (velocity rows, stress columns) */
-static PetscErrorCode CreatePlaceholders(PhlexSystem sys, Mat *Jss, Mat *Jvs)
+/* a placeholder of the stress block (Jss), the resultant block (velocity rows, stress columns: Jvs) or the coupling
+   block (stress rows, velocity columns: Jsv) */
+static PetscErrorCode CreatePlaceholder(PhlexSystem sys, PhlexField rows, PhlexField cols, Mat *A)
 {
-  PetscInt ns, nv;
+  PetscInt m, n;
 
   PetscFunctionBeginUser;
-  PetscCall(ISGetLocalSize(sys->is[PHLEX_FIELD_STRESS], &ns));
-  PetscCall(ISGetLocalSize(sys->is[PHLEX_FIELD_VELOCITY], &nv));
-  PetscCall(PhlexMatCreateShell(sys->comm, ns, ns, PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, Jss));
-  PetscCall(PhlexMatCreateShell(sys->comm, nv, ns, PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, Jvs));
+  PetscCall(ISGetLocalSize(sys->is[rows], &m));
+  PetscCall(ISGetLocalSize(sys->is[cols], &n));
+  PetscCall(PhlexMatCreateShell(sys->comm, m, n, PETSC_DETERMINE, PETSC_DETERMINE, NULL, MatMult_NotAssembled, A));
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexSystemReleaseJacobian - frees what PhlexSystemCompleteJacobian() built once the run no longer multiplies it
-  (the consistent start of a scene whose steps SNES phlexreduced solves), placeholders again in their place
+  PhlexSystemReleaseJacobian - frees what only Newton on the whole state multiplies once the stages of SNES
+  phlexcondensed or phlexreduced solve the steps (after the initial state and the consistent start): the blocks
+  PhlexSystemCompleteJacobian() built, and the coupling block G with the bodies' assembled G and Ms
+  (PhlexPartOps mixedoperators); placeholders in their place until PhlexSystemCompleteJacobian() builds them again
 
   Collective
 @*/
@@ -147,13 +149,47 @@ PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem sys)
   const PetscInt S = sys->field[PHLEX_FIELD_STRESS], V = sys->field[PHLEX_FIELD_VELOCITY];
 
   PetscFunctionBeginUser;
-  if (!sys->Ms) PetscFunctionReturn(0);
-  PetscCall(MatDestroy(&sys->Ms));
-  PetscCall(MatDestroy(&sys->Jss));
-  PetscCall(MatDestroy(&sys->Jvs));
-  PetscCall(CreatePlaceholders(sys, &sys->Jss, &sys->Jvs));
-  PetscCall(MatNestSetSubMat(sys->J, S, S, sys->Jss));
-  PetscCall(MatNestSetSubMat(sys->J, V, S, sys->Jvs));
+  if (!sys->nfparts) PetscFunctionReturn(0);
+  if (sys->Ms) {
+    PetscCall(MatDestroy(&sys->Ms));
+    PetscCall(MatDestroy(&sys->Jss));
+    PetscCall(MatDestroy(&sys->Jvs));
+    PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_STRESS, &sys->Jss));
+    PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, &sys->Jvs));
+    PetscCall(MatNestSetSubMat(sys->J, S, S, sys->Jss));
+    PetscCall(MatNestSetSubMat(sys->J, V, S, sys->Jvs));
+  }
+  if (!sys->mixed_released && !sys->state_dependent_fields) {
+    PetscCall(MatDestroy(&sys->Jsv));
+    PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+    PetscCall(MatNestSetSubMat(sys->J, S, V, sys->Jsv));
+    for (PetscInt i = 0; i < sys->nfparts; i++)
+      if (sys->fparts[i]->ops.mixedoperators) PetscCall((*sys->fparts[i]->ops.mixedoperators)(sys->fparts[i], PETSC_FALSE));
+    sys->mixed_released = PETSC_TRUE;
+  }
+  PetscFunctionReturn(0);
+}
+
+/* the coupling block G of the bodies (stress rows, velocity columns), assembled again after a release */
+static PetscErrorCode RestoreCoupling(PhlexSystem sys)
+{
+  const PetscInt S = sys->field[PHLEX_FIELD_STRESS], V = sys->field[PHLEX_FIELD_VELOCITY];
+  Mat           *m;
+
+  PetscFunctionBeginUser;
+  if (!sys->mixed_released) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc1(sys->nfparts, &m));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    if (sys->fparts[i]->ops.mixedoperators) PetscCall((*sys->fparts[i]->ops.mixedoperators)(sys->fparts[i], PETSC_TRUE));
+    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    m[i] = ops.G;
+  }
+  PetscCall(MatDestroy(&sys->Jsv));
+  PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+  PetscCall(MatNestSetSubMat(sys->J, S, V, sys->Jsv));
+  PetscCall(PetscFree(m));
+  sys->mixed_released = PETSC_FALSE;
   PetscFunctionReturn(0);
 }
 
@@ -172,7 +208,9 @@ PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem sys)
   const PetscInt       S = sys->field[PHLEX_FIELD_STRESS], V = sys->field[PHLEX_FIELD_VELOCITY];
 
   PetscFunctionBeginUser;
-  if (!sys->nfparts || sys->Ms) PetscFunctionReturn(0);
+  if (!sys->nfparts) PetscFunctionReturn(0);
+  PetscCall(RestoreCoupling(sys));
+  if (sys->Ms) PetscFunctionReturn(0);
   PetscCall(PetscMalloc2(sys->nfparts, &ops, sys->nfparts, &m));
   for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops[i]));
   PetscCall(AssembleStressBlock(sys, ops, &sys->Ms));
@@ -333,7 +371,8 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
        whole state, the consistent start): until PhlexSystemCompleteJacobian() builds them they are placeholders that
        stop any product (the stages of SNES phlexcondensed and phlexreduced never need them: at 2.2e5 velocity DOFs
        they would hold 1.1 GB) */
-    PetscCall(CreatePlaceholders(sys, &sys->Jss, &sys->Jvs));
+    PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_STRESS, &sys->Jss));
+    PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, &sys->Jvs));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvv;
