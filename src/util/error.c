@@ -97,6 +97,32 @@ static void NameMalformedOption(const char *mess, char *out, size_t len)
   if (names[0]) snprintf(out, len, "option %s: '%s' is %s", names, v, kind);
 }
 
+/* PETSc's "MatSolverType X does not support matrix type Y" (a factorization package that cannot factor the operator,
+   such as a one-process package on several processes, where PETSc's matrices are mpiaij or mpisbaij) names neither the
+   option that chose the package nor the way out: the options naming it are found in the database */
+static void NameFactorPackage(const char *mess, char *out, size_t len)
+{
+  char  package[64], type[64], *all = NULL, *tok, *next, names[512] = "";
+  int   count = 0;
+  const char *suffix = "pc_factor_mat_solver_type";
+
+  out[0] = 0;
+  if (!mess || sscanf(mess, "MatSolverType %63s does not support matrix type %63s", package, type) != 2) return;
+  if (PetscOptionsGetAll(NULL, &all)) return;
+  for (tok = strtok(all, " "); tok; tok = next) {
+    size_t nt = strlen(tok), ns = strlen(suffix);
+    next = strtok(NULL, " ");
+    if (tok[0] == '-' && nt > ns && !strcmp(tok + nt - ns, suffix) && next && !strcmp(next, package)) {
+      size_t n = strlen(names);
+      snprintf(names + n, sizeof(names) - n, "%s%s %s", n ? ", " : "", tok, next);
+      count++;
+    }
+  }
+  (void)PetscFree(all);
+  if (!names[0]) return;
+  snprintf(out, len, "option%s %s: the package has no factorization of matrix type %s%s", count > 1 ? "s" : "", names, type, strncmp(type, "mpi", 3) ? "" : " (it factors on one process only); on several processes use mumps (options/solver/exact.opts, bordered.opts; exact_serial.opts is for one process)");
+}
+
 static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
 {
   PetscBool ours = (file && !strncmp(file, "src/", 4)) ? PETSC_TRUE : PETSC_FALSE;
@@ -109,6 +135,20 @@ static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun
     /* PETSc's own option parsing (an unknown value of a list option, a malformed number) is input too */
     const PetscBool options = (file && (strstr(file, "sys/objects/options.c") || strstr(file, "sys/objects/aoptions.c"))) ? PETSC_TRUE : PETSC_FALSE;
     if (!phlex_exit) phlex_exit = ExitCodeOf(n, (ours || options) ? PETSC_TRUE : PETSC_FALSE);
+    if (n == PETSC_ERR_MISSING_FACTOR && !phlex_traceback) {
+      char named[1024];
+      NameFactorPackage(mess, named, sizeof(named));
+      if (named[0]) {
+        /* the options named are input; the first error fixes the exit code */
+        if (phlex_exit == PHLEX_EXIT_INTERNAL && ExitCodeOf(n, PETSC_FALSE) == PHLEX_EXIT_INTERNAL) phlex_exit = PHLEX_EXIT_INPUT;
+        phlex_short = PETSC_TRUE;
+        if (rank == 0) {
+          fprintf(stderr, "phlex: error: %s\n", named);
+          fflush(stderr);
+        }
+        return n;
+      }
+    }
     if ((ours || options) && IsOneLineError(n) && !phlex_traceback) {
       phlex_short = PETSC_TRUE;
       if (rank == 0) {
