@@ -156,6 +156,8 @@ struct _p_PhlexFlexible {
   PhlexProfile        body_force_profile;
   PetscBool           has_body_force;
   PhlexIC             ic_velocity, ic_displacement, ic_stress;
+  Vec                 ic_mode[2];          /* a mode IC's eigenvector (velocity, displacement), computed ahead (PhlexFlexiblePrepareInitialState) */
+  PetscReal           ic_mode_rigid[2][6]; /* and its rigid-motion row */
 
   /* floating frame */
   PetscBool           floating;         /* rigid motion of the frame is an unknown */
@@ -295,6 +297,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexPortDestroy(PhlexFlexPort *);
 
 /* flexible_ic.c */
 PETSC_INTERN PetscErrorCode PhlexFlexibleICSetFromOptions(PhlexFlexible, PhlexIC *, const char[], PetscInt);
+PETSC_INTERN PetscErrorCode PhlexFlexiblePrepareInitialState(PhlexPart);
 PETSC_INTERN PetscBool      PhlexFlexibleFrameVelocity(PhlexFlexible, PetscReal[3], PetscReal[3]);
 PETSC_INTERN PetscErrorCode PhlexFlexibleInitialState(PhlexPart, PhlexPartVec *);
 

@@ -94,6 +94,7 @@ typedef struct {
   PetscErrorCode (*view)(PhlexPart, PetscViewer);
   PetscErrorCode (*destroy)(PhlexPart);
   /* state */
+  PetscErrorCode (*prepareinitialstate)(PhlexPart); /* the heavy part of initialstate (an eigensolve), before the system's operators exist; NULL: none */
   PetscErrorCode (*initialstate)(PhlexPart, PhlexPartVec *);
   PetscErrorCode (*evaluate)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *); /* t, X, X' (or NULL: rest) */
   PetscErrorCode (*residual)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PhlexPartVec *);

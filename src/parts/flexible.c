@@ -393,6 +393,8 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(PhlexProfileDestroy(&b->body_force_profile));
   PetscCall(PhlexProfileDestroy(&b->frame_profile));
   PetscCall(PhlexFrameStateDestroy(&b->fs));
+  PetscCall(VecDestroy(&b->ic_mode[0]));
+  PetscCall(VecDestroy(&b->ic_mode[1]));
   PetscCall(MatDestroy(&b->Mvaij));
   PetscCall(MatDestroy(&b->Mvp));
   PetscCall(MatDestroy(&b->Kaij));
@@ -603,6 +605,7 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   part->ops.setup          = FlexSetUp;
   part->ops.view           = FlexView;
   part->ops.destroy        = FlexDestroy;
+  part->ops.prepareinitialstate = PhlexFlexiblePrepareInitialState;
   part->ops.initialstate   = PhlexFlexibleInitialState;
   part->ops.energy         = FlexEnergy;
   part->ops.inputpower     = FlexInputPower;

@@ -446,6 +446,9 @@ PetscErrorCode PhlexSystemCreateForScene(PhlexScene scene, PhlexSystem *sys, Vec
   PetscInt ndropped = 0;
 
   PetscFunctionBeginUser;
+  /* eigensolves of the initial state first: their factorizations are freed before the operators are built */
+  for (PetscInt i = 0; i < scene->nparts; i++)
+    if (scene->parts[i]->ops.prepareinitialstate) PetscCall((*scene->parts[i]->ops.prepareinitialstate)(scene->parts[i]));
   PetscCall(PhlexSystemCreate(scene, sys));
   PetscCall(DMCreateGlobalVector((*sys)->dm, X));
   PetscCall(PetscObjectSetName((PetscObject)*X, "state"));
