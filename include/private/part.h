@@ -102,9 +102,11 @@ typedef struct {
   PetscErrorCode (*poststep)(PhlexPart, PetscReal *, PetscReal *);         /* its discrete unknowns after a step; largest correction */
   /* Jacobian pieces of the field blocks and of the border between fields and discrete unknowns */
   PetscErrorCode (*fieldoperators)(PhlexPart, PhlexFieldOperators *);
-  PetscErrorCode (*mixedoperators)(PhlexPart, PetscBool); /* PETSC_FALSE: free the assembled G and Ms (fieldoperators
-                                                             then hands out NULL for them); PETSC_TRUE: assemble them
-                                                             again if freed. NULL: the part keeps what it has */
+  PetscErrorCode (*mixedoperators)(PhlexPart, PetscBool); /* PETSC_FALSE: free what only Newton on the whole state
+                                                             multiplies, the assembled G and Ms (and a fixed body's
+                                                             AIJ M and K): fieldoperators then hands out NULL for them;
+                                                             PETSC_TRUE: assemble them again if freed. NULL: the part
+                                                             keeps what it has */
   PetscErrorCode (*bordermult)(PhlexPart, const PetscReal *, Vec);               /* y_v += B x_q (its own columns) */
   PetscErrorCode (*bordermulttranspose)(PhlexPart, Vec, PetscReal, Vec, PetscReal *); /* y_q += a Cu^T x_u + Cv^T x_v (its own rows; NULL vectors are zero) */
   PetscErrorCode (*borderbasis)(PhlexPart, Mat *);                               /* W: state-independent span of its borders */

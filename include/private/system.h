@@ -101,6 +101,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemSNESConvergedStage(SNES, PetscInt, PetscR
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem);
+PETSC_INTERN PetscErrorCode PhlexSystemJacobianPmat(PhlexSystem, KSP, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, PetscInt, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);
 

@@ -786,17 +786,15 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PhlexSystemIJacobian(ts, 0.0, X, Xdot, 1.0 / dt, sys->J, sys->J, sys));
     PetscCall(VecDestroy(&Xdot));
     {
-      /* a field split (the presets' generic path) takes its blocks, and their point-block sizes, from the system's
-         nested operator; the assembled one is then the Krylov operator (and -snes_test_jacobian's) */
-      SNES      snes;
-      KSP       ksp;
-      PC        pc;
-      PetscBool split;
+      /* the assembled operator is the Krylov operator (and -snes_test_jacobian's); a field split takes its blocks
+         from the nested one */
+      SNES snes;
+      KSP  ksp;
+      Mat  P;
       PetscCall(TSGetSNES(ts, &snes));
       PetscCall(SNESGetKSP(snes, &ksp));
-      PetscCall(KSPGetPC(ksp, &pc));
-      PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCFIELDSPLIT, &split));
-      PetscCall(TSSetIJacobian(ts, sys->Jaij, split ? sys->J : sys->Jaij, PhlexSystemIJacobian, sys));
+      PetscCall(PhlexSystemJacobianPmat(sys, ksp, &P));
+      PetscCall(TSSetIJacobian(ts, sys->Jaij, P, PhlexSystemIJacobian, sys));
     }
   }
   /* a mechanism starts consistent: loops closed, velocities on the constraints, multipliers solved (a restart

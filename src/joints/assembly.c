@@ -442,6 +442,14 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
       PetscCall(SNESLineSearchSetFromOptions(ls));
     }
   }
+  {
+    /* with -phlex_jacobian_aij the assembled Jacobian, but a field split takes its blocks from the nested one */
+    KSP ksp;
+    Mat P;
+    PetscCall(SNESGetKSP(snes, &ksp));
+    PetscCall(PhlexSystemJacobianPmat(sys, ksp, &P));
+    PetscCall(SNESSetJacobian(snes, sys->use_aij ? sys->Jaij : sys->J, P, ShortStepJacobian, &c));
+  }
   PetscCall(SNESSetConvergenceTest(snes, PhlexSystemSNESConverged, sys, NULL));
 
   PetscCall(Energy(sys, t0, X, &H0, &K0));

@@ -78,7 +78,6 @@ static PetscErrorCode ICFunction(PetscInt dim, PetscReal t, const PetscReal x[],
   return 0;
 }
 
-/* An initial field of the velocity space (velocity or displacement), non-dimensional. */
 /* a mode initial condition's eigenvector (as the eigensolver gives it) and its rigid-motion row (floating body) */
 static PetscErrorCode ModeField(PhlexPart part, const PhlexIC *ic, const char field[], Vec *mode, PetscReal rigid[6])
 {
@@ -118,6 +117,7 @@ PetscErrorCode PhlexFlexiblePrepareInitialState(PhlexPart part)
   PetscFunctionReturn(0);
 }
 
+/* An initial field of the velocity space (velocity or displacement), non-dimensional. */
 static PetscErrorCode SetKinematicIC(PhlexPart part, const PhlexIC *ic, const char field[], PetscReal scale, Vec x, PetscReal rigid[6])
 {
   PhlexFlexible b = (PhlexFlexible)part->data;

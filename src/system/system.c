@@ -17,6 +17,7 @@
    the Q x Q block is dense (replicated array D, copied to rank 0's rows). */
 #include <phlex_impl.h>
 #include <petsc/private/petscimpl.h> /* PetscObjectStateIncrease: blocks changed in place */
+#include <petsc/private/matimpl.h>   /* the nested Jacobian's nonzero state follows the assembled one's pattern */
 
 const char *const PhlexFieldNames[] = {"displacement", "stress", "velocity", "discrete"};
 
@@ -435,6 +436,25 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
 }
 
 /*@C
+  PhlexSystemJacobianPmat - the preconditioning matrix of a Newton solve on the whole state: with -phlex_jacobian_aij
+  the assembled Jacobian, unless the preconditioner is a field split, which takes its blocks (and the stress rows'
+  cell block sizes that point-block Jacobi needs) from the nested one; else the nested one
+
+  Not collective
+@*/
+PetscErrorCode PhlexSystemJacobianPmat(PhlexSystem sys, KSP ksp, Mat *P)
+{
+  PC        pc;
+  PetscBool split;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCFIELDSPLIT, &split));
+  *P = (sys->use_aij && !split) ? sys->Jaij : sys->J;
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexSystemCreateForScene - the system of a scene, its initial state and the joints' geometry at the drawn
   configuration; redundant constraint components found (and dropped if asked: the layout changes, the initial state
   is carried over). Both the transient and the linearised analysis start here.
@@ -817,8 +837,15 @@ PetscErrorCode PhlexSystemIJacobian(TS ts, PetscReal t, Vec X, Vec Xdot, PetscRe
     PetscCall(MatComputeOperator(sys->J, MATAIJ, &Jaij));
     if (!sys->Jaij) sys->Jaij = Jaij;
     else {
+      PetscObjectState before, after;
+      PetscCall(MatGetNonzeroState(sys->Jaij, &before));
       PetscCall(MatCopy(Jaij, sys->Jaij, DIFFERENT_NONZERO_PATTERN));
       PetscCall(MatDestroy(&Jaij));
+      PetscCall(MatGetNonzeroState(sys->Jaij, &after));
+      /* the product's pattern holds the entries that are nonzero at this state: when it changed, a field split on
+         the nested operator (PhlexSystemJacobianPmat) must take the assembled operator's blocks anew, which it does
+         only for a new nonzero state of its preconditioning matrix */
+      if (after != before) sys->J->nonzerostate++;
     }
     if (A != sys->Jaij && A != sys->J) PetscCall(MatCopy(sys->Jaij, A, DIFFERENT_NONZERO_PATTERN));
   }

@@ -97,30 +97,47 @@ static void NameMalformedOption(const char *mess, char *out, size_t len)
   if (names[0]) snprintf(out, len, "option %s: '%s' is %s", names, v, kind);
 }
 
-/* PETSc's "MatSolverType X does not support matrix type Y" (a factorization package that cannot factor the operator,
-   such as a one-process package on several processes, where PETSc's matrices are mpiaij or mpisbaij) names neither the
-   option that chose the package nor the way out: the options naming it are found in the database */
+/* PETSc's "MatSolverType X does not support [factorization type F for] matrix type Y" (a package that cannot factor
+   the operator: a one-process package on several processes, where PETSc's matrices are mpiaij or mpisbaij, or an
+   LU-only package asked for Cholesky) names neither the option that chose the package nor the way out: the options
+   naming it are found in the database (phlex's per-body copies of a preset option among them) */
 static void NameFactorPackage(const char *mess, char *out, size_t len)
 {
-  char  package[64], type[64], *all = NULL, *tok, *next, names[512] = "";
-  int   count = 0;
+  char        package[64], type[64], kind[64], what[160], *all = NULL, *tok, *next, names[1024] = "", pctype[256] = "";
+  int         count = 0, cut = 0;
   const char *suffix = "pc_factor_mat_solver_type";
 
   out[0] = 0;
-  if (!mess || sscanf(mess, "MatSolverType %63s does not support matrix type %63s", package, type) != 2) return;
+  if (!mess) return;
+  if (sscanf(mess, "MatSolverType %63s does not support factorization type %63s for matrix type %63s", package, kind, type) == 3) snprintf(what, sizeof(what), "no %s factorization of matrix type %s", kind, type);
+  else if (sscanf(mess, "MatSolverType %63s does not support matrix type %63s", package, type) == 2) snprintf(what, sizeof(what), "no factorization of matrix type %s", type);
+  else return;
   if (PetscOptionsGetAll(NULL, &all)) return;
   for (tok = strtok(all, " "); tok; tok = next) {
     size_t nt = strlen(tok), ns = strlen(suffix);
     next = strtok(NULL, " ");
     if (tok[0] == '-' && nt > ns && !strcmp(tok + nt - ns, suffix) && next && !strcmp(next, package)) {
       size_t n = strlen(names);
+      if (n + nt + strlen(next) + 8 >= sizeof(names)) {
+        cut++;
+        continue;
+      }
       snprintf(names + n, sizeof(names) - n, "%s%s %s", n ? ", " : "", tok, next);
+      if (!count) snprintf(pctype, sizeof(pctype), "%.*spc_type", (int)(nt - ns), tok); /* the first one's factorization */
       count++;
     }
   }
   (void)PetscFree(all);
   if (!names[0]) return;
-  snprintf(out, len, "option%s %s: the package has no factorization of matrix type %s%s", count > 1 ? "s" : "", names, type, strncmp(type, "mpi", 3) ? "" : " (it factors on one process only); on several processes use mumps (options/solver/exact.opts, bordered.opts; exact_serial.opts is for one process)");
+  if (cut) {
+    size_t n = strlen(names);
+    snprintf(names + n, sizeof(names) - n, " and %d more", cut);
+  }
+  if (strncmp(type, "mpi", 3)) {
+    snprintf(out, len, "option%s %s: the package has %s; choose another package (mumps has LU and Cholesky) or factorization (%s)", count + cut > 1 ? "s" : "", names, what, pctype);
+    return;
+  }
+  snprintf(out, len, "option%s %s: the package has %s (it factors on one process only); on several processes use mumps (options/solver/exact.opts, bordered.opts; exact_serial.opts is for one process)", count + cut > 1 ? "s" : "", names, what);
 }
 
 static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
@@ -136,7 +153,7 @@ static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun
     const PetscBool options = (file && (strstr(file, "sys/objects/options.c") || strstr(file, "sys/objects/aoptions.c"))) ? PETSC_TRUE : PETSC_FALSE;
     if (!phlex_exit) phlex_exit = ExitCodeOf(n, (ours || options) ? PETSC_TRUE : PETSC_FALSE);
     if (n == PETSC_ERR_MISSING_FACTOR && !phlex_traceback) {
-      char named[1024];
+      char named[2048];
       NameFactorPackage(mess, named, sizeof(named));
       if (named[0]) {
         /* the options named are input; the first error fixes the exit code */
