@@ -417,7 +417,6 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
   PetscCall(SNESCreate(sys->comm, &snes));
   PetscCall(SNESSetDM(snes, sys->dm_aux));
   PetscCall(SNESSetFunction(snes, F, ShortStepFunction, &c));
-  PetscCall(SNESSetJacobian(snes, sys->use_aij ? sys->Jaij : sys->J, sys->use_aij ? sys->Jaij : sys->J, ShortStepJacobian, &c));
   PetscCall(SNESSetTolerances(snes, 1e-50, 1e-12, 0.0, 20, PETSC_DEFAULT));
   {
     SNESLineSearch ls;
