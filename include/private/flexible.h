@@ -69,7 +69,20 @@ typedef struct {
 PETSC_INTERN PetscErrorCode PhlexFrameEvaluate(PhlexFrame *, Vec, Vec, Vec, Vec, const PetscReal[18], const PetscReal[18], PhlexFrameState *);
 PETSC_INTERN PetscErrorCode PhlexFrameAddLoadArms(PhlexFrame *, Vec, PhlexFrameState *);
 PETSC_INTERN PetscErrorCode PhlexFrameResidual(PhlexFrame *, PhlexFrameState *, Vec, Vec, Vec, Vec, PetscReal[18]);
-PETSC_INTERN PetscErrorCode PhlexFrameJacobian(PhlexFrame *, PhlexFrameState *, PetscReal, Vec, Vec, PetscScalar *, PetscScalar *, PetscScalar *, PetscInt, PetscReal[9], PetscReal[9], PetscReal[324]);
+/* The node inputs of a frame's field borders (PhlexFrameJacobian): t(l), z(l) = w(l) + (Mv u)(l), (Mv u')(l), (Mv v)(l),
+   (Mv v')(l), the load arm b(l), w(l) = int rho x phi_l; the columns of the node-input matrix P, in this order */
+enum {
+  PHLEX_FRAME_IN_T   = 0,
+  PHLEX_FRAME_IN_Z   = 1,
+  PHLEX_FRAME_IN_ZD  = 4,
+  PHLEX_FRAME_IN_MV  = 7,
+  PHLEX_FRAME_IN_MVD = 10,
+  PHLEX_FRAME_IN_B   = 13,
+  PHLEX_FRAME_IN_W   = 16,
+  PHLEX_FRAME_NIN    = 19
+};
+PETSC_INTERN PetscErrorCode PhlexFrameJacobian(PhlexFrame *, PhlexFrameState *, PetscReal, PetscScalar *, PetscScalar *, PetscScalar *, PetscInt, PetscReal[9], PetscReal[9], PetscReal[324]);
+PETSC_INTERN PetscErrorCode PhlexFrameNodeInputs(PhlexFrame *, PhlexFrameState *, PetscScalar *, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexFrameEnergy(PhlexFrame *, PhlexFrameState *, Vec, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFrameMomenta(PhlexFrameState *, PetscReal[3], PetscReal[3]);
 PETSC_INTERN PetscErrorCode PhlexFrameStateDestroy(PhlexFrameState *);
@@ -216,7 +229,13 @@ struct _p_PhlexFlexible {
   PetscReal shift;          /* non-dimensional shift of the assembled blocks (0: none yet) */
   Mat       Mvaij, Kaij, Jvv, Jvu, Jvc, Sv;
   Mat       Mvp; /* the products with Mv: the scalar mass times I_3 (MAIJ), a ninth of Mv's entries */
-  PetscScalar *Bc, *Cu, *Cv, *Cpre; /* floating: dense borders of its own discrete unknowns (n_local x nq, column-major) */
+  /* floating: the borders of its own discrete unknowns, node-wise (PhlexFrameJacobian): border[(l, c), j] =
+     sum_i L[(3 j + c) nin + i] P[i nnode + l], for Lb (velocity rows), Lu, Lv (the discrete rows' displacement and
+     velocity columns) and Lpre = Lv + Lu / shift (the rows with the displacement eliminated) */
+  PetscInt   border_nin;      /* node inputs: the frame's PHLEX_FRAME_NIN, then 18 per port with inertial loads */
+  PetscScalar *border_P;      /* n_local/3 x border_nin, column-major: the node inputs at the Jacobian's state */
+  PetscScalar *border_Lb, *border_Lu, *border_Lv, *border_Lpre; /* 3 nq x border_nin each */
+  PetscInt  *port_inertial_in; /* first node input of each port's distributions (-1: no inertial load) */
   PetscReal Bvv[9], Bvu[9];   /* floating: node-wise blocks applied after Mv */
   Mat       W;                /* border basis: frame (12 columns) and the ports with joints (6 each) */
   PetscInt *port_basis_col;   /* first column of each port's distribution in W (-1: not in W) */

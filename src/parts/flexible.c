@@ -403,7 +403,8 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(MatDestroy(&b->Jvc));
   PetscCall(MatDestroy(&b->Sv));
   PetscCall(MatDestroy(&b->W));
-  PetscCall(PetscFree4(b->Bc, b->Cu, b->Cv, b->Cpre));
+  PetscCall(PetscFree5(b->border_P, b->border_Lb, b->border_Lu, b->border_Lv, b->border_Lpre));
+  PetscCall(PetscFree(b->port_inertial_in));
   PetscCall(PetscFree2(b->gram, b->gram_piv));
   PetscCall(VecDestroy(&b->load));
   PetscCall(VecDestroy(&b->work));

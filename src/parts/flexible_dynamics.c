@@ -536,6 +536,37 @@ static PetscErrorCode AIJCopies(PhlexFlexible b)
 }
 
 /* the matrices of the field blocks, built at the first request (a modal analysis never needs them) */
+/* the node-wise borders (PhlexFrameJacobian): the node inputs (a port's distributions with inertial loads copied once,
+   they do not change) and room for the coefficients */
+static PetscErrorCode BorderSetUp(PhlexPart part)
+{
+  PhlexFlexible  b = (PhlexFlexible)part->data;
+  const PetscInt nnode = b->nv_local / 3, nq = part->nq;
+  PetscInt       nin = PHLEX_FRAME_NIN;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(PetscMax(b->nports, 1), &b->port_inertial_in));
+  for (PetscInt q = 0; q < b->nports; q++) {
+    b->port_inertial_in[q] = -1;
+    if (!b->ports[q].load.loaded || b->ports[q].load.frame != PHLEX_DIRECTION_INERTIAL) continue;
+    b->port_inertial_in[q] = nin;
+    nin += 18;
+  }
+  b->border_nin = nin;
+  PetscCall(PetscCalloc5(PetscMax(nnode * nin, 1), &b->border_P, 3 * nq * nin, &b->border_Lb, 3 * nq * nin, &b->border_Lu, 3 * nq * nin, &b->border_Lv, 3 * nq * nin, &b->border_Lpre));
+  for (PetscInt q = 0; q < b->nports; q++) {
+    if (b->port_inertial_in[q] < 0) continue;
+    for (PetscInt c = 0; c < 6; c++) {
+      const PetscScalar *da;
+      PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da));
+      for (PetscInt l = 0; l < nnode; l++)
+        for (PetscInt e = 0; e < 3; e++) b->border_P[(b->port_inertial_in[q] + 3 * c + e) * nnode + l] = da[3 * l + e];
+      PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da));
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *ops)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
@@ -563,7 +594,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       PetscCall(PhlexMatCreateShell(b->comm, n, n, N, N, b, MatMult_Avc, &b->Jvc));
       PetscCall(VecDuplicate(b->load, &b->ud));
       PetscCall(VecDuplicate(b->load, &b->vd));
-      PetscCall(PetscCalloc4(PetscMax(n * part->nq, 1), &b->Bc, PetscMax(n * part->nq, 1), &b->Cu, PetscMax(n * part->nq, 1), &b->Cv, PetscMax(n * part->nq, 1), &b->Cpre));
+      PetscCall(BorderSetUp(part));
     }
     b->kpattern = SUBSET_NONZERO_PATTERN;
     if (b->spinning || b->stiffening) {
@@ -681,23 +712,19 @@ static PetscErrorCode RateOperator(PhlexFlexible b, PetscReal shift, const Petsc
 /* the derivatives of the inputs with directions fixed in the inertial frame with respect to R (own columns) */
 static PetscErrorCode InertialLoadsJacobian(PhlexPart part, PetscReal Arr[324])
 {
-  PhlexFlexible b = (PhlexFlexible)part->data;
-  const PetscInt n = b->nv_local;
+  PhlexFlexible  b   = (PhlexFlexible)part->data;
+  const PetscInt nin = b->border_nin;
 
   PetscFunctionBeginUser;
   for (PetscInt q = 0; q < b->nports; q++) {
-    if (!b->ports[q].load.loaded || b->ports[q].load.frame != PHLEX_DIRECTION_INERTIAL) continue;
+    if (b->port_inertial_in[q] < 0) continue;
     for (PetscInt k = 0; k < 9; k++) {
-      PetscReal          dw[6], fq[18] = {0};
-      const PetscScalar *da;
+      PetscReal dw[6], fq[18] = {0};
       PetscCall(PhlexPortLoadDerivativeR(&b->ports[q].load, b->t_eval, part->units, k, dw));
-      /* F_v = ... - B w, F_q = ... - (F, M): the derivative enters with a minus sign */
-      for (PetscInt c = 0; c < 6; c++) {
-        if (dw[c] == 0.0) continue;
-        PetscCall(VecGetArrayRead(b->ports[q].dist[c], &da));
-        for (PetscInt i = 0; i < n; i++) b->Bc[(3 + k) * n + i] -= dw[c] * PetscRealPart(da[i]);
-        PetscCall(VecRestoreArrayRead(b->ports[q].dist[c], &da));
-      }
+      /* F_v = ... - B w, F_q = ... - (F, M): the derivative enters with a minus sign; column 3 + k of the velocity
+         rows' border is - sum_c dw_c dist_c, node by node the identity on the distributions' node inputs */
+      for (PetscInt c = 0; c < 6; c++)
+        for (PetscInt e = 0; e < 3; e++) b->border_Lb[(3 * (3 + k) + e) * nin + b->port_inertial_in[q] + 3 * c + e] -= dw[c];
       PetscCall(FlexPortForce(part, q, dw, NULL, fq));
       for (PetscInt i = 12; i < 18; i++) Arr[18 * i + 3 + k] -= fq[i];
     }
@@ -708,7 +735,7 @@ static PetscErrorCode InertialLoadsJacobian(PhlexPart part, PetscReal Arr[324])
 static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexPartVec *X, PetscReal *D, PetscInt ldD)
 {
   PhlexFlexible  b = (PhlexFlexible)part->data;
-  const PetscInt n = b->nv_local, nq = part->nq;
+  const PetscInt n = b->nv_local, nq = part->nq, nin = b->border_nin;
   PetscReal      Arr[324];
 
   PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift), converted = PETSC_FALSE;
@@ -760,7 +787,11 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   }
   PetscCall(PetscLogEventBegin(PHLEX_FloatJacobian, 0, 0, 0, 0));
   PetscCall(AddJointLoads(part));
-  PetscCall(PhlexFrameJacobian(&b->frame, &b->fs, shift, X->u, X->v, b->Bc, b->Cu, b->Cv, n, b->Bvv, b->Bvu, Arr));
+  PetscCall(PetscArrayzero(b->border_Lb, 3 * nq * nin));
+  PetscCall(PetscArrayzero(b->border_Lu, 3 * nq * nin));
+  PetscCall(PetscArrayzero(b->border_Lv, 3 * nq * nin));
+  PetscCall(PhlexFrameJacobian(&b->frame, &b->fs, shift, b->border_Lb, b->border_Lu, b->border_Lv, nin, b->Bvv, b->Bvu, Arr));
+  PetscCall(PhlexFrameNodeInputs(&b->frame, &b->fs, b->border_P, n / 3));
   if (new_shift || b->stiffening)
     for (PetscInt k = 0; k < 9; k++) b->pc_rate_B[k] = 0.0; /* Sv was rebuilt above without the rate's terms */
   if (b->pc_rate_tol > 0 && !b->stiffening) {
@@ -782,33 +813,25 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   PetscCall(InertialLoadsJacobian(part, Arr));
   if (b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
     /* rows T^T v and the force -T mu': column c (translation) t(l) e_c, column a (rotation) e_a x w(l) */
-    const PetscScalar *ta, *wa;
-    PetscCall(VecGetArrayRead(b->tnode, &ta));
-    PetscCall(VecGetArrayRead(b->wnode, &wa));
-    for (PetscInt col = 18; col < 24; col++)
-      for (PetscInt i = 0; i < n; i++) b->Cu[col * n + i] = 0.0;
-    for (PetscInt l = 0; l < n / 3; l++) {
-      PetscReal wl[3];
-      for (PetscInt k = 0; k < 3; k++) wl[k] = PetscRealPart(wa[3 * l + k]);
-      for (PetscInt c = 0; c < 3; c++) {
-        PetscReal ec[3] = {0, 0, 0}, a[3];
-        ec[c] = 1.0;
-        for (PetscInt k = 0; k < 3; k++) b->Cv[(18 + c) * n + 3 * l + k] = k == c ? PetscRealPart(ta[3 * l]) : 0.0;
-        PhlexCross(ec, wl, a);
-        for (PetscInt k = 0; k < 3; k++) b->Cv[(21 + c) * n + 3 * l + k] = a[k];
+    for (PetscInt c = 0; c < 3; c++) {
+      PetscReal ec[3] = {0, 0, 0};
+      ec[c] = 1.0;
+      b->border_Lv[(3 * (18 + c) + c) * nin + PHLEX_FRAME_IN_T] = 1.0;
+      for (PetscInt m = 0; m < 3; m++) {
+        PetscReal em[3] = {0, 0, 0}, a[3];
+        em[m] = 1.0;
+        PhlexCross(ec, em, a);
+        for (PetscInt k = 0; k < 3; k++) b->border_Lv[(3 * (21 + c) + k) * nin + PHLEX_FRAME_IN_W + m] = a[k];
       }
     }
-    for (PetscInt col = 18; col < 24; col++)
-      for (PetscInt i = 0; i < n; i++) b->Bc[col * n + i] = -shift * b->Cv[col * n + i];
-    PetscCall(VecRestoreArrayRead(b->tnode, &ta));
-    PetscCall(VecRestoreArrayRead(b->wnode, &wa));
+    for (PetscInt i = 3 * 18 * nin; i < 3 * 24 * nin; i++) b->border_Lb[i] = -shift * b->border_Lv[i];
   }
   for (PetscInt i = 0; i < 18; i++)
     for (PetscInt j = 0; j < 18; j++) D[ldD * i + j] = Arr[18 * i + j];
   for (PetscInt i = 18; i < nq; i++)
     for (PetscInt j = 0; j < nq; j++) D[ldD * i + j] = D[ldD * j + i] = 0.0;
   /* the border of the preconditioner: rigid rows after eliminating u (u = v / shift) */
-  for (PetscInt i = 0; i < n * nq; i++) b->Cpre[i] = b->Cv[i] + b->Cu[i] / shift;
+  for (PetscInt i = 0; i < 3 * nq * nin; i++) b->border_Lpre[i] = b->border_Lv[i] + b->border_Lu[i] / shift;
   PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvv));
   PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvu));
   PetscCall(PetscObjectStateIncrease((PetscObject)b->Jvc));
@@ -822,41 +845,92 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
 static PetscErrorCode FlexBorderMult(PhlexPart part, const PetscReal *x, Vec y)
 {
   PhlexFlexible  b = (PhlexFlexible)part->data;
-  const PetscInt n = b->nv_local;
-  PetscScalar   *ya;
+  const PetscInt n = b->nv_local, nin = b->border_nin;
+  PetscScalar   *ya, *A;
+  PetscBLASInt   bnode, bnin, three = 3;
+  PetscScalar    one = 1.0;
 
   PetscFunctionBeginUser;
-  if (!part->nq) PetscFunctionReturn(0);
-  PetscCall(VecGetArray(y, &ya));
+  if (!part->nq || !n) PetscFunctionReturn(0);
+  /* y_(l,c) += sum_i A[c][i] P[l][i], A[c][i] = sum_j x_j Lb[(3 j + c) nin + i]: one product with the node inputs */
+  PetscCall(PetscCalloc1(3 * nin, &A));
   for (PetscInt j = 0; j < part->nq; j++) {
     if (x[j] == 0.0) continue;
-    for (PetscInt i = 0; i < n; i++) ya[i] += b->Bc[j * n + i] * x[j];
+    for (PetscInt c = 0; c < 3; c++)
+      for (PetscInt i = 0; i < nin; i++) A[c + 3 * i] += x[j] * b->border_Lb[(3 * j + c) * nin + i];
   }
+  PetscCall(PetscBLASIntCast(n / 3, &bnode));
+  PetscCall(PetscBLASIntCast(nin, &bnin));
+  PetscCall(VecGetArray(y, &ya));
+  PetscCallBLAS("BLASgemm", BLASgemm_("N", "T", &three, &bnode, &bnin, &one, A, &three, b->border_P, &bnode, &one, ya, &three));
   PetscCall(VecRestoreArray(y, &ya));
+  PetscCall(PetscFree(A));
   PetscFunctionReturn(0);
+}
+
+/* Mom (3 x nin, column-major) = sum_l x_l P_l^T: the moments of a velocity-space vector (3 values per node) with the
+   node inputs; x may be strided by column (ld) for the columns of a dense matrix */
+static PetscErrorCode BorderMoments(PhlexFlexible b, const PetscScalar *x, PetscScalar *Mom)
+{
+  const PetscInt nnode = b->nv_local / 3, nin = b->border_nin;
+  PetscBLASInt   bnode, bnin, three = 3;
+  PetscScalar    one = 1.0, zero = 0.0;
+
+  PetscFunctionBeginUser;
+  if (!nnode) {
+    PetscCall(PetscArrayzero(Mom, 3 * nin));
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscBLASIntCast(nnode, &bnode));
+  PetscCall(PetscBLASIntCast(nin, &bnin));
+  PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &three, &bnin, &bnode, &one, x, &three, b->border_P, &bnode, &zero, Mom, &three));
+  PetscFunctionReturn(0);
+}
+
+/* y_j += a sum_{c,i} L[(3 j + c) nin + i] Mom[c + 3 i], j < nq: the border rows applied to a vector, from its moments */
+static void BorderRowsOfMoments(PetscInt nq, PetscInt nin, const PetscScalar *L, const PetscScalar *Mom, PetscReal a, PetscReal *y)
+{
+  for (PetscInt j = 0; j < nq; j++) {
+    PetscScalar s = 0.0;
+    for (PetscInt c = 0; c < 3; c++)
+      for (PetscInt i = 0; i < nin; i++) s += L[(3 * j + c) * nin + i] * Mom[c + 3 * i];
+    y[j] += a * PetscRealPart(s);
+  }
 }
 
 static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *y)
 {
   PhlexFlexible      b = (PhlexFlexible)part->data;
-  const PetscInt     n = b->nv_local, nq = part->nq;
-  const PetscScalar *ua = NULL, *va = NULL;
-  PetscReal          loc[24], glob[24];
+  const PetscInt     nq = part->nq, nin = b->border_nin;
+  const PetscScalar *xa;
+  PetscScalar       *Mom;
+  PetscReal          loc[24] = {0}, glob[24];
 
   PetscFunctionBeginUser;
   if (!nq) PetscFunctionReturn(0);
-  if (xu) PetscCall(VecGetArrayRead(xu, &ua));
-  if (xv) PetscCall(VecGetArrayRead(xv, &va));
-  for (PetscInt j = 0; j < nq; j++) {
-    PetscReal s = 0;
-    if (ua)
-      for (PetscInt i = 0; i < n; i++) s += au * b->Cu[j * n + i] * PetscRealPart(ua[i]);
-    if (va)
-      for (PetscInt i = 0; i < n; i++) s += b->Cv[j * n + i] * PetscRealPart(va[i]);
-    loc[j] = s;
+  PetscCall(PetscMalloc1(3 * nin, &Mom));
+  if (xu && xu == xv && au != 0.0) {
+    /* the condensed rows Cv^T + au Cu^T from one pass over the vector */
+    PetscCall(VecGetArrayRead(xu, &xa));
+    PetscCall(BorderMoments(b, xa, Mom));
+    PetscCall(VecRestoreArrayRead(xu, &xa));
+    BorderRowsOfMoments(nq, nin, b->border_Lu, Mom, au, loc);
+    BorderRowsOfMoments(nq, nin, b->border_Lv, Mom, 1.0, loc);
+  } else {
+    if (xu && au != 0.0) {
+      PetscCall(VecGetArrayRead(xu, &xa));
+      PetscCall(BorderMoments(b, xa, Mom));
+      PetscCall(VecRestoreArrayRead(xu, &xa));
+      BorderRowsOfMoments(nq, nin, b->border_Lu, Mom, au, loc);
+    }
+    if (xv) {
+      PetscCall(VecGetArrayRead(xv, &xa));
+      PetscCall(BorderMoments(b, xa, Mom));
+      PetscCall(VecRestoreArrayRead(xv, &xa));
+      BorderRowsOfMoments(nq, nin, b->border_Lv, Mom, 1.0, loc);
+    }
   }
-  if (xu) PetscCall(VecRestoreArrayRead(xu, &ua));
-  if (xv) PetscCall(VecRestoreArrayRead(xv, &va));
+  PetscCall(PetscFree(Mom));
   PetscCall(MPIU_Allreduce(loc, glob, nq, MPIU_REAL, MPI_SUM, b->comm));
   for (PetscInt j = 0; j < nq; j++) y[j] += glob[j];
   PetscFunctionReturn(0);
@@ -938,9 +1012,10 @@ static PetscErrorCode FlexBorderBasis(PhlexPart part, Mat *W)
 static PetscErrorCode FlexBorderRows(PhlexPart part, Mat Y, PetscReal *out, PetscInt ld)
 {
   PhlexFlexible      b = (PhlexFlexible)part->data;
-  const PetscInt     n = b->nv_local, nq = part->nq;
+  const PetscInt     nq = part->nq, nin = b->border_nin;
   const PetscScalar *Ya;
   PetscInt           k, ldy;
+  PetscScalar       *Mom;
   PetscReal         *loc, *glob;
 
   PetscFunctionBeginUser;
@@ -948,18 +1023,14 @@ static PetscErrorCode FlexBorderRows(PhlexPart part, Mat Y, PetscReal *out, Pets
   PetscCall(MatGetSize(Y, NULL, &k));
   PetscCall(MatDenseGetLDA(Y, &ldy));
   PetscCall(PetscCalloc2(nq * k, &loc, nq * k, &glob));
+  PetscCall(PetscMalloc1(3 * nin, &Mom));
   PetscCall(MatDenseGetArrayRead(Y, &Ya));
-  if (n > 0) {
-    /* loc = Cpre^T Y (nq x k): one BLAS product */
-    PetscBLASInt bn, bnq, bk, bld;
-    PetscScalar  one = 1.0, zero = 0.0;
-    PetscCall(PetscBLASIntCast(n, &bn));
-    PetscCall(PetscBLASIntCast(nq, &bnq));
-    PetscCall(PetscBLASIntCast(k, &bk));
-    PetscCall(PetscBLASIntCast(ldy, &bld));
-    PetscCallBLAS("BLASgemm", BLASgemm_("T", "N", &bnq, &bk, &bn, &one, b->Cpre, &bn, Ya, &bld, &zero, loc, &bnq));
+  for (PetscInt j = 0; j < k; j++) {
+    PetscCall(BorderMoments(b, Ya + j * ldy, Mom));
+    BorderRowsOfMoments(nq, nin, b->border_Lpre, Mom, 1.0, loc + nq * j);
   }
   PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
+  PetscCall(PetscFree(Mom));
   PetscCall(MPIU_Allreduce(loc, glob, nq * k, MPIU_REAL, MPI_SUM, b->comm));
   for (PetscInt j = 0; j < k; j++)
     for (PetscInt i = 0; i < nq; i++) out[i + ld * j] = glob[i + nq * j];
@@ -972,26 +1043,24 @@ static PetscErrorCode FlexBorderRows(PhlexPart part, Mat Y, PetscReal *out, Pets
 static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, PetscInt ld)
 {
   PhlexFlexible      b = (PhlexFlexible)part->data;
-  const PetscInt     n = b->nv_local, nq = part->nq, k = b->kW;
+  const PetscInt     nq = part->nq, k = b->kW, nin = b->border_nin;
   const PetscScalar *Wa;
   PetscInt           ldw;
-  PetscScalar       *loc, *glob;
+  PetscScalar       *Mom, *loc, *glob;
+  PetscReal         *row;
   PetscBLASInt       kb, nrhs, info;
 
   PetscFunctionBeginUser;
   if (!nq || !k) PetscFunctionReturn(0);
   PetscCall(MatDenseGetLDA(b->W, &ldw));
-  PetscCall(PetscCalloc2(k * nq, &loc, k * nq, &glob));
+  PetscCall(PetscCalloc4(k * nq, &loc, k * nq, &glob, 3 * nin, &Mom, nq, &row));
   PetscCall(MatDenseGetArrayRead(b->W, &Wa));
-  if (n > 0) {
-    /* loc = W^T Bc (k x nq): one BLAS product */
-    PetscBLASInt bn, bk, bnq, bldw;
-    PetscScalar  one = 1.0, zero = 0.0;
-    PetscCall(PetscBLASIntCast(n, &bn));
-    PetscCall(PetscBLASIntCast(k, &bk));
-    PetscCall(PetscBLASIntCast(nq, &bnq));
-    PetscCall(PetscBLASIntCast(ldw, &bldw));
-    PetscCallBLAS("BLASgemm", BLASgemm_("T", "N", &bk, &bnq, &bn, &one, Wa, &bldw, b->Bc, &bn, &zero, loc, &bk));
+  /* loc = W^T Bc (k x nq): each column of W's moments with the node inputs */
+  for (PetscInt i = 0; i < k; i++) {
+    PetscCall(BorderMoments(b, Wa + i * ldw, Mom));
+    PetscCall(PetscArrayzero(row, nq));
+    BorderRowsOfMoments(nq, nin, b->border_Lb, Mom, 1.0, row);
+    for (PetscInt j = 0; j < nq; j++) loc[i + k * j] = row[j];
   }
   PetscCall(MatDenseRestoreArrayRead(b->W, &Wa));
   PetscCall(MPIU_Allreduce(loc, glob, k * nq, MPIU_SCALAR, MPIU_SUM, b->comm));
@@ -1000,7 +1069,7 @@ static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, Pe
   PetscCallBLAS("LAPACKgetrs", LAPACKgetrs_("N", &kb, &nrhs, b->gram, &kb, b->gram_piv, glob, &kb, &info));
   for (PetscInt j = 0; j < nq; j++)
     for (PetscInt i = 0; i < k; i++) beta[i + ld * j] = PetscRealPart(glob[i + k * j]);
-  PetscCall(PetscFree2(loc, glob));
+  PetscCall(PetscFree4(loc, glob, Mom, row));
   PetscFunctionReturn(0);
 }
 

@@ -378,28 +378,138 @@ static inline void InertiaDerivative(const PetscReal z[3], const PetscReal w[3],
     for (PetscInt e = 0; e < 3; e++) D[3 * a + e] = 2.0 * z[e] * w[a] - z[a] * w[e] - (a == e ? zw : 0.0);
 }
 
+/* the field borders at one node (inputs PHLEX_FRAME_IN_*, linear in them): bc[3 j + c] = d(elastic row c)/d(rigid
+   unknown j), cu[3 k + e], cv[3 k + e] = d(rigid row k)/d u_e, d v_e */
+static void NodeBorders(const PhlexFrame *fr, const PhlexFrameState *f, PetscReal shift, const PetscReal in[PHLEX_FRAME_NIN], PetscReal bc[54], PetscReal cu[54], PetscReal cv[54])
+{
+  const PetscBool  full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
+  const PetscReal *w = f->w, *wd = f->wd, *vP = f->vP, *g = fr->gravity;
+  const PetscReal  tl = in[PHLEX_FRAME_IN_T], *z = in + PHLEX_FRAME_IN_Z, *zd = in + PHLEX_FRAME_IN_ZD, *Mvl = in + PHLEX_FRAME_IN_MV, *Mvdl = in + PHLEX_FRAME_IN_MVD, *bl = in + PHLEX_FRAME_IN_B;
+
+  for (PetscInt i = 0; i < 54; i++) bc[i] = cu[i] = cv[i] = 0.0;
+  /* elastic rows x rigid columns */
+  for (PetscInt c = 0; c < 3; c++)
+    for (PetscInt i = 0; i < 3; i++) bc[3 * (3 + 3 * i + c) + c] = -tl * g[i]; /* R_ic: gravity -t g_i */
+  for (PetscInt j = 0; j < 3; j++) {
+    PetscReal ej[3] = {0, 0, 0}, col[3], a3[3];
+    ej[j] = 1.0;
+    /* vP_j: shift t e_j - t (e_j x w) */
+    PhlexCross(ej, w, a3);
+    for (PetscInt c = 0; c < 3; c++) bc[3 * (12 + j) + c] = shift * tl * ej[c] - (full || fr->gyroscopic ? tl * a3[c] : 0.0);
+    /* w_a (a = j): shift e_a x z + [e_a x Mud - t vP x e_a - dC/dw_a z - Mv v x e_a] */
+    PhlexCross(ej, z, col);
+    for (PetscInt c = 0; c < 3; c++) col[c] *= shift;
+    if (full) {
+      PetscReal t1[3], t2[3], t3[3];
+      PhlexCross(ej, zd, t1);
+      PhlexCross(vP, ej, t2);
+      PhlexCross(Mvl, ej, t3);
+      for (PetscInt c = 0; c < 3; c++) {
+        const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
+        col[c] += t1[c] - tl * t2[c] - dCz - t3[c];
+      }
+    } else if (fr->gyroscopic) {
+      /* constant model: - (t vP x e_a + dC/dw_a z + 2 Mv v x e_a) */
+      PetscReal t2[3], t3[3];
+      PhlexCross(vP, ej, t2);
+      PhlexCross(Mvl, ej, t3);
+      for (PetscInt c = 0; c < 3; c++) {
+        const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
+        col[c] += -tl * t2[c] - dCz - 2.0 * t3[c];
+      }
+    }
+    for (PetscInt c = 0; c < 3; c++) bc[3 * (15 + j) + c] = col[c];
+  }
+  /* rigid rows x elastic columns */
+  for (PetscInt e = 0; e < 3; e++) {
+    PetscReal ee[3] = {0, 0, 0}, a3[3], b3[3], c3[3];
+    ee[e] = 1.0;
+    /* v: p_t row: t (shift e_e + w x e_e) */
+    PhlexCross(w, ee, a3);
+    for (PetscInt k = 0; k < 3; k++) cv[3 * (12 + k) + e] = tl * (shift * ee[k] + a3[k]);
+    /* v: p_r row: shift (z x e_e) [+ Mud x e_e] + w x (z x e_e) + vP x (t e_e) */
+    {
+      PetscReal zxe[3], wz[3], r3[3];
+      PhlexCross(z, ee, zxe);
+      PhlexCross(w, zxe, wz);
+      PhlexCross(vP, ee, r3);
+      for (PetscInt k = 0; k < 3; k++) cv[3 * (15 + k) + e] = shift * zxe[k] + wz[k] + tl * r3[k];
+      if (full) {
+        PetscReal mdx[3];
+        PhlexCross(zd, ee, mdx);
+        for (PetscInt k = 0; k < 3; k++) cv[3 * (15 + k) + e] += mdx[k];
+      } else if (fr->gyroscopic) {
+        /* constant model: translation + t (w x e_e); rotation + w z_e - e_e (z . w) (z = w_l) */
+        const PetscReal zw = PhlexDot3(z, w);
+        for (PetscInt k = 0; k < 3; k++) {
+          cv[3 * (12 + k) + e] += tl * a3[k];
+          cv[3 * (15 + k) + e] += w[k] * z[e] - ee[k] * zw;
+        }
+      }
+    }
+    /* u: sgrav depends on u in both models: p_r row -t (e_e x R^T g) */
+    PhlexCross(ee, f->gbody, b3);
+    for (PetscInt k = 0; k < 3; k++) cu[3 * (15 + k) + e] = -tl * b3[k];
+    if (full) {
+      PetscReal D[9], Dd[9], Dwd[9], dpr[3], t1[3], t2[3], wsum[3];
+      /* p_t row: t [(w' + shift w) x e_e + w x (w x e_e)] */
+      for (PetscInt k = 0; k < 3; k++) wsum[k] = wd[k] + shift * w[k];
+      PhlexCross(wsum, ee, a3);
+      PhlexCross(w, ee, t1);
+      PhlexCross(w, t1, t2);
+      for (PetscInt k = 0; k < 3; k++) cu[3 * (12 + k) + e] = tl * (a3[k] + t2[k]);
+      /* p_r row */
+      InertiaDerivative(z, w, D);
+      InertiaDerivative(zd, w, Dd);
+      InertiaDerivative(z, wd, Dwd);
+      /* dp_r/du(l,e) = t (e_e x vP) + D e_e + e_e x Mv v */
+      PhlexCross(ee, vP, t1);
+      PhlexCross(ee, Mvl, t2);
+      for (PetscInt k = 0; k < 3; k++) dpr[k] = tl * t1[k] + D[3 * k + e] + t2[k];
+      PhlexCross(w, dpr, c3); /* w x dp_r/du */
+      {
+        PetscReal t3[3], t4[3], t5[3], t6[3];
+        PhlexCross(ee, vP, t3);     /* shift t (e_e x vP) from s' x vP */
+        PhlexCross(ee, f->vPd, t4); /* t (e_e x vP') from s x vP' */
+        PhlexCross(ee, Mvl, t5);    /* shift (e_e x Mv v) from L' */
+        PhlexCross(ee, Mvdl, t6);   /* e_e x Mv v' from L' */
+        PhlexCross(w, ee, t1);
+        PhlexCross(vP, t1, t2);     /* vP x (w x e_e) t from vP x p_t */
+        PhlexCross(ee, bl, b3);     /* - e_e x b_arm from -M */
+        for (PetscInt k = 0; k < 3; k++) cu[3 * (15 + k) + e] += shift * tl * t3[k] + tl * t4[k] + shift * D[3 * k + e] + Dd[3 * k + e] + Dwd[3 * k + e] + shift * t5[k] + t6[k] + c3[k] + tl * t2[k] - b3[k];
+      }
+    }
+  }
+}
+
 /*@C
   PhlexFrameJacobian - dF/dX + shift dF/dX' of the floating-frame terms (non-dimensional shift)
 
-  Collective
+  Not collective
+
+  Input Parameter:
+. nin - the node inputs of the caller's border representation (at least PHLEX_FRAME_NIN)
 
   Output Parameters:
-+ Bvv, Bvu - node-wise 3x3 matrices: the elastic-row blocks are shift Mv + Bvv Mv (velocity) and Bvu Mv
-             (displacement); they vanish in the frozen model
-. Bc       - n_local x 18 (column-major, leading dimension ld): d(elastic rows)/d(rigid unknowns)
-. Cu, Cv   - n_local x 18 (column-major, ld): d(rigid row k)/d u, d v, i.e. the transposes of the rigid rows
-- Arr      - 18 x 18 row-major rigid block (meaningful on every rank)
++ Bvv, Bvu   - node-wise 3x3 matrices: the elastic-row blocks are shift Mv + Bvv Mv (velocity) and Bvu Mv
+               (displacement); they vanish in the frozen model
+. Lb, Lu, Lv - the field borders' coefficients (NULL: not wanted), entries (3 j + c) nin + i for i < PHLEX_FRAME_NIN
+               and rigid unknowns j < 18: d(elastic row (l, c))/d(rigid unknown j) = sum_i Lb[(3 j + c) nin + i] P[l][i]
+               with P the node inputs (PhlexFrameNodeInputs); Lu, Lv likewise d(rigid row j)/d u, d v at (l, c)
+- Arr        - 18 x 18 row-major rigid block (meaningful on every rank)
 
   Notes:
   Rigid unknowns in the order r (0-2), R (3-11, row-wise), v_P (12-14), w (15-17).
+  The borders are node-wise: each column is, at every node, the same linear map of the node's inputs (t, its
+  position moment w(l) + (Mv u)(l), (Mv u')(l), (Mv v)(l), (Mv v')(l), the load arm). Stored as that map (its
+  coefficients are the borders at unit inputs), a product with a border reads 19 inputs per node, about 6 values per
+  field unknown, instead of 18 dense columns, and the Jacobian writes no field-sized arrays.
 @*/
-PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal shift, Vec u, Vec v, PetscScalar *Bc, PetscScalar *Cu, PetscScalar *Cv, PetscInt ld, PetscReal Bvv[9], PetscReal Bvu[9], PetscReal Arr[324])
+PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal shift, PetscScalar *Lb, PetscScalar *Lu, PetscScalar *Lv, PetscInt nin, PetscReal Bvv[9], PetscReal Bvu[9], PetscReal Arr[324])
 {
-  const PetscBool    full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
-  const PetscReal   *w = f->w, *wd = f->wd, *vP = f->vP, *g = fr->gravity;
-  const PetscScalar *ta, *wa, *Mua, *Mvva, *Muda, *Mvda, *ba;
-  PetscInt           n;
-  PetscReal          S[9], C[9], sx[9];
+  const PetscBool  full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
+  const PetscReal *w = f->w, *wd = f->wd, *vP = f->vP, *g = fr->gravity;
+  PetscReal        S[9], C[9], sx[9];
 
   PetscFunctionBeginUser;
   PhlexSkew(w, S);
@@ -498,9 +608,37 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
   }
 #undef A
 
-  /* field borders, node by node */
-  if (!fr->tnode) PetscFunctionReturn(0);
-  PetscCall(VecGetLocalSize(u, &n));
+  /* the field borders: every column is linear in the node inputs, with coefficients the same at every node; they are
+     the borders' values at unit inputs */
+  if (!fr->tnode || !Lb) PetscFunctionReturn(0);
+  for (PetscInt i = 0; i < PHLEX_FRAME_NIN; i++) {
+    PetscReal in[PHLEX_FRAME_NIN] = {0}, bc[54], cu[54], cv[54];
+    in[i] = 1.0;
+    NodeBorders(fr, f, shift, in, bc, cu, cv);
+    for (PetscInt jc = 0; jc < 54; jc++) {
+      Lb[jc * nin + i] = bc[jc];
+      Lu[jc * nin + i] = cu[jc];
+      Lv[jc * nin + i] = cv[jc];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFrameNodeInputs - the node inputs of the field borders at the evaluated state (PHLEX_FRAME_IN_*)
+
+  Not collective
+
+  Output Parameter:
+. P - n_local/3 x PHLEX_FRAME_NIN, column-major with leading dimension ld (its first PHLEX_FRAME_NIN columns)
+@*/
+PetscErrorCode PhlexFrameNodeInputs(PhlexFrame *fr, PhlexFrameState *f, PetscScalar *P, PetscInt ld)
+{
+  const PetscScalar *ta, *wa, *Mua, *Mvva, *Muda, *Mvda, *ba;
+  PetscInt           n;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(fr->tnode, &n));
   PetscCall(VecGetArrayRead(fr->tnode, &ta));
   PetscCall(VecGetArrayRead(fr->wnode, &wa));
   PetscCall(VecGetArrayRead(f->Mu, &Mua));
@@ -508,115 +646,15 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
   PetscCall(VecGetArrayRead(f->Mud, &Muda));
   PetscCall(VecGetArrayRead(f->Mvd, &Mvda));
   PetscCall(VecGetArrayRead(f->barm, &ba));
-  for (PetscInt col = 0; col < 18; col++)
-    for (PetscInt i = 0; i < n; i++) Bc[col * ld + i] = Cu[col * ld + i] = Cv[col * ld + i] = 0.0;
   for (PetscInt l = 0; l < n / 3; l++) {
-    const PetscReal tl = PetscRealPart(ta[3 * l]);
-    PetscReal       z[3], zd[3], Mvl[3], Mvdl[3], bl[3];
+    P[PHLEX_FRAME_IN_T * ld + l] = PetscRealPart(ta[3 * l]);
     for (PetscInt k = 0; k < 3; k++) {
-      z[k]    = PetscRealPart(wa[3 * l + k] + Mua[3 * l + k]);
-      zd[k]   = PetscRealPart(Muda[3 * l + k]);
-      Mvl[k]  = PetscRealPart(Mvva[3 * l + k]);
-      Mvdl[k] = PetscRealPart(Mvda[3 * l + k]);
-      bl[k]   = PetscRealPart(ba[3 * l + k]);
-    }
-    /* elastic rows x rigid columns: Bc[(l,c), col] */
-    for (PetscInt c = 0; c < 3; c++) {
-      const PetscInt row = 3 * l + c;
-      /* R_ij: gravity -t g_i delta_cj */
-      for (PetscInt i = 0; i < 3; i++) Bc[(3 + 3 * i + c) * ld + row] = -tl * g[i];
-    }
-    for (PetscInt j = 0; j < 3; j++) {
-      PetscReal ej[3] = {0, 0, 0}, col[3], a3[3];
-      ej[j] = 1.0;
-      /* vP_j: shift t e_j - t (e_j x w) */
-      PhlexCross(ej, w, a3);
-      for (PetscInt c = 0; c < 3; c++) col[c] = shift * tl * ej[c] - (full || fr->gyroscopic ? tl * a3[c] : 0.0);
-      for (PetscInt c = 0; c < 3; c++) Bc[(12 + j) * ld + 3 * l + c] = col[c];
-      /* w_a (a = j): shift e_a x z + [e_a x Mud - t vP x e_a - dC/dw_a z - Mv v x e_a] */
-      PhlexCross(ej, z, col);
-      for (PetscInt c = 0; c < 3; c++) col[c] *= shift;
-      if (full) {
-        PetscReal t1[3], t2[3], t3[3];
-        PhlexCross(ej, zd, t1);
-        PhlexCross(vP, ej, t2);
-        PhlexCross(Mvl, ej, t3);
-        for (PetscInt c = 0; c < 3; c++) {
-          const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
-          col[c] += t1[c] - tl * t2[c] - dCz - t3[c];
-        }
-      } else if (fr->gyroscopic) {
-        /* constant model: - (t vP x e_a + dC/dw_a z + 2 Mv v x e_a) */
-        PetscReal t2[3], t3[3];
-        PhlexCross(vP, ej, t2);
-        PhlexCross(Mvl, ej, t3);
-        for (PetscInt c = 0; c < 3; c++) {
-          const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
-          col[c] += -tl * t2[c] - dCz - 2.0 * t3[c];
-        }
-      }
-      for (PetscInt c = 0; c < 3; c++) Bc[(15 + j) * ld + 3 * l + c] = col[c];
-    }
-    /* rigid rows x elastic columns: Cu[(l,e), row], Cv[(l,e), row] */
-    for (PetscInt e = 0; e < 3; e++) {
-      const PetscInt colidx = 3 * l + e;
-      PetscReal      ee[3] = {0, 0, 0}, a3[3], b3[3], c3[3];
-      ee[e] = 1.0;
-      /* v: p_t row: t (shift e_e + w x e_e) */
-      PhlexCross(w, ee, a3);
-      for (PetscInt k = 0; k < 3; k++) Cv[(12 + k) * ld + colidx] = tl * (shift * ee[k] + a3[k]);
-      /* v: p_r row: shift (z x e_e) [+ Mud x e_e] + w x (z x e_e) + vP x (t e_e) */
-      {
-        PetscReal zxe[3], wz[3], r3[3];
-        PhlexCross(z, ee, zxe);
-        PhlexCross(w, zxe, wz);
-        PhlexCross(vP, ee, r3);
-        for (PetscInt k = 0; k < 3; k++) Cv[(15 + k) * ld + colidx] = shift * zxe[k] + wz[k] + tl * r3[k];
-        if (full) {
-          PetscReal mdx[3];
-          PhlexCross(zd, ee, mdx);
-          for (PetscInt k = 0; k < 3; k++) Cv[(15 + k) * ld + colidx] += mdx[k];
-        } else if (fr->gyroscopic) {
-          /* constant model: translation + t (w x e_e); rotation + w z_e - e_e (z . w) (z = w_l) */
-          const PetscReal zw = PhlexDot3(z, w);
-          for (PetscInt k = 0; k < 3; k++) {
-            Cv[(12 + k) * ld + colidx] += tl * a3[k];
-            Cv[(15 + k) * ld + colidx] += w[k] * z[e] - ee[k] * zw;
-          }
-        }
-      }
-      /* u: sgrav depends on u in both models: p_r row -t (e_e x R^T g) */
-      PhlexCross(ee, f->gbody, b3);
-      for (PetscInt k = 0; k < 3; k++) Cu[(15 + k) * ld + colidx] = -tl * b3[k];
-      if (full) {
-        PetscReal D[9], Dd[9], Dwd[9], dpr[3], t1[3], t2[3], wsum[3];
-        /* p_t row: t [(w' + shift w) x e_e + w x (w x e_e)] */
-        for (PetscInt k = 0; k < 3; k++) wsum[k] = wd[k] + shift * w[k];
-        PhlexCross(wsum, ee, a3);
-        PhlexCross(w, ee, t1);
-        PhlexCross(w, t1, t2);
-        for (PetscInt k = 0; k < 3; k++) Cu[(12 + k) * ld + colidx] = tl * (a3[k] + t2[k]);
-        /* p_r row */
-        InertiaDerivative(z, w, D);
-        InertiaDerivative(zd, w, Dd);
-        InertiaDerivative(z, wd, Dwd);
-        /* dp_r/du(l,e) = t (e_e x vP) + D e_e + e_e x Mv v */
-        PhlexCross(ee, vP, t1);
-        PhlexCross(ee, Mvl, t2);
-        for (PetscInt k = 0; k < 3; k++) dpr[k] = tl * t1[k] + D[3 * k + e] + t2[k];
-        PhlexCross(w, dpr, c3); /* w x dp_r/du */
-        {
-          PetscReal t3[3], t4[3], t5[3], t6[3];
-          PhlexCross(ee, vP, t3);     /* shift t (e_e x vP) from s' x vP */
-          PhlexCross(ee, f->vPd, t4); /* t (e_e x vP') from s x vP' */
-          PhlexCross(ee, Mvl, t5);    /* shift (e_e x Mv v) from L' */
-          PhlexCross(ee, Mvdl, t6);   /* e_e x Mv v' from L' */
-          PhlexCross(w, ee, t1);
-          PhlexCross(vP, t1, t2);     /* vP x (w x e_e) t from vP x p_t */
-          PhlexCross(ee, bl, b3);     /* - e_e x b_arm from -M */
-          for (PetscInt k = 0; k < 3; k++) Cu[(15 + k) * ld + colidx] += shift * tl * t3[k] + tl * t4[k] + shift * D[3 * k + e] + Dd[3 * k + e] + Dwd[3 * k + e] + shift * t5[k] + t6[k] + c3[k] + tl * t2[k] - b3[k];
-        }
-      }
+      P[(PHLEX_FRAME_IN_Z + k) * ld + l]   = PetscRealPart(wa[3 * l + k] + Mua[3 * l + k]);
+      P[(PHLEX_FRAME_IN_ZD + k) * ld + l]  = PetscRealPart(Muda[3 * l + k]);
+      P[(PHLEX_FRAME_IN_MV + k) * ld + l]  = PetscRealPart(Mvva[3 * l + k]);
+      P[(PHLEX_FRAME_IN_MVD + k) * ld + l] = PetscRealPart(Mvda[3 * l + k]);
+      P[(PHLEX_FRAME_IN_B + k) * ld + l]   = PetscRealPart(ba[3 * l + k]);
+      P[(PHLEX_FRAME_IN_W + k) * ld + l]   = PetscRealPart(wa[3 * l + k]);
     }
   }
   PetscCall(VecRestoreArrayRead(fr->tnode, &ta));

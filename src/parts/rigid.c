@@ -245,7 +245,7 @@ static PetscErrorCode RigidJacobian(PhlexPart part, PetscReal shift, const Phlex
   PetscReal Arr[324], Bvv[9], Bvu[9];
 
   PetscFunctionBeginUser;
-  PetscCall(PhlexFrameJacobian(&r->frame, &r->fs, shift, NULL, NULL, NULL, NULL, NULL, 0, Bvv, Bvu, Arr));
+  PetscCall(PhlexFrameJacobian(&r->frame, &r->fs, shift, NULL, NULL, NULL, 0, Bvv, Bvu, Arr));
   /* inputs with inertial directions: -d(F, M)/dR */
   for (PetscInt p = 0; p < r->nports; p++) {
     if (!r->load[p].loaded || r->load[p].frame != PHLEX_DIRECTION_INERTIAL) continue;

@@ -1,6 +1,6 @@
 /* The borders of the system's Jacobian between the field unknowns of the flexible bodies and the discrete unknowns
-   (rigid states, impulses): never one dense global block (DESIGN section 4), but per body its own dense border (its
-   frame) and the joints' port maps applied on the fly. Shells for the Jacobian, and the callbacks of PC
+   (rigid states, impulses): never one dense global block (DESIGN section 4), but per body its own border (its frame's,
+   node-wise: frame.c) and the joints' port maps applied on the fly. Shells for the Jacobian, and the callbacks of PC
    phlexbordered, which eliminates the fields body by body (one sparse solve each) and the discrete unknowns through
    a small dense Schur complement. Also the preconditioning matrices of the field splits. */
 #include <phlex_impl.h>
