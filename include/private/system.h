@@ -127,6 +127,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemResultantMult(PhlexSystem, PhlexStressMap
 PETSC_INTERN PetscErrorCode PhlexSNESReducedRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedApplicable(PhlexSystem, TS, PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedSetSystem(SNES, PhlexSystem, TS);
+PETSC_INTERN PetscErrorCode PhlexSNESReducedSetStage(SNES, PhlexSystem, Vec, PetscReal, PetscReal, PetscReal);
 
 /* assembly.c: consistent configuration and velocities, redundancy, drift */
 PETSC_INTERN PetscErrorCode PhlexAssemblyPlaceAttached(PhlexSystem, Vec);

@@ -370,7 +370,9 @@ static PetscErrorCode ShortStepJacobian(SNES snes, Vec Y, Mat A, Mat P, void *ct
   Collective
 
   Notes:
-  Both come from implicit Euler steps of length eps = 1e-6 dt with the system's own solver: from X0, M (z - z0) =
+  Both come from implicit Euler steps of length eps = 1e-6 dt with the system's own solver (SNES phlexreduced, the
+  steps as stages without a TS, when the preset names it and the scene admits it; else Newton on the whole state with
+  the preset's field split): from X0, M (z - z0) =
   eps f + G^T Lambda, G(q) z = g, so as eps -> 0 the step is the impulsive projection z - z0 = M^{-1} G^T Lambda,
   the smallest M-norm change that satisfies the constraints; the configuration and the stress are kept. A second
   step from the projected state gives lambda0 = Lambda(eps)/eps.
@@ -382,7 +384,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
   ShortStep         c;
   Vec               Y, F;
   PetscReal         cmax = 0, zmax = 0, H0, K0, H1, K1;
-  PetscBool         impulses = PETSC_FALSE;
+  PetscBool         impulses = PETSC_FALSE, reduced;
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < sys->nq; k++)
@@ -413,7 +415,6 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     zmax = PetscMax(zmax, vmax);
   }
 
-  PetscCall(PhlexSystemCompleteJacobian(sys));
   PetscCall(SNESCreate(sys->comm, &snes));
   PetscCall(SNESSetDM(snes, sys->dm_aux));
   PetscCall(SNESSetFunction(snes, F, ShortStepFunction, &c));
@@ -425,13 +426,21 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
   }
   PetscCall(SNESSetFromOptions(snes));
-  {
-    /* the presets' stage solvers (phlexcondensed, phlexreduced) solve theta-method stages of a TS: this short step
-       takes Newton with the preset's field split */
+  PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &reduced));
+  if (reduced) PetscCall(PhlexSNESReducedApplicable(sys, NULL, &reduced));
+  if (reduced) {
+    /* the preset's stage solver takes these steps as stages without a TS: Newton on the velocities and the discrete
+       unknowns (KSP reduced_), displacement and stress eliminated; the whole state's Jacobian is not needed */
+    PetscCall(PhlexSNESReducedSetStage(snes, sys, c.X0, t0, c.eps, 1.0));
+  } else {
+    KSP  ksp;
+    Mat  P;
     PetscBool stage;
+    /* Newton on the whole state with the preset's field split (SNES phlexcondensed solves theta-method stages of fixed
+       bodies only, phlexreduced those of scenes without state-dependent fields) */
+    PetscCall(PhlexSystemCompleteJacobian(sys));
     PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &stage, "phlexcondensed", "phlexreduced", ""));
     if (stage) {
-      KSP            ksp;
       SNESLineSearch ls;
       PetscCall(SNESSetType(snes, SNESNEWTONLS));
       PetscCall(SNESGetKSP(snes, &ksp));
@@ -440,11 +449,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
       PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
       PetscCall(SNESLineSearchSetFromOptions(ls));
     }
-  }
-  {
     /* with -phlex_jacobian_aij the assembled Jacobian, but a field split takes its blocks from the nested one */
-    KSP ksp;
-    Mat P;
     PetscCall(SNESGetKSP(snes, &ksp));
     PetscCall(PhlexSystemJacobianPmat(sys, ksp, &P));
     PetscCall(SNESSetJacobian(snes, sys->use_aij ? sys->Jaij : sys->J, P, ShortStepJacobian, &c));

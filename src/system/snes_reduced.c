@@ -28,7 +28,8 @@
    no prescribed spin) and the integrator is the theta method without endpoint (the default implicit midpoint,
    backward Euler). The preset bordered.opts asks for it (-snes_type phlexreduced); where it does not apply the
    transient analysis takes the preset's field split, unless -snes_type phlexreduced was typed on the command line
-   (then an error says why). The linear solve is KSP "reduced_" (the preset configures it). */
+   (then an error says why). The linear solve is KSP "reduced_" (the preset configures it). The consistent start of a
+   mechanism solves its vanishing implicit Euler steps with it too, as stages without a TS (PhlexSNESReducedSetStage). */
 #include <phlex_impl.h>
 #include <petsc/private/snesimpl.h>
 
@@ -45,19 +46,23 @@ typedef struct {
   Vec         Z, Dz;    /* {velocity, discrete}: residual, Newton correction */
   IS          isv, isq; /* the blocks of the {velocity, discrete} vectors */
   PetscReal   shift;    /* non-dimensional shift of the Jacobian (0: none yet) */
+  Vec         X0;       /* a stage without a TS (PhlexSNESReducedSetStage): its start, time, length and theta */
+  PetscReal   t0, dt, theta;
   PetscReal   vrtol;    /* the velocity rows' convergence, relative to their residual at the initial guess */
 } SNES_Reduced;
 
-/* why a scene or an integrator cannot use the reduced Newton (empty: it can) */
+/* why a scene or an integrator (NULL: a stage without a TS) cannot use the reduced Newton (empty: it can) */
 static PetscErrorCode Eligibility(PhlexSystem sys, TS ts, char why[], size_t len)
 {
-  PetscBool theta, beuler, endpoint = PETSC_FALSE;
+  PetscBool theta = PETSC_TRUE, beuler = PETSC_FALSE, endpoint = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   why[0] = 0;
-  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSTHETA, &theta));
-  PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSBEULER, &beuler));
-  if (theta) PetscCall(TSThetaGetEndpoint(ts, &endpoint));
+  if (ts) {
+    PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSTHETA, &theta));
+    PetscCall(PetscObjectTypeCompare((PetscObject)ts, TSBEULER, &beuler));
+    if (theta) PetscCall(TSThetaGetEndpoint(ts, &endpoint));
+  }
   if (!sys->nfparts) PetscCall(PetscSNPrintf(why, len, "the scene has no flexible body"));
   else if (!sys->nq) PetscCall(PetscSNPrintf(why, len, "the scene has no discrete unknowns (no frame, joint, rigid or lumped part: SNES phlexcondensed solves fixed bodies)"));
   else if (sys->state_dependent_fields || sys->inexact_schur) PetscCall(PetscSNPrintf(why, len, "a body's field operators change with the state (geometric stiffening, spin)"));
@@ -70,7 +75,8 @@ static PetscErrorCode Eligibility(PhlexSystem sys, TS ts, char why[], size_t len
 }
 
 /*@C
-  PhlexSNESReducedApplicable - whether the scene and the integrator admit SNES phlexreduced
+  PhlexSNESReducedApplicable - whether the scene and the integrator (NULL: a stage without a TS) admit SNES
+  phlexreduced
 
   Collective
 @*/
@@ -100,6 +106,32 @@ PetscErrorCode PhlexSNESReducedSetSystem(SNES snes, PhlexSystem sys, TS ts)
   PetscCheck(!why[0], sys->comm, PETSC_ERR_USER_INPUT, "-snes_type phlexreduced cannot solve this scene's steps: %s; use -snes_type newtonls", why);
   c->sys = sys;
   c->ts  = ts;
+  c->X0  = NULL;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESReducedSetStage - hands SNES phlexreduced a theta-method stage without a TS: X = X0 + theta dt X' at time
+  t0 + theta dt (the consistent start's vanishing implicit Euler steps); X0 is referenced, not copied, and is read at
+  every solve. An error names what the scene lacks.
+
+  Collective
+@*/
+PetscErrorCode PhlexSNESReducedSetStage(SNES snes, PhlexSystem sys, Vec X0, PetscReal t0, PetscReal dt, PetscReal theta)
+{
+  SNES_Reduced *c = (SNES_Reduced *)snes->data;
+  char          why[256];
+
+  PetscFunctionBeginUser;
+  PetscCall(Eligibility(sys, NULL, why, sizeof(why)));
+  PetscCheck(!why[0], sys->comm, PETSC_ERR_USER_INPUT, "-snes_type phlexreduced cannot solve this stage: %s; use -snes_type newtonls", why);
+  PetscCheck(dt > 0 && theta > 0 && theta <= 1, sys->comm, PETSC_ERR_ARG_OUTOFRANGE, "SNES phlexreduced: a stage needs dt > 0 and theta in (0, 1], got dt %g, theta %g", (double)dt, (double)theta);
+  c->sys   = sys;
+  c->ts    = NULL;
+  c->X0    = X0;
+  c->t0    = t0;
+  c->dt    = dt;
+  c->theta = theta;
   PetscFunctionReturn(0);
 }
 
@@ -141,7 +173,7 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
   PC            pc;
 
   PetscFunctionBeginUser;
-  PetscCheck(c->sys, PetscObjectComm((PetscObject)snes), PETSC_ERR_ORDER, "SNES phlexreduced: PhlexSNESReducedSetSystem() was not called");
+  PetscCheck(c->sys, PetscObjectComm((PetscObject)snes), PETSC_ERR_ORDER, "SNES phlexreduced: neither PhlexSNESReducedSetSystem() nor PhlexSNESReducedSetStage() was called");
   if (c->ksp) PetscFunctionReturn(0);
   sys = c->sys;
   PetscCheck(sys->Jvc, sys->comm, PETSC_ERR_PLIB, "SNES phlexreduced: a body has no velocity block with the displacement eliminated");
@@ -260,10 +292,17 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   snes->reason = SNES_CONVERGED_ITERATING;
   snes->iter   = 0;
   snes->norm   = 0.0;
-  PetscCall(TSGetSolution(c->ts, &X0));
-  PetscCall(TSGetTime(c->ts, &t));
-  PetscCall(TSGetTimeStep(c->ts, &dt));
-  PetscCall(TSThetaGetTheta(c->ts, &theta));
+  if (c->ts) {
+    PetscCall(TSGetSolution(c->ts, &X0));
+    PetscCall(TSGetTime(c->ts, &t));
+    PetscCall(TSGetTimeStep(c->ts, &dt));
+    PetscCall(TSThetaGetTheta(c->ts, &theta));
+  } else {
+    X0    = c->X0;
+    t     = c->t0;
+    dt    = c->dt;
+    theta = c->theta;
+  }
   a      = 1.0 / (theta * dt);
   s      = a * sys->units->time;
   tstage = t + theta * dt;
