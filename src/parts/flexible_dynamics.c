@@ -887,6 +887,26 @@ static PetscErrorCode BorderMoments(PhlexFlexible b, const PetscScalar *x, Petsc
   PetscFunctionReturn(0);
 }
 
+/* Mom_j (3 x nin, column-major, at Mom + 3 nin j) for the k columns Y_j of a dense matrix (leading dimension ldy), node
+   block by node block so that the block of node inputs stays in cache while every column takes its moments (one pass
+   over the inputs instead of one per column) */
+static PetscErrorCode BorderMomentsColumns(PhlexFlexible b, const PetscScalar *Y, PetscInt ldy, PetscInt k, PetscScalar *Mom)
+{
+  const PetscInt nnode = b->nv_local / 3, nin = b->border_nin, chunk = 2048;
+  PetscBLASInt   bnode, bnin, blen, three = 3;
+  PetscScalar    one = 1.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscArrayzero(Mom, 3 * nin * k));
+  PetscCall(PetscBLASIntCast(nnode, &bnode));
+  PetscCall(PetscBLASIntCast(nin, &bnin));
+  for (PetscInt l0 = 0; l0 < nnode; l0 += chunk) {
+    PetscCall(PetscBLASIntCast(PetscMin(chunk, nnode - l0), &blen));
+    for (PetscInt j = 0; j < k; j++) PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &three, &bnin, &blen, &one, Y + j * ldy + 3 * l0, &three, b->border_P + l0, &bnode, &one, Mom + 3 * nin * j, &three));
+  }
+  PetscFunctionReturn(0);
+}
+
 /* y_j += a sum_{c,i} L[(3 j + c) nin + i] Mom[c + 3 i], j < nq: the border rows applied to a vector, from its moments */
 static void BorderRowsOfMoments(PetscInt nq, PetscInt nin, const PetscScalar *L, const PetscScalar *Mom, PetscReal a, PetscReal *y)
 {
@@ -1023,13 +1043,11 @@ static PetscErrorCode FlexBorderRows(PhlexPart part, Mat Y, PetscReal *out, Pets
   PetscCall(MatGetSize(Y, NULL, &k));
   PetscCall(MatDenseGetLDA(Y, &ldy));
   PetscCall(PetscCalloc2(nq * k, &loc, nq * k, &glob));
-  PetscCall(PetscMalloc1(3 * nin, &Mom));
+  PetscCall(PetscMalloc1(3 * nin * PetscMax(k, 1), &Mom));
   PetscCall(MatDenseGetArrayRead(Y, &Ya));
-  for (PetscInt j = 0; j < k; j++) {
-    PetscCall(BorderMoments(b, Ya + j * ldy, Mom));
-    BorderRowsOfMoments(nq, nin, b->border_Lpre, Mom, 1.0, loc + nq * j);
-  }
+  PetscCall(BorderMomentsColumns(b, Ya, ldy, k, Mom));
   PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
+  for (PetscInt j = 0; j < k; j++) BorderRowsOfMoments(nq, nin, b->border_Lpre, Mom + 3 * nin * j, 1.0, loc + nq * j);
   PetscCall(PetscFree(Mom));
   PetscCall(MPIU_Allreduce(loc, glob, nq * k, MPIU_REAL, MPI_SUM, b->comm));
   for (PetscInt j = 0; j < k; j++)
@@ -1053,16 +1071,16 @@ static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, Pe
   PetscFunctionBeginUser;
   if (!nq || !k) PetscFunctionReturn(0);
   PetscCall(MatDenseGetLDA(b->W, &ldw));
-  PetscCall(PetscCalloc4(k * nq, &loc, k * nq, &glob, 3 * nin, &Mom, nq, &row));
+  PetscCall(PetscCalloc4(k * nq, &loc, k * nq, &glob, 3 * nin * k, &Mom, nq, &row));
+  /* loc = W^T Bc (k x nq): the moments of W's columns with the node inputs */
   PetscCall(MatDenseGetArrayRead(b->W, &Wa));
-  /* loc = W^T Bc (k x nq): each column of W's moments with the node inputs */
+  PetscCall(BorderMomentsColumns(b, Wa, ldw, k, Mom));
+  PetscCall(MatDenseRestoreArrayRead(b->W, &Wa));
   for (PetscInt i = 0; i < k; i++) {
-    PetscCall(BorderMoments(b, Wa + i * ldw, Mom));
     PetscCall(PetscArrayzero(row, nq));
-    BorderRowsOfMoments(nq, nin, b->border_Lb, Mom, 1.0, row);
+    BorderRowsOfMoments(nq, nin, b->border_Lb, Mom + 3 * nin * i, 1.0, row);
     for (PetscInt j = 0; j < nq; j++) loc[i + k * j] = row[j];
   }
-  PetscCall(MatDenseRestoreArrayRead(b->W, &Wa));
   PetscCall(MPIU_Allreduce(loc, glob, k * nq, MPIU_SCALAR, MPIU_SUM, b->comm));
   PetscCall(PetscBLASIntCast(k, &kb));
   PetscCall(PetscBLASIntCast(nq, &nrhs));
