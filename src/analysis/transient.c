@@ -481,7 +481,7 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
     if (m->condensed && typed)
       PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexcondensed (fixed linear bodies, theta method): its linear solve reads -condensed_ksp_* and -condensed_pc_*; -snes_type ksponly takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
     if (m->reduced && typed)
-      PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexreduced (Newton on the velocities and discrete unknowns, theta method): its linear solve reads -reduced_ksp_*, -reduced_pc_* and -reduced_bordered_*; -snes_type newtonls takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
+      PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexreduced (Newton on the velocities and discrete unknowns, theta method; a mechanism's consistent start too): its linear solve reads -reduced_ksp_*, -reduced_pc_* and -reduced_bordered_*; -snes_type newtonls takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
     PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
   }
   PetscCall(TSGetMaxTime(ts, &tmax));
@@ -693,8 +693,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       }
     }
     /* Newton on the whole state multiplies the Jacobian's stress blocks (the stages of phlexcondensed and phlexreduced
-       do not; the consistent start of a mechanism takes phlexreduced too where the scene admits it, and else builds
-       them for itself and frees them below) */
+       do not, nor does the consistent start of a mechanism, which takes the steps' solver) */
     if (!m.condensed && !m.reduced) PetscCall(PhlexSystemCompleteJacobian(sys));
     if ((m.condensed || m.reduced) && PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
       /* what the stage's own solve will read (it is made at the first step) */
@@ -796,7 +795,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
      continues a consistent state) */
   if (sys->njoints && !restarting) PetscCall(PhlexAssemblyClose(sys, 0.0, X, PETSC_TRUE, NULL));
   if (sys->nq && !restarting) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
-  /* a consistent start by Newton on the whole state needed the stress blocks; the stages do not */
+  /* the stages need neither the whole state's stress blocks nor the assembled G and Ms (the initial state did) */
   if (m.reduced || m.condensed) PetscCall(PhlexSystemReleaseJacobian(sys));
   /* what the set-up freed (the initial condition's eigensolve, the operators released above) back to the system
      before the first factorization: else the resident size keeps it, and the factor comes on top */

@@ -370,9 +370,9 @@ static PetscErrorCode ShortStepJacobian(SNES snes, Vec Y, Mat A, Mat P, void *ct
   Collective
 
   Notes:
-  Both come from implicit Euler steps of length eps = 1e-6 dt with the system's own solver (SNES phlexreduced, the
-  steps as stages without a TS, when the preset names it and the scene admits it; else Newton on the whole state with
-  the preset's field split): from X0, M (z - z0) =
+  Both come from implicit Euler steps of length eps = 1e-6 dt with the solver of the time steps (SNES phlexreduced,
+  these steps as stages without a TS, when it solves the time steps; else Newton on the whole state with the preset's
+  field split): from X0, M (z - z0) =
   eps f + G^T Lambda, G(q) z = g, so as eps -> 0 the step is the impulsive projection z - z0 = M^{-1} G^T Lambda,
   the smallest M-norm change that satisfies the constraints; the configuration and the stress are kept. A second
   step from the projected state gives lambda0 = Lambda(eps)/eps.
@@ -426,18 +426,23 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHBASIC));
   }
   PetscCall(SNESSetFromOptions(snes));
-  PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &reduced));
-  if (reduced) PetscCall(PhlexSNESReducedApplicable(sys, NULL, &reduced));
+  {
+    /* the solver of the steps solves the start: SNES phlexreduced takes these steps as stages without a TS */
+    SNES tsnes;
+    PetscCall(TSGetSNES(ts, &tsnes));
+    PetscCall(PetscObjectTypeCompare((PetscObject)tsnes, "phlexreduced", &reduced));
+    if (reduced) PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &reduced));
+  }
   if (reduced) {
-    /* the preset's stage solver takes these steps as stages without a TS: Newton on the velocities and the discrete
-       unknowns (KSP reduced_), displacement and stress eliminated; the whole state's Jacobian is not needed */
+    /* Newton on the velocities and the discrete unknowns (KSP reduced_, the steps' options), displacement and stress
+       eliminated; the whole state's Jacobian is not needed */
     PetscCall(PhlexSNESReducedSetStage(snes, sys, c.X0, t0, c.eps, 1.0));
   } else {
     KSP  ksp;
     Mat  P;
     PetscBool stage;
-    /* Newton on the whole state with the preset's field split (SNES phlexcondensed solves theta-method stages of fixed
-       bodies only, phlexreduced those of scenes without state-dependent fields) */
+    /* Newton on the whole state with the preset's field split, as the steps (SNES phlexcondensed solves theta-method
+       stages of fixed bodies only) */
     PetscCall(PhlexSystemCompleteJacobian(sys));
     PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &stage, "phlexcondensed", "phlexreduced", ""));
     if (stage) {

@@ -535,7 +535,6 @@ static PetscErrorCode AIJCopies(PhlexFlexible b)
   PetscFunctionReturn(0);
 }
 
-/* the matrices of the field blocks, built at the first request (a modal analysis never needs them) */
 /* the node-wise borders (PhlexFrameJacobian): the node inputs (a port's distributions with inertial loads copied once,
    they do not change) and room for the coefficients */
 static PetscErrorCode BorderSetUp(PhlexPart part)
@@ -567,6 +566,7 @@ static PetscErrorCode BorderSetUp(PhlexPart part)
   PetscFunctionReturn(0);
 }
 
+/* the matrices of the field blocks, built at the first request (a modal analysis never needs them) */
 static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *ops)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;

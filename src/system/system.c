@@ -198,7 +198,7 @@ static PetscErrorCode RestoreCoupling(PhlexSystem sys)
   PhlexSystemCompleteJacobian - builds the whole-state Jacobian's blocks that only the generic path multiplies: the
   stress block -shift Ms (all bodies' compliance masses in one AIJ, the cells' blocks as variable block sizes) and the
   resultant block G^T (a body's own, state-dependent one with geometric stiffening, else the transpose of its G);
-  once, for Newton on the whole state and the consistent start of a scene with discrete unknowns
+  once, for Newton on the whole state (the steps, and the consistent start of a mechanism whose steps it solves)
 
   Collective
 @*/
@@ -369,7 +369,7 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], 1.0, &sys->Juu));
     PetscCall(IdentityMatrix(sys->comm, nlocal[PHLEX_FIELD_DISPLACEMENT], -1.0, &sys->Juv));
     /* the stress block -shift Ms and the resultant block G^T are multiplied by the generic path only (Newton on the
-       whole state, the consistent start): until PhlexSystemCompleteJacobian() builds them they are placeholders that
+       whole state, in the steps and then also in the consistent start): until PhlexSystemCompleteJacobian() builds them they are placeholders that
        stop any product (the stages of SNES phlexcondensed and phlexreduced never need them: at 2.2e5 velocity DOFs
        they would hold 1.1 GB) */
     PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_STRESS, &sys->Jss));
