@@ -868,28 +868,10 @@ static PetscErrorCode FlexBorderMult(PhlexPart part, const PetscReal *x, Vec y)
   PetscFunctionReturn(0);
 }
 
-/* Mom (3 x nin, column-major) = sum_l x_l P_l^T: the moments of a velocity-space vector (3 values per node) with the
-   node inputs; x may be strided by column (ld) for the columns of a dense matrix */
-static PetscErrorCode BorderMoments(PhlexFlexible b, const PetscScalar *x, PetscScalar *Mom)
-{
-  const PetscInt nnode = b->nv_local / 3, nin = b->border_nin;
-  PetscBLASInt   bnode, bnin, three = 3;
-  PetscScalar    one = 1.0, zero = 0.0;
-
-  PetscFunctionBeginUser;
-  if (!nnode) {
-    PetscCall(PetscArrayzero(Mom, 3 * nin));
-    PetscFunctionReturn(0);
-  }
-  PetscCall(PetscBLASIntCast(nnode, &bnode));
-  PetscCall(PetscBLASIntCast(nin, &bnin));
-  PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &three, &bnin, &bnode, &one, x, &three, b->border_P, &bnode, &zero, Mom, &three));
-  PetscFunctionReturn(0);
-}
-
-/* Mom_j (3 x nin, column-major, at Mom + 3 nin j) for the k columns Y_j of a dense matrix (leading dimension ldy), node
-   block by node block so that the block of node inputs stays in cache while every column takes its moments (one pass
-   over the inputs instead of one per column) */
+/* Mom_j (3 x nin, column-major, at Mom + 3 nin j) = sum_l Y_j(l) P_l^T: the moments with the node inputs of the k
+   columns Y_j (3 values per node) of a dense matrix (leading dimension ldy; k = 1: a vector), node block by node block
+   so that the block of node inputs stays in cache while every column takes its moments (one pass over the inputs
+   instead of one per column) */
 static PetscErrorCode BorderMomentsColumns(PhlexFlexible b, const PetscScalar *Y, PetscInt ldy, PetscInt k, PetscScalar *Mom)
 {
   const PetscInt nnode = b->nv_local / 3, nin = b->border_nin, chunk = 2048;
@@ -932,20 +914,20 @@ static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal 
   if (xu && xu == xv && au != 0.0) {
     /* the condensed rows Cv^T + au Cu^T from one pass over the vector */
     PetscCall(VecGetArrayRead(xu, &xa));
-    PetscCall(BorderMoments(b, xa, Mom));
+    PetscCall(BorderMomentsColumns(b, xa, 0, 1, Mom));
     PetscCall(VecRestoreArrayRead(xu, &xa));
     BorderRowsOfMoments(nq, nin, b->border_Lu, Mom, au, loc);
     BorderRowsOfMoments(nq, nin, b->border_Lv, Mom, 1.0, loc);
   } else {
     if (xu && au != 0.0) {
       PetscCall(VecGetArrayRead(xu, &xa));
-      PetscCall(BorderMoments(b, xa, Mom));
+      PetscCall(BorderMomentsColumns(b, xa, 0, 1, Mom));
       PetscCall(VecRestoreArrayRead(xu, &xa));
       BorderRowsOfMoments(nq, nin, b->border_Lu, Mom, au, loc);
     }
     if (xv) {
       PetscCall(VecGetArrayRead(xv, &xa));
-      PetscCall(BorderMoments(b, xa, Mom));
+      PetscCall(BorderMomentsColumns(b, xa, 0, 1, Mom));
       PetscCall(VecRestoreArrayRead(xv, &xa));
       BorderRowsOfMoments(nq, nin, b->border_Lv, Mom, 1.0, loc);
     }
