@@ -75,6 +75,7 @@ PETSC_EXTERN PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm);
 PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedFromFile(const char[], const char *const[]);
 PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedOverridden(const char[]);
 PETSC_EXTERN PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PhlexOptionsSetPathRenames(const char *const[], const char *const[]);
 
 /* scene_file.c: the YAML syntax of the scene files, before PETSc reads them */
 PETSC_EXTERN int PhlexSceneFilesCheck(int, char **);

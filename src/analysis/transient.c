@@ -474,7 +474,10 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
     /* the preset's own options of the solver path not taken (a preset configures both) */
     const char *const generic[] = {"ksp_", "pc_", "fieldsplit_", NULL}, *const stage[] = {"condensed_", "reduced_", "snes_phlexreduced_", NULL};
     const char *const newton[]  = {"ksp_", "pc_", "fieldsplit_", "snes_linesearch_", NULL}; /* phlexreduced takes full steps */
-    PetscBool         typed;
+    /* a body's solver options on the path not taken, answered with their equivalents on the path taken */
+    static const char *const split_solve[] = {"fieldsplit_1_bordered_", "fieldsplit_velocity_", NULL};
+    static const char *const stage_solve[] = {"reduced_bordered_", "condensed_", NULL};
+    PetscBool                typed;
     PetscCall(PhlexOptionsSetUsedFromFile(m->preset, m->reduced ? newton : (m->condensed ? generic : stage)));
     PetscCall(PhlexOptionsSetUsedOverridden(m->preset));
     PetscCall(PhlexOptionsCommandLineHasPrefix(generic, &typed));
@@ -482,7 +485,10 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
       PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexcondensed (fixed linear bodies, theta method): its linear solve reads -condensed_ksp_* and -condensed_pc_*; -snes_type ksponly takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
     if (m->reduced && typed)
       PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexreduced (Newton on the velocities and discrete unknowns, theta method; a mechanism's consistent start too): its linear solve reads -reduced_ksp_*, -reduced_pc_* and -reduced_bordered_*; -snes_type newtonls takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
+    if (m->reduced || m->condensed) PetscCall(PhlexOptionsSetPathRenames(split_solve, stage_solve));
+    else PetscCall(PhlexOptionsSetPathRenames(stage_solve, split_solve));
     PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
+    PetscCall(PhlexOptionsSetPathRenames(NULL, NULL));
   }
   PetscCall(TSGetMaxTime(ts, &tmax));
   PetscCall(TSGetMaxSteps(ts, &smax));

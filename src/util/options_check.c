@@ -45,6 +45,26 @@ static PetscInt Distance(const char *a, const char *b)
   return row[nb];
 }
 
+/* the solver paths a run did not take, and the prefixes of their equivalents on the path it took (a NULL-terminated
+   pair of lists, PhlexOptionsSetPathRenames) */
+static const char *const *rename_from, *const *rename_to;
+
+/*@C
+  PhlexOptionsSetPathRenames - prefixes of solver options whose equivalents on the path the run takes have other
+  prefixes (-fieldsplit_1_bordered_* of the field split against -reduced_bordered_* of SNES phlexreduced): an unused
+  option with one is answered with its equivalent, when the run reads that. The lists are NULL-terminated and must
+  outlive the check (static arrays).
+
+  Not collective
+@*/
+PetscErrorCode PhlexOptionsSetPathRenames(const char *const from[], const char *const to[])
+{
+  PetscFunctionBeginUser;
+  rename_from = from;
+  rename_to   = to;
+  PetscFunctionReturn(0);
+}
+
 /* the valid name nearest to name (NULL when nothing is close: more than a third of the name differs) */
 static const char *Nearest(const char name[], PetscInt n, char *const valid[])
 {
@@ -137,10 +157,19 @@ PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm comm, PetscErrorCode (*reread)(v
     PetscCall(AddUsedNames(&nvalid, &valid));
   }
   for (PetscInt i = 0; i < n; i++) {
-    const char *near, *value = values[i] ? values[i] : "";
+    const char *near = NULL, *value = values[i] ? values[i] : "";
     PetscBool   given;
     if (ReadLate(names[i])) continue;
-    near = Nearest(names[i], nvalid, valid);
+    for (PetscInt k = 0; rename_from && rename_from[k] && !near; k++) {
+      /* the same option on the path the run takes, if it reads it */
+      const size_t nf = strlen(rename_from[k]);
+      char         equivalent[256];
+      if (strncasecmp(names[i], rename_from[k], nf)) continue;
+      PetscCall(PetscSNPrintf(equivalent, sizeof(equivalent), "%s%s", rename_to[k], names[i] + nf));
+      for (PetscInt v = 0; v < nvalid && !near; v++)
+        if (!strcasecmp(valid[v], equivalent)) near = valid[v];
+    }
+    if (!near) near = Nearest(names[i], nvalid, valid);
     PetscCall(OnCommandLine(names[i], &given));
     if (!given && !near) {
       char      option[256];
