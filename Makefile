@@ -42,6 +42,7 @@ build/%.o: src/%.c
 # the block kernels' loops vectorize only with GCC's dynamic cost model (-O2's leaves them scalar); no fused
 # multiply-add there (with -march flags that have it), so that their clones give the same bits
 build/util/mat_block_mult.o: VECFLAGS = -fvect-cost-model=dynamic -ffp-contract=off
+build/parts/flexible_stress_maps.o: VECFLAGS = -ffp-contract=off
 
 bin:
 	@mkdir -p $@
