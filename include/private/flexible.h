@@ -306,6 +306,8 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
 /* flexible_stress_maps.c: B = Ms^{-1} G and G^T cell by cell */
 PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexStressMapsPredict(Mat, Vec, Vec, PetscReal, Vec, Vec);
+PETSC_INTERN PetscErrorCode PhlexStressMapsCorrect(Mat, Vec, Vec, PetscReal, Vec);
 
 /* flexible_port.c */
 typedef PetscErrorCode (*PhlexSurfaceFunc)(void *, PetscInt, const PetscReal *, const PetscReal *, const PetscReal *, const PetscInt *, const PetscInt *, PetscInt);

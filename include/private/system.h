@@ -123,6 +123,8 @@ PETSC_INTERN PetscErrorCode PhlexSystemGetStressMaps(PhlexSystem, const char *, 
 PETSC_INTERN PetscErrorCode PhlexSystemStressMapsDestroy(PhlexSystem, PhlexStressMaps *);
 PETSC_INTERN PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem, PhlexStressMaps *, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemResultantMult(PhlexSystem, PhlexStressMaps *, Vec, Vec);
+PETSC_INTERN PetscErrorCode PhlexSystemStressPredict(PhlexSystem, PhlexStressMaps *, Vec, Vec, PetscReal, Vec, Vec);
+PETSC_INTERN PetscErrorCode PhlexSystemStressCorrect(PhlexSystem, PhlexStressMaps *, Vec, Vec, PetscReal, Vec);
 /* snes_reduced.c: SNES phlexreduced, Newton on the velocities and discrete unknowns of a theta-method stage */
 PETSC_INTERN PetscErrorCode PhlexSNESReducedRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedApplicable(PhlexSystem, TS, PetscBool *);

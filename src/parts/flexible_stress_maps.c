@@ -227,6 +227,54 @@ PHLEX_KERNEL_CLONES static void CondensedStiffnessCells(PhlexFlexible b, const P
   }
 }
 
+/* spa = s0a + a B v and fa (local velocity rows) += G^T spa over the rank's cells (the stress fields' first entry
+   rstart): the stage's predicted stress and its resultant in one pass. Each entry is s0 + a (B v) as VecWAXPY forms it,
+   and the resultant reads that entry: the bytes of the three passes B v, VecWAXPY, G^T */
+PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *s0a, PetscReal a, PetscScalar *spa, PetscScalar *fa)
+{
+  const PetscInt nv = b->ref.nv, nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+
+  for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
+    CellBatch cb;
+    PhlexLane ve[3 * PHLEX_MAX_NODES], y[24], sigma[24], fe[3 * PHLEX_MAX_NODES];
+    GatherBatch(b, c0, ncell, PETSC_TRUE, &cb);
+    GatherVelocities(b, &cb, va, ve);
+    CellStressRate(nv, nn, b->ref.coup, cb.invJ, cb.D, b->smass_inv, ve, y);
+    for (PetscInt l = 0; l < PHLEX_LANES; l++) {
+      const PetscScalar *sc = s0a + (b->cell_soff[cb.cell[l]] - rstart);
+      for (PetscInt k = 0; k < 6 * nn; k++) LANE(sigma[k], l) = PetscRealPart(sc[k]);
+    }
+    for (PetscInt k = 0; k < 6 * nn; k++) sigma[k] = sigma[k] + a * y[k];
+    for (PetscInt l = 0; l < cb.used; l++) {
+      PetscScalar *sc = spa + (b->cell_soff[cb.cell[l]] - rstart);
+      for (PetscInt k = 0; k < 6 * nn; k++) sc[k] = LANE(sigma[k], l);
+    }
+    CellResultant(nv, nn, b->ref.coup, cb.detJ, cb.invJ, sigma, fe);
+    ScatterResultants(b, &cb, fe, fa);
+  }
+}
+
+/* sa = spa + a B v over the rank's cells (the stress fields' first entry rstart), as VecWAXPY forms it from B v: the
+   bytes of the two passes */
+PHLEX_KERNEL_CLONES static void CorrectCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *spa, PetscReal a, PetscScalar *sa)
+{
+  const PetscInt nv = b->ref.nv, nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+
+  for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
+    CellBatch cb;
+    PhlexLane ve[3 * PHLEX_MAX_NODES], y[24];
+    GatherBatch(b, c0, ncell, PETSC_TRUE, &cb);
+    GatherVelocities(b, &cb, va, ve);
+    CellStressRate(nv, nn, b->ref.coup, cb.invJ, cb.D, b->smass_inv, ve, y);
+    for (PetscInt l = 0; l < cb.used; l++) {
+      const PetscInt     off = b->cell_soff[cb.cell[l]] - rstart;
+      const PetscScalar *sp  = spa + off;
+      PetscScalar       *sc  = sa + off;
+      for (PetscInt k = 0; k < 6 * nn; k++) sc[k] = sp[k] + a * LANE(y[k], l);
+    }
+  }
+}
+
 /* the flops of one cell's stress rate and of one cell's resultant (PetscLogFlops) */
 static inline PetscLogDouble RateFlops(PetscInt nv, PetscInt nn)
 {
@@ -339,6 +387,69 @@ static PetscErrorCode MatMult_CondensedStiffness(Mat A, Vec v, Vec y)
   PetscCall(ResultantsToGlobal(b, y));
   PetscCall(PetscLogFlops((RateFlops(nv, nn) + ResultantFlops(nv, nn)) * (b->cEnd - b->cStart)));
   PetscCall(PetscLogEventEnd(PHLEX_StressMaps, A, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexStressMapsPredict - with B a body's cell-by-cell stress rate map (PhlexFlexibleCreateStressMaps): the predicted
+  stress sp = s0 + a B v and its resultant r = G^T sp in one pass over the cells (the bytes of MatMult with B,
+  VecWAXPY and MatMult with the resultant map)
+
+  Collective
+@*/
+PetscErrorCode PhlexStressMapsPredict(Mat B, Vec v, Vec s0, PetscReal a, Vec sp, Vec r)
+{
+  PhlexFlexible      b;
+  PetscInt           rstart;
+  const PetscScalar *va, *s0a;
+  PetscScalar       *spa, *fa;
+
+  PetscFunctionBeginUser;
+  PetscCall(MapBegin(B, &b));
+  PetscCall(VelocitiesToLocal(b, v));
+  PetscCall(VecSet(b->smap_floc, 0.0));
+  PetscCall(VecGetOwnershipRange(sp, &rstart, NULL));
+  PetscCall(VecGetArrayRead(b->smap_vloc, &va));
+  PetscCall(VecGetArrayRead(s0, &s0a));
+  PetscCall(VecGetArrayWrite(sp, &spa));
+  PetscCall(VecGetArray(b->smap_floc, &fa));
+  PredictCells(b, rstart, va, s0a, a, spa, fa);
+  PetscCall(VecRestoreArray(b->smap_floc, &fa));
+  PetscCall(VecRestoreArrayWrite(sp, &spa));
+  PetscCall(VecRestoreArrayRead(s0, &s0a));
+  PetscCall(VecRestoreArrayRead(b->smap_vloc, &va));
+  PetscCall(ResultantsToGlobal(b, r));
+  PetscCall(PetscLogFlops((RateFlops(b->ref.nv, b->ref.ns) + 2.0 * 6 * b->ref.ns + ResultantFlops(b->ref.nv, b->ref.ns)) * (b->cEnd - b->cStart)));
+  PetscCall(PetscLogEventEnd(PHLEX_StressMaps, B, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexStressMapsCorrect - with B a body's cell-by-cell stress rate map: the stress s = sp + a B v in one pass over the
+  cells (the bytes of MatMult with B and VecWAXPY)
+
+  Collective
+@*/
+PetscErrorCode PhlexStressMapsCorrect(Mat B, Vec v, Vec sp, PetscReal a, Vec s)
+{
+  PhlexFlexible      b;
+  PetscInt           rstart;
+  const PetscScalar *va, *spa;
+  PetscScalar       *sa;
+
+  PetscFunctionBeginUser;
+  PetscCall(MapBegin(B, &b));
+  PetscCall(VelocitiesToLocal(b, v));
+  PetscCall(VecGetOwnershipRange(s, &rstart, NULL));
+  PetscCall(VecGetArrayRead(b->smap_vloc, &va));
+  PetscCall(VecGetArrayRead(sp, &spa));
+  PetscCall(VecGetArrayWrite(s, &sa));
+  CorrectCells(b, rstart, va, spa, a, sa);
+  PetscCall(VecRestoreArrayWrite(s, &sa));
+  PetscCall(VecRestoreArrayRead(sp, &spa));
+  PetscCall(VecRestoreArrayRead(b->smap_vloc, &va));
+  PetscCall(PetscLogFlops((RateFlops(b->ref.nv, b->ref.ns) + 2.0 * 6 * b->ref.ns) * (b->cEnd - b->cStart)));
+  PetscCall(PetscLogEventEnd(PHLEX_StressMaps, B, 0, 0, 0));
   PetscFunctionReturn(0);
 }
 

@@ -21,7 +21,10 @@
        product): the tip velocities moved by 1e-12 to 2e-11 of their scale.
    A step costs one solve, two products with B and one with G^T, against a residual (G, G^T, Ms, Mv) and a
    field-split Newton step (Ms^{-1} twice, G, G^T, copies of the five-times-larger stress field) on the generic path.
-   B and G^T are applied cell by cell from the element structure (flexible_stress_maps.c): nothing assembled.
+   B and G^T are applied cell by cell from the element structure (flexible_stress_maps.c): nothing assembled; and in
+   two passes over the cells (PhlexSystemStressPredict: Sigma_p with G^T Sigma_p, PhlexSystemStressCorrect: Sigma),
+   each stress entry formed as the separate products and VecWAXPY formed it (the same bytes, fewer passes over the
+   stress field).
 
    Used when every part is a fixed flexible body with constant operators (no frame, joint, spin or stiffening) and
    the integrator is the theta method without endpoint (the default implicit midpoint, backward Euler). The presets
@@ -37,7 +40,7 @@ typedef struct {
   KSP         ksp;   /* the condensed velocity operator s Mv + K / s (the bodies' Sv, block diagonal) */
   PhlexStressMaps maps; /* per body B = Ms^{-1} G and G^T, cell by cell (the parts' shells) */
   Vec         r;     /* the condensed right-hand side */
-  Vec         bv, sp; /* stress field: B v0, then B dv; Sigma_p */
+  Vec         sp;    /* stress field: Sigma_p */
   PetscReal   shift; /* non-dimensional shift of the operator last handed to the KSP (0: none) */
 } SNES_Condensed;
 
@@ -176,6 +179,52 @@ PetscErrorCode PhlexSystemResultantMult(PhlexSystem sys, PhlexStressMaps *maps, 
   PetscFunctionReturn(0);
 }
 
+/*@C
+  PhlexSystemStressPredict - over the bodies, the predicted stress sp = s0 + a B v and its resultant r = G^T sp
+  (v, r velocity field vectors; s0, sp stress field vectors), one pass over each body's cells
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemStressPredict(PhlexSystem sys, PhlexStressMaps *maps, Vec v, Vec s0, PetscReal a, Vec sp, Vec r)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    Vec vi, s0i, spi, ri;
+    PetscCall(VecGetSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+    PetscCall(VecGetSubVector(s0, sys->fis[PHLEX_FIELD_STRESS][i], &s0i));
+    PetscCall(VecGetSubVector(sp, sys->fis[PHLEX_FIELD_STRESS][i], &spi));
+    PetscCall(VecGetSubVector(r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
+    PetscCall(PhlexStressMapsPredict(maps->B[i], vi, s0i, a, spi, ri));
+    PetscCall(VecRestoreSubVector(r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
+    PetscCall(VecRestoreSubVector(sp, sys->fis[PHLEX_FIELD_STRESS][i], &spi));
+    PetscCall(VecRestoreSubVector(s0, sys->fis[PHLEX_FIELD_STRESS][i], &s0i));
+    PetscCall(VecRestoreSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemStressCorrect - over the bodies, the stress s = sp + a B v (v a velocity field vector, sp and s stress
+  field vectors), one pass over each body's cells
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemStressCorrect(PhlexSystem sys, PhlexStressMaps *maps, Vec v, Vec sp, PetscReal a, Vec s)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    Vec vi, spi, si;
+    PetscCall(VecGetSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+    PetscCall(VecGetSubVector(sp, sys->fis[PHLEX_FIELD_STRESS][i], &spi));
+    PetscCall(VecGetSubVector(s, sys->fis[PHLEX_FIELD_STRESS][i], &si));
+    PetscCall(PhlexStressMapsCorrect(maps->B[i], vi, spi, a, si));
+    PetscCall(VecRestoreSubVector(s, sys->fis[PHLEX_FIELD_STRESS][i], &si));
+    PetscCall(VecRestoreSubVector(sp, sys->fis[PHLEX_FIELD_STRESS][i], &spi));
+    PetscCall(VecRestoreSubVector(v, sys->fis[PHLEX_FIELD_VELOCITY][i], &vi));
+  }
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode SNESSetUp_Condensed(SNES snes)
 {
   SNES_Condensed *c = (SNES_Condensed *)snes->data;
@@ -204,7 +253,6 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
   /* the three products of a step, cell by cell from the element structure: nothing assembled */
   PetscCall(PhlexSystemGetStressMaps(sys, "phlexcondensed", &c->maps));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
-  PetscCall(VecDuplicate(c->sp, &c->bv));
   PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -268,18 +316,14 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_DISPLACEMENT], &u0));
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
-  /* Sigma_p = Sigma0 + B v0 / s; per body r = b - G^T Sigma_p */
-  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, v0, c->bv));
-  PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
+  /* Sigma_p = Sigma0 + B v0 / s and G^T Sigma_p in one pass; per body r = b - G^T Sigma_p */
+  PetscCall(PhlexSystemStressPredict(sys, &c->maps, v0, s0, 1.0 / s, c->sp, c->r));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
-    Vec                 ri, si;
+    Vec                 ri;
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
     PetscCall(VecGetSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
-    PetscCall(VecGetSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
-    PetscCall(MatMult(c->maps.Res[i], si, ri));
     PetscCall(VecAYPX(ri, -1.0, ops.load));
-    PetscCall(VecRestoreSubVector(c->sp, sys->fis[PHLEX_FIELD_STRESS][i], &si));
     PetscCall(VecRestoreSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
   }
   /* dv: the condensed solve, straight into the stage's velocity block; v = v0 + dv */
@@ -289,9 +333,8 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
   PetscCall(KSPGetConvergedReason(c->ksp, &kreason));
   snes->linear_its += its;
   /* Sigma = Sigma_p + B dv / s (not Sigma0 + B v / s: the momentum rows saw G^T Sigma_p); v = v0 + dv; u = u0 + v / s */
-  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, xv, c->bv));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
-  PetscCall(VecWAXPY(xs, 1.0 / s, c->bv, c->sp));
+  PetscCall(PhlexSystemStressCorrect(sys, &c->maps, xv, c->sp, 1.0 / s, xs));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(VecAXPY(xv, 1.0, v0));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_DISPLACEMENT], &xu));
@@ -317,7 +360,6 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   if (c->sys) PetscCall(PhlexSystemStressMapsDestroy(c->sys, &c->maps));
   PetscCall(VecDestroy(&c->r));
   PetscCall(VecDestroy(&c->sp));
-  PetscCall(VecDestroy(&c->bv));
   c->shift = 0.0;
   PetscFunctionReturn(0);
 }

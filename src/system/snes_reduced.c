@@ -19,8 +19,9 @@
    step (pcbordered.c).
 
    A Newton iteration costs one residual (products with Mv and K: velocity sized, no pass over the stress field) and
-   a few Krylov iterations, each one product with the shell and one sparse solve per body; a step adds three passes
-   over the stress field: B v0 and G^T Sigma_p before Newton, B (v - v0) after it. The generic path (Newton on the
+   a few Krylov iterations, each one product with the shell and one sparse solve per body; a step adds two passes
+   over the cells: Sigma_p = Sigma0 + B v0 / s with G^T Sigma_p before Newton (PhlexSystemStressPredict), Sigma after
+   it (PhlexSystemStressCorrect). The generic path (Newton on the
    whole state with a Schur field split) pays two products with G, one with G^T and one with Ms per residual, and
    several per Krylov iteration.
 
@@ -41,7 +42,7 @@ typedef struct {
   Mat         K;        /* the bodies' condensed stiffnesses G^T Ms^{-1} G cell by cell (block diagonal, velocity field) */
   PhlexStressMaps maps; /* per body B = Ms^{-1} G, G^T and K, cell by cell (the parts' shells) */
   Vec         Xd, F;    /* whole state: rate, residual */
-  Vec         sp, bv;   /* stress field: Sigma_p, B v */
+  Vec         sp;       /* stress field: Sigma_p */
   Vec         P, Pp, dv, wv; /* velocity field: G^T Sigma at the iterate and at Sigma_p, v - v0, work */
   Vec         Z, Dz;    /* {velocity, discrete}: residual, Newton correction */
   IS          isv, isq; /* the blocks of the {velocity, discrete} vectors */
@@ -199,7 +200,6 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
   PetscCall(VecDuplicate(snes->vec_sol, &c->Xd));
   PetscCall(VecDuplicate(snes->vec_sol, &c->F));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->P)); /* stress columns, velocity rows */
-  PetscCall(VecDuplicate(c->sp, &c->bv));
   PetscCall(VecDuplicate(c->P, &c->Pp));
   PetscCall(VecDuplicate(c->P, &c->dv));
   PetscCall(VecDuplicate(c->P, &c->wv));
@@ -312,10 +312,8 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
      (the residual does not read it; the norm of the state does) */
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
   PetscCall(VecGetSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
-  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, v0, c->bv));
-  PetscCall(VecWAXPY(c->sp, 1.0 / s, c->bv, s0));
+  PetscCall(PhlexSystemStressPredict(sys, &c->maps, v0, s0, 1.0 / s, c->sp, c->Pp));
   PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_STRESS], &s0));
-  PetscCall(PhlexSystemResultantMult(sys, &c->maps, c->sp, c->Pp));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(VecCopy(c->sp, xs));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
@@ -388,9 +386,8 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   }
   PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
   /* Sigma = Sigma_p + B (v - v0) / s: the stress whose resultant the momentum rows saw (through K) */
-  PetscCall(PhlexSystemStressMapsMult(sys, &c->maps, c->dv, c->bv));
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
-  PetscCall(VecWAXPY(xs, 1.0 / s, c->bv, c->sp));
+  PetscCall(PhlexSystemStressCorrect(sys, &c->maps, c->dv, c->sp, 1.0 / s, xs));
   PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
   PetscCall(PetscLogEventEnd(PHLEX_ReducedStage, 0, 0, 0, 0));
   PetscFunctionReturn(0);
@@ -408,7 +405,6 @@ static PetscErrorCode SNESReset_Reduced(SNES snes)
   PetscCall(VecDestroy(&c->Xd));
   PetscCall(VecDestroy(&c->F));
   PetscCall(VecDestroy(&c->sp));
-  PetscCall(VecDestroy(&c->bv));
   PetscCall(VecDestroy(&c->P));
   PetscCall(VecDestroy(&c->Pp));
   PetscCall(VecDestroy(&c->dv));
