@@ -306,6 +306,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
 /* flexible_stress_maps.c: B = Ms^{-1} G and G^T cell by cell */
 PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexFlexibleStrainEnergy(PhlexFlexible, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexStressMapsPredict(Mat, Vec, Vec, PetscReal, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexStressMapsCorrect(Mat, Vec, Vec, PetscReal, Vec);
 

@@ -554,48 +554,6 @@ PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible b, const PhlexUnits *units)
   PetscFunctionReturn(0);
 }
 
-/* 1/2 s^T Ms s from Ms's structure: the block of cell c is detJ_c (smass (x) A_m) (PhlexElementComplianceMass), smass
-   the reference mass of the stress basis, A_m the compliance of the cell's material, so a cell's energy is
-   1/2 detJ_c sum_ij smass_ij s_i . A_m s_j over its stress nodes i, j (6 components each). The monitor needs it every
-   step: a product with the assembled Ms streamed its 224 MB at 2.2e5 velocity DOFs (30-47 ms, one BLAS dgemv call per
-   cell), this reads the stresses and the cells' volumes only (BENCHMARKS.md section 18). The sums are not dgemv's:
-   the energy differs from 1/2 s^T (Ms s) in its last bits. */
-static PetscErrorCode StrainEnergy(PhlexFlexible b, Vec s, PetscReal *strain)
-{
-  const PetscInt     nn = b->ref.ns; /* stress nodes per cell */
-  const PetscReal   *smass = b->ref.smass;
-  const PetscScalar *sa;
-  PetscInt           rstart;
-  PetscReal          local = 0, global;
-
-  PetscFunctionBeginUser;
-  PetscCall(VecGetOwnershipRange(s, &rstart, NULL));
-  PetscCall(VecGetArrayRead(s, &sa));
-  for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
-    const PetscScalar *sc = sa + (b->cell_soff[c] - rstart);
-    const PetscReal   *A  = b->compliance[b->cell_material[c]];
-    PetscReal          e  = 0;
-
-    for (PetscInt i = 0; i < nn; i++) {
-      const PetscScalar *si = sc + 6 * i;
-      PetscReal          t[6] = {0, 0, 0, 0, 0, 0}; /* sum_j smass_ij s_j */
-      for (PetscInt j = 0; j < nn; j++)
-        for (PetscInt k = 0; k < 6; k++) t[k] += smass[i * nn + j] * PetscRealPart(sc[6 * j + k]);
-      for (PetscInt k = 0; k < 6; k++) {
-        PetscReal Asi = 0;
-        for (PetscInt l = 0; l < 6; l++) Asi += A[k * 6 + l] * PetscRealPart(si[l]);
-        e += t[k] * Asi;
-      }
-    }
-    local += b->cell_geom[10 * c] * e;
-  }
-  PetscCall(VecRestoreArrayRead(s, &sa));
-  PetscCall(PetscLogFlops((2.0 * 6 * nn * nn + 2.0 * 42 * nn + 1) * (b->cEnd - b->cStart)));
-  PetscCall(MPIU_Allreduce(&local, &global, 1, MPIU_REAL, MPIU_SUM, b->comm));
-  *strain = 0.5 * global;
-  PetscFunctionReturn(0);
-}
-
 /*@C
   PhlexFlexibleEnergy - kinetic and strain energy 1/2 v^T Mv v, 1/2 s^T Ms s (non-dimensional)
 
@@ -611,7 +569,7 @@ PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible b, Vec v, Vec s, PetscReal *kin
   PetscCall(MatMult(b->Mvp ? b->Mvp : b->Mv, v, b->ewv));
   PetscCall(VecDot(b->ewv, v, &e));
   *kinetic = 0.5 * PetscRealPart(e);
-  PetscCall(StrainEnergy(b, s, strain));
+  PetscCall(PhlexFlexibleStrainEnergy(b, s, strain));
   PetscFunctionReturn(0);
 }
 
