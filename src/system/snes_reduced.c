@@ -334,8 +334,17 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
     PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
     PetscCall(VecWAXPY(c->dv, -1.0, v0, xv));
     PetscCall(VecRestoreSubVector(X, sys->is[PHLEX_FIELD_VELOCITY], &xv));
-    PetscCall(MatMult(c->K, c->dv, c->P));
-    PetscCall(VecAYPX(c->P, 1.0 / s, c->Pp));
+    {
+      /* the initial guess is mostly the step's start (TSTHETA without extrapolation): v = v0, and K 0 would be a pass
+         over the cells for nothing */
+      PetscReal dvmax = 1.0;
+      if (!snes->iter) PetscCall(VecNorm(c->dv, NORM_INFINITY, &dvmax));
+      if (dvmax == 0.0) PetscCall(VecCopy(c->Pp, c->P));
+      else {
+        PetscCall(MatMult(c->K, c->dv, c->P));
+        PetscCall(VecAYPX(c->P, 1.0 / s, c->Pp));
+      }
+    }
     PetscCall(PhlexSystemReducedResidual(sys, tstage, X, c->Xd, c->P, c->F));
     if (!c->Jred) {
       /* the first Jacobian sets the shift the preconditioning matrix needs */
