@@ -14,8 +14,10 @@
    A product reads the velocities, the cells' geometry and the stresses (about 25 MB at 2.2e5 velocity DOFs) instead
    of the 280 MB of B's or G's entries, and nothing is assembled or stored beyond two work vectors and the cells'
    local offsets. The condensed stiffness K = G^T Ms^{-1} G (SNES phlexreduced's residual and Jacobian) is the two in
-   one pass per cell, the stress kept in the cell. The sums are not those of the assembled products: results differ from them in the last bits
-   (BENCHMARKS.md section 18). For the body's undeformed geometry only: geometric stiffening's G(u) is assembled
+   one pass per cell, the stress kept in the cell; a linear stage's predicted stress with its resultant, and its final
+   stress, are one pass each (PhlexStressMapsPredict, PhlexStressMapsCorrect), and the monitor's strain energy 1/2
+   Sigma^T Ms Sigma comes from the same structure (PhlexFlexibleStrainEnergy). The sums are not those of the assembled
+   products: results differ from them in the last bits (BENCHMARKS.md section 18). For the body's undeformed geometry only: geometric stiffening's G(u) is assembled
    (flexible_stiffening.c). */
 #include <phlex_impl.h>
 #include <petscblaslapack.h>
