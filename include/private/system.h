@@ -115,14 +115,12 @@ PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSNESRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESCondensedApplicable(PhlexSystem, TS, PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexSNESCondensedSetSystem(SNES, PhlexSystem, TS);
-/* the bodies' cell-by-cell products (PhlexFieldOperators B, Res, Kc), referenced per body */
+/* the bodies' cell-by-cell products (PhlexFieldOperators B, Kc), referenced per body */
 typedef struct {
-  Mat *B, *Res, *K;
+  Mat *B, *K;
 } PhlexStressMaps;
 PETSC_INTERN PetscErrorCode PhlexSystemGetStressMaps(PhlexSystem, const char *, PhlexStressMaps *);
 PETSC_INTERN PetscErrorCode PhlexSystemStressMapsDestroy(PhlexSystem, PhlexStressMaps *);
-PETSC_INTERN PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem, PhlexStressMaps *, Vec, Vec);
-PETSC_INTERN PetscErrorCode PhlexSystemResultantMult(PhlexSystem, PhlexStressMaps *, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemStressPredict(PhlexSystem, PhlexStressMaps *, Vec, Vec, PetscReal, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemStressCorrect(PhlexSystem, PhlexStressMaps *, Vec, Vec, PetscReal, Vec);
 /* snes_reduced.c: SNES phlexreduced, Newton on the velocities and discrete unknowns of a theta-method stage */

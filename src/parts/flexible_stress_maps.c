@@ -137,7 +137,7 @@ CELL_INLINE void CellStressRate(PetscInt nv, PetscInt nn, const PetscReal *coup,
 }
 
 /* fe = G_c^T Sigma_c for the cells: sigma their stresses (6 per stress node), fe their velocity rows (3 per node) */
-CELL_INLINE void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup, PhlexLane detJ, const PhlexLane *invJ, const PhlexLane *sigma, PhlexLane *fe)
+CELL_INLINE void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup, const PhlexLane *detJ, const PhlexLane *invJ, const PhlexLane *sigma, PhlexLane *fe)
 {
   for (PetscInt k = 0; k < 3 * nv; k++) fe[k] = LANE_ZERO;
   for (PetscInt i = 0; i < nn; i++) {
@@ -149,7 +149,7 @@ CELL_INLINE void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup, 
     };
     PhlexLane T[3][3]; /* detJ S invJ^T */
     for (PetscInt a = 0; a < 3; a++)
-      for (PetscInt y = 0; y < 3; y++) T[a][y] = detJ * (S[a][0] * invJ[y * 3 + 0] + S[a][1] * invJ[y * 3 + 1] + S[a][2] * invJ[y * 3 + 2]);
+      for (PetscInt y = 0; y < 3; y++) T[a][y] = *detJ * (S[a][0] * invJ[y * 3 + 0] + S[a][1] * invJ[y * 3 + 1] + S[a][2] * invJ[y * 3 + 2]);
     for (PetscInt bnode = 0; bnode < nv; bnode++) {
       const PetscReal *cb = &coup[(i * nv + bnode) * 3];
       for (PetscInt a = 0; a < 3; a++) fe[3 * bnode + a] += T[a][0] * cb[0] + T[a][1] * cb[1] + T[a][2] * cb[2];
@@ -208,7 +208,7 @@ PHLEX_KERNEL_CLONES static void ResultantCells(PhlexFlexible b, PetscInt rstart,
       const PetscScalar *sc = sa + (b->cell_soff[cb.cell[l]] - rstart);
       for (PetscInt k = 0; k < 6 * nn; k++) LANE(sigma[k], l) = PetscRealPart(sc[k]);
     }
-    CellResultant(nv, nn, b->ref.coup, cb.detJ, cb.invJ, sigma, fe);
+    CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
     ScatterResultants(b, &cb, fe, fa);
   }
 }
@@ -224,7 +224,7 @@ PHLEX_KERNEL_CLONES static void CondensedStiffnessCells(PhlexFlexible b, const P
     GatherBatch(b, c0, ncell, PETSC_TRUE, &cb);
     GatherVelocities(b, &cb, va, ve);
     CellStressRate(nv, nn, b->ref.coup, cb.invJ, cb.D, b->smass_inv, ve, sigma);
-    CellResultant(nv, nn, b->ref.coup, cb.detJ, cb.invJ, sigma, fe);
+    CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
     ScatterResultants(b, &cb, fe, fa);
   }
 }
@@ -251,7 +251,7 @@ PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, c
       PetscScalar *sc = spa + (b->cell_soff[cb.cell[l]] - rstart);
       for (PetscInt k = 0; k < 6 * nn; k++) sc[k] = LANE(sigma[k], l);
     }
-    CellResultant(nv, nn, b->ref.coup, cb.detJ, cb.invJ, sigma, fe);
+    CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
     ScatterResultants(b, &cb, fe, fa);
   }
 }
@@ -503,7 +503,8 @@ PetscErrorCode PhlexStressMapsCorrect(Mat B, Vec v, Vec sp, PetscReal a, Vec s)
   of the cell's material, so a cell's energy is 1/2 detJ_c sum_ij smass_ij s_i . A_m s_j over its stress nodes i, j
   (6 components each). The monitor needs it every step: a product with the assembled Ms streamed its 224 MB at 2.2e5
   velocity DOFs (30-47 ms, one BLAS dgemv call per cell), this reads the stresses and the cells' volumes only
-  (BENCHMARKS.md section 18), four cells per instruction (the cells' sum in cell order). The sums are not dgemv's: the
+  (BENCHMARKS.md section 18), several cells per instruction where the compiler has vectors (the cells' sum in cell
+  order). The sums are not dgemv's: the
   energy differs from 1/2 s^T (Ms s) in its last bits.
 
   Collective

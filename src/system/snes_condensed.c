@@ -100,7 +100,7 @@ PetscErrorCode PhlexSNESCondensedSetSystem(SNES snes, PhlexSystem sys, TS ts)
 }
 
 /*@C
-  PhlexSystemGetStressMaps - references each body's cell-by-cell products (PhlexFieldOperators B, Res and Kc) in
+  PhlexSystemGetStressMaps - references each body's cell-by-cell products (PhlexFieldOperators B and Kc) in
   arrays the caller frees with PhlexSystemStressMapsDestroy(); an error names the SNES type (who) if a body has none
   (geometric stiffening assembles G(u): the stages that use these maps are not chosen for it)
 
@@ -109,17 +109,15 @@ PetscErrorCode PhlexSNESCondensedSetSystem(SNES snes, PhlexSystem sys, TS ts)
 PetscErrorCode PhlexSystemGetStressMaps(PhlexSystem sys, const char *who, PhlexStressMaps *maps)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscCalloc3(sys->nfparts, &maps->B, sys->nfparts, &maps->Res, sys->nfparts, &maps->K));
+  PetscCall(PetscCalloc2(sys->nfparts, &maps->B, sys->nfparts, &maps->K));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
-    PetscCheck(ops.B && ops.Res && ops.Kc, sys->comm, PETSC_ERR_PLIB, "SNES %s: part %" PetscInt_FMT " has no cell-by-cell stress maps", who, i);
+    PetscCheck(ops.B && ops.Kc, sys->comm, PETSC_ERR_PLIB, "SNES %s: part %" PetscInt_FMT " has no cell-by-cell stress maps", who, i);
     PetscCall(PetscObjectReference((PetscObject)ops.B));
-    PetscCall(PetscObjectReference((PetscObject)ops.Res));
     PetscCall(PetscObjectReference((PetscObject)ops.Kc));
-    maps->B[i]   = ops.B;
-    maps->Res[i] = ops.Res;
-    maps->K[i]   = ops.Kc;
+    maps->B[i] = ops.B;
+    maps->K[i] = ops.Kc;
   }
   PetscFunctionReturn(0);
 }
@@ -133,49 +131,9 @@ PetscErrorCode PhlexSystemStressMapsDestroy(PhlexSystem sys, PhlexStressMaps *ma
   if (!maps->B) PetscFunctionReturn(0);
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PetscCall(MatDestroy(&maps->B[i]));
-    PetscCall(MatDestroy(&maps->Res[i]));
     PetscCall(MatDestroy(&maps->K[i]));
   }
-  PetscCall(PetscFree3(maps->B, maps->Res, maps->K));
-  PetscFunctionReturn(0);
-}
-
-/* per body y_i = A_i x_i, x a vector of field fx and y one of field fy */
-static PetscErrorCode BodyMapsApply(PhlexSystem sys, Mat *A, PhlexField fx, PhlexField fy, Vec x, Vec y)
-{
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    Vec xi, yi;
-    PetscCall(VecGetSubVector(x, sys->fis[fx][i], &xi));
-    PetscCall(VecGetSubVector(y, sys->fis[fy][i], &yi));
-    PetscCall(MatMult(A[i], xi, yi));
-    PetscCall(VecRestoreSubVector(y, sys->fis[fy][i], &yi));
-    PetscCall(VecRestoreSubVector(x, sys->fis[fx][i], &xi));
-  }
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexSystemStressMapsMult - y = B v over the bodies (v a velocity field vector, y a stress field vector)
-
-  Collective
-@*/
-PetscErrorCode PhlexSystemStressMapsMult(PhlexSystem sys, PhlexStressMaps *maps, Vec v, Vec y)
-{
-  PetscFunctionBeginUser;
-  PetscCall(BodyMapsApply(sys, maps->B, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, v, y));
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexSystemResultantMult - y = G^T Sigma over the bodies (Sigma a stress field vector, y a velocity field vector)
-
-  Collective
-@*/
-PetscErrorCode PhlexSystemResultantMult(PhlexSystem sys, PhlexStressMaps *maps, Vec sigma, Vec y)
-{
-  PetscFunctionBeginUser;
-  PetscCall(BodyMapsApply(sys, maps->Res, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, sigma, y));
+  PetscCall(PetscFree2(maps->B, maps->K));
   PetscFunctionReturn(0);
 }
 

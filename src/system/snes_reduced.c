@@ -18,10 +18,10 @@
    condensed operators (once per step size), the border bases solved once, a small dense Schur complement per Newton
    step (pcbordered.c).
 
-   A Newton iteration costs one residual (products with Mv and K: velocity sized, no pass over the stress field) and
-   a few Krylov iterations, each one product with the shell and one sparse solve per body; a step adds two passes
-   over the cells: Sigma_p = Sigma0 + B v0 / s with G^T Sigma_p before Newton (PhlexSystemStressPredict), Sigma after
-   it (PhlexSystemStressCorrect). The generic path (Newton on the
+   A Newton iteration costs one residual (products with Mv and K: velocity sized, no pass over the stress field; the
+   first of a stage skips K when it starts at v = v0) and a few Krylov iterations, each one product with the shell and
+   one sparse solve per body; a step adds two passes over the cells: Sigma_p = Sigma0 + B v0 / s with G^T Sigma_p
+   before Newton (PhlexSystemStressPredict), Sigma after it (PhlexSystemStressCorrect). The generic path (Newton on the
    whole state with a Schur field split) pays two products with G, one with G^T and one with Ms per residual, and
    several per Krylov iteration.
 
