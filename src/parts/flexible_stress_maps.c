@@ -177,17 +177,33 @@ CELL_INLINE void ScatterResultants(PhlexFlexible b, const CellBatch *cb, const P
   }
 }
 
+/* the batch of cells from c0: its geometry, materials and velocities (va local), and its stress rates y = B v */
+CELL_INLINE void BatchStressRate(PhlexFlexible b, PetscInt c0, PetscInt ncell, const PetscScalar *va, CellBatch *cb, PhlexLane *y)
+{
+  PhlexLane ve[3 * PHLEX_MAX_NODES];
+  GatherBatch(b, c0, ncell, PETSC_TRUE, cb);
+  GatherVelocities(b, cb, va, ve);
+  CellStressRate(b->ref.nv, b->ref.ns, b->ref.coup, cb->invJ, cb->D, b->smass_inv, ve, y);
+}
+
+/* the batch's stresses from the rank's stress field sa (first entry rstart) */
+CELL_INLINE void GatherStresses(PhlexFlexible b, const CellBatch *cb, PetscInt rstart, const PetscScalar *sa, PhlexLane *sigma)
+{
+  for (PetscInt l = 0; l < PHLEX_LANES; l++) {
+    const PetscScalar *sc = sa + (b->cell_soff[cb->cell[l]] - rstart);
+    for (PetscInt k = 0; k < 6 * b->ref.ns; k++) LANE(sigma[k], l) = PetscRealPart(sc[k]);
+  }
+}
+
 /* ya (the rank's stress field, first entry rstart) = B v over the rank's cells, va the local velocities */
 PHLEX_KERNEL_CLONES static void StressRateCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, PetscScalar *ya)
 {
-  const PetscInt nv = b->ref.nv, nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt nn = b->ref.ns, ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
-    PhlexLane ve[3 * PHLEX_MAX_NODES], y[24];
-    GatherBatch(b, c0, ncell, PETSC_TRUE, &cb);
-    GatherVelocities(b, &cb, va, ve);
-    CellStressRate(nv, nn, b->ref.coup, cb.invJ, cb.D, b->smass_inv, ve, y);
+    PhlexLane y[24];
+    BatchStressRate(b, c0, ncell, va, &cb, y);
     for (PetscInt l = 0; l < cb.used; l++) {
       PetscScalar *yc = ya + (b->cell_soff[cb.cell[l]] - rstart);
       for (PetscInt k = 0; k < 6 * nn; k++) yc[k] = LANE(y[k], l);
@@ -204,10 +220,7 @@ PHLEX_KERNEL_CLONES static void ResultantCells(PhlexFlexible b, PetscInt rstart,
     CellBatch cb;
     PhlexLane sigma[24], fe[3 * PHLEX_MAX_NODES];
     GatherBatch(b, c0, ncell, PETSC_FALSE, &cb);
-    for (PetscInt l = 0; l < PHLEX_LANES; l++) {
-      const PetscScalar *sc = sa + (b->cell_soff[cb.cell[l]] - rstart);
-      for (PetscInt k = 0; k < 6 * nn; k++) LANE(sigma[k], l) = PetscRealPart(sc[k]);
-    }
+    GatherStresses(b, &cb, rstart, sa, sigma);
     CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
     ScatterResultants(b, &cb, fe, fa);
   }
@@ -220,10 +233,8 @@ PHLEX_KERNEL_CLONES static void CondensedStiffnessCells(PhlexFlexible b, const P
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
-    PhlexLane ve[3 * PHLEX_MAX_NODES], sigma[24], fe[3 * PHLEX_MAX_NODES];
-    GatherBatch(b, c0, ncell, PETSC_TRUE, &cb);
-    GatherVelocities(b, &cb, va, ve);
-    CellStressRate(nv, nn, b->ref.coup, cb.invJ, cb.D, b->smass_inv, ve, sigma);
+    PhlexLane sigma[24], fe[3 * PHLEX_MAX_NODES];
+    BatchStressRate(b, c0, ncell, va, &cb, sigma);
     CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
     ScatterResultants(b, &cb, fe, fa);
   }
@@ -238,14 +249,9 @@ PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, c
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
-    PhlexLane ve[3 * PHLEX_MAX_NODES], y[24], sigma[24], fe[3 * PHLEX_MAX_NODES];
-    GatherBatch(b, c0, ncell, PETSC_TRUE, &cb);
-    GatherVelocities(b, &cb, va, ve);
-    CellStressRate(nv, nn, b->ref.coup, cb.invJ, cb.D, b->smass_inv, ve, y);
-    for (PetscInt l = 0; l < PHLEX_LANES; l++) {
-      const PetscScalar *sc = s0a + (b->cell_soff[cb.cell[l]] - rstart);
-      for (PetscInt k = 0; k < 6 * nn; k++) LANE(sigma[k], l) = PetscRealPart(sc[k]);
-    }
+    PhlexLane y[24], sigma[24], fe[3 * PHLEX_MAX_NODES];
+    BatchStressRate(b, c0, ncell, va, &cb, y);
+    GatherStresses(b, &cb, rstart, s0a, sigma);
     for (PetscInt k = 0; k < 6 * nn; k++) sigma[k] = sigma[k] + a * y[k];
     for (PetscInt l = 0; l < cb.used; l++) {
       PetscScalar *sc = spa + (b->cell_soff[cb.cell[l]] - rstart);
@@ -260,14 +266,12 @@ PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, c
    bytes of the two passes */
 PHLEX_KERNEL_CLONES static void CorrectCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *spa, PetscReal a, PetscScalar *sa)
 {
-  const PetscInt nv = b->ref.nv, nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt nn = b->ref.ns, ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
-    PhlexLane ve[3 * PHLEX_MAX_NODES], y[24];
-    GatherBatch(b, c0, ncell, PETSC_TRUE, &cb);
-    GatherVelocities(b, &cb, va, ve);
-    CellStressRate(nv, nn, b->ref.coup, cb.invJ, cb.D, b->smass_inv, ve, y);
+    PhlexLane y[24];
+    BatchStressRate(b, c0, ncell, va, &cb, y);
     for (PetscInt l = 0; l < cb.used; l++) {
       const PetscInt     off = b->cell_soff[cb.cell[l]] - rstart;
       const PetscScalar *sp  = spa + off;
