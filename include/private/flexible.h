@@ -303,7 +303,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexiblePlacement(PhlexFlexible, uint64_t *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
 
-/* flexible_stress_maps.c: B = Ms^{-1} G and G^T cell by cell */
+/* flexible_stress_maps.c: B = Ms^{-1} G, G^T and K cell by cell, a linear stage's fused stress passes, the strain energy */
 PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStrainEnergy(PhlexFlexible, Vec, PetscReal *);

@@ -208,7 +208,7 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
     PetscCall(PCSetType(pc, PCCHOLESKY));
   }
   PetscCall(KSPSetFromOptions(c->ksp));
-  /* the three products of a step, cell by cell from the element structure: nothing assembled */
+  /* the step's products with B and G^T, cell by cell from the element structure (two passes): nothing assembled */
   PetscCall(PhlexSystemGetStressMaps(sys, "phlexcondensed", &c->maps));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
   PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
