@@ -195,19 +195,35 @@ CELL_INLINE void GatherStresses(PhlexFlexible b, const CellBatch *cb, PetscInt r
   }
 }
 
+/* the used lanes' stresses into the rank's stress field sa (first entry rstart) */
+CELL_INLINE void StoreStresses(PhlexFlexible b, const CellBatch *cb, PetscInt rstart, const PhlexLane *sigma, PetscScalar *sa)
+{
+  for (PetscInt l = 0; l < cb->used; l++) {
+    PetscScalar *sc = sa + (b->cell_soff[cb->cell[l]] - rstart);
+    for (PetscInt k = 0; k < 6 * b->ref.ns; k++) sc[k] = LANE(sigma[k], l);
+  }
+}
+
+/* the batch's stresses s0 + a B v (s0 from the rank's stress field s0a, first entry rstart; va the local velocities),
+   each entry as VecWAXPY forms it from B v */
+CELL_INLINE void BatchStressUpdate(PhlexFlexible b, PetscInt c0, PetscInt ncell, PetscInt rstart, const PetscScalar *va, const PetscScalar *s0a, PetscReal a, CellBatch *cb, PhlexLane *sigma)
+{
+  PhlexLane y[24];
+  BatchStressRate(b, c0, ncell, va, cb, y);
+  GatherStresses(b, cb, rstart, s0a, sigma);
+  for (PetscInt k = 0; k < 6 * b->ref.ns; k++) sigma[k] = sigma[k] + a * y[k];
+}
+
 /* ya (the rank's stress field, first entry rstart) = B v over the rank's cells, va the local velocities */
 PHLEX_KERNEL_CLONES static void StressRateCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, PetscScalar *ya)
 {
-  const PetscInt nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
     PhlexLane y[24];
     BatchStressRate(b, c0, ncell, va, &cb, y);
-    for (PetscInt l = 0; l < cb.used; l++) {
-      PetscScalar *yc = ya + (b->cell_soff[cb.cell[l]] - rstart);
-      for (PetscInt k = 0; k < 6 * nn; k++) yc[k] = LANE(y[k], l);
-    }
+    StoreStresses(b, &cb, rstart, y, ya);
   }
 }
 
@@ -249,14 +265,9 @@ PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, c
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
-    PhlexLane y[24], sigma[24], fe[3 * PHLEX_MAX_NODES];
-    BatchStressRate(b, c0, ncell, va, &cb, y);
-    GatherStresses(b, &cb, rstart, s0a, sigma);
-    for (PetscInt k = 0; k < 6 * nn; k++) sigma[k] = sigma[k] + a * y[k];
-    for (PetscInt l = 0; l < cb.used; l++) {
-      PetscScalar *sc = spa + (b->cell_soff[cb.cell[l]] - rstart);
-      for (PetscInt k = 0; k < 6 * nn; k++) sc[k] = LANE(sigma[k], l);
-    }
+    PhlexLane sigma[24], fe[3 * PHLEX_MAX_NODES];
+    BatchStressUpdate(b, c0, ncell, rstart, va, s0a, a, &cb, sigma);
+    StoreStresses(b, &cb, rstart, sigma, spa);
     CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
     ScatterResultants(b, &cb, fe, fa);
   }
@@ -266,18 +277,13 @@ PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, c
    bytes of the two passes */
 PHLEX_KERNEL_CLONES static void CorrectCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *spa, PetscReal a, PetscScalar *sa)
 {
-  const PetscInt nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
-    PhlexLane y[24];
-    BatchStressRate(b, c0, ncell, va, &cb, y);
-    for (PetscInt l = 0; l < cb.used; l++) {
-      const PetscInt     off = b->cell_soff[cb.cell[l]] - rstart;
-      const PetscScalar *sp  = spa + off;
-      PetscScalar       *sc  = sa + off;
-      for (PetscInt k = 0; k < 6 * nn; k++) sc[k] = sp[k] + a * LANE(y[k], l);
-    }
+    PhlexLane sigma[24];
+    BatchStressUpdate(b, c0, ncell, rstart, va, spa, a, &cb, sigma);
+    StoreStresses(b, &cb, rstart, sigma, sa);
   }
 }
 
