@@ -128,6 +128,10 @@ PETSC_INTERN PetscErrorCode PhlexSNESReducedRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedApplicable(PhlexSystem, TS, PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedSetSystem(SNES, PhlexSystem, TS);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedSetStage(SNES, PhlexSystem, Vec, PetscReal, PetscReal, PetscReal);
+#define PHLEX_REDUCED_HISTORY 8                                  /* Newton iterations whose contraction a stage keeps */
+#define PHLEX_REDUCED_NCONTRACTIONS (7 + 2 * PHLEX_REDUCED_HISTORY) /* their record: count, dt, theta, the looser solves' state (off, iterations, stages off, wait), two ratios each */
+PETSC_INTERN PetscErrorCode PhlexSNESReducedGetContractions(SNES, PetscReal[PHLEX_REDUCED_NCONTRACTIONS]);
+PETSC_INTERN PetscErrorCode PhlexSNESReducedSetContractions(SNES, const PetscReal[PHLEX_REDUCED_NCONTRACTIONS]);
 
 /* assembly.c: consistent configuration and velocities, redundancy, drift */
 PETSC_INTERN PetscErrorCode PhlexAssemblyPlaceAttached(PhlexSystem, Vec);

@@ -253,6 +253,14 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
   PetscCall(PhlexCheckpointWriteReals(v, "/state", "multipliers", n, m->lambda));
   PetscCheck(PackMonitor(m, mon) == CHECKPOINT_NMONITOR, comm, PETSC_ERR_PLIB, "the checkpoint's list of accumulators is out of date");
   PetscCall(PhlexCheckpointWriteReals(v, "/monitor", "accumulators", CHECKPOINT_NMONITOR, mon));
+  {
+    /* SNES phlexreduced's last Newton contractions set the next stage's linear tolerances: a restart repeats them */
+    SNES      snes;
+    PetscReal rec[PHLEX_REDUCED_NCONTRACTIONS];
+    PetscCall(TSGetSNES(ts, &snes));
+    PetscCall(PhlexSNESReducedGetContractions(snes, rec));
+    PetscCall(PhlexCheckpointWriteReals(v, "/solver", "newton_contractions", PHLEX_REDUCED_NCONTRACTIONS, rec));
+  }
   PetscCall(PhlexOutputSaveState(m->scene->output, v));
   PetscCall(PhlexCheckpointCommit(comm, tmp, m->ck_file, &v));
   m->ck_step = step;
@@ -394,6 +402,19 @@ PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, co
   PetscCall(PhlexCheckpointReadReals(v, "/state", "multipliers", nq, m->lambda));
   PetscCall(PhlexCheckpointReadReals(v, "/monitor", "accumulators", CHECKPOINT_NMONITOR, mon));
   UnpackMonitor(m, mon);
+  {
+    /* absent from the checkpoints of earlier versions: the first stage then solves every Newton step to the linear
+       tolerance (the same solution to Newton's tolerance, not the same bytes) */
+    SNES      snes;
+    PetscReal rec[PHLEX_REDUCED_NCONTRACTIONS];
+    PetscBool has;
+    PetscCall(PetscViewerHDF5HasDataset(v, "/solver/newton_contractions", &has));
+    if (has) {
+      PetscCall(PhlexCheckpointReadReals(v, "/solver", "newton_contractions", PHLEX_REDUCED_NCONTRACTIONS, rec));
+      PetscCall(TSGetSNES(ts, &snes));
+      PetscCall(PhlexSNESReducedSetContractions(snes, rec));
+    }
+  }
   PetscCall(TSSetTime(ts, t));
   PetscCall(TSSetStepNumber(ts, step));
   if (m->adaptive) PetscCall(TSSetTimeStep(ts, dt)); /* the controller's next step */

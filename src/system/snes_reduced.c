@@ -25,6 +25,21 @@
    whole state with a Schur field split) pays two products with G, one with G^T and one with Ms per residual, and
    several per Krylov iteration.
 
+   The linear solve of a Newton iteration that is not the stage's last need not be more accurate than the residual
+   that Newton leaves after it: -snes_phlexreduced_forcing (1e-2) asks it for that share of the next residual, as
+   predicted by the contraction of the same iteration in the last stage of the same length (an inexact Newton method,
+   Eisenstat and Walker's forcing term proportional to the contraction, taken from the last stage instead of the last
+   iteration, since a stage takes two or three). A mechanism's first Newton iteration then takes one Krylov iteration
+   instead of two (its preconditioner lacks the borders' state-dependent gyroscopic terms, whose error a second
+   iteration removes), which saves a fifth of the double pendulum's sparse solves. The iteration predicted to be the
+   last is solved to -reduced_ksp_rtol, and Newton never stops right after a looser solve (one more iteration, at
+   -reduced_ksp_rtol, follows): the multipliers' accuracy, which the residual's norm does not show, is that of the last
+   solve. Where a looser solve cost a Newton iteration (the tumbling bar without its rate in the preconditioner: the
+   bilinear gyroscopic terms turn the error of the first iteration's velocity rows into a larger quadratic residual),
+   the stages keep the tolerance for 50 stages, then for twice as many each time it costs again. Stages without a TS
+   (the consistent start) and stages whose length changed (adaptive steps) solve every iteration to the tolerance. A
+   checkpoint keeps the contractions, so that a restart repeats the run that wrote it.
+
    Used when the scene has discrete unknowns and flexible bodies with constant operators (no geometric stiffening,
    no prescribed spin) and the integrator is the theta method without endpoint (the default implicit midpoint,
    backward Euler). The preset bordered.opts asks for it (-snes_type phlexreduced); where it does not apply the
@@ -50,6 +65,14 @@ typedef struct {
   Vec         X0;       /* a stage without a TS (PhlexSNESReducedSetStage): its start, time, length and theta */
   PetscReal   t0, dt, theta;
   PetscReal   vrtol;    /* the velocity rows' convergence, relative to their residual at the initial guess */
+  PetscReal   forcing;  /* a linear solve that is not Newton's last stops at this share of the next residual */
+  PetscReal   ksp_rtol; /* KSP reduced_'s own relative tolerance (the options'), that of a last Newton iteration */
+  /* the contractions of the last stage's Newton iterations (residual after / before, the whole and the velocity rows),
+     which predict the next stage's when it has the same length */
+  PetscReal   rho[PHLEX_REDUCED_HISTORY], rhov[PHLEX_REDUCED_HISTORY], rho_dt, rho_theta;
+  PetscInt    nrho, niter; /* the contractions kept (at most PHLEX_REDUCED_HISTORY), the last stage's Newton iterations */
+  PetscBool   forcing_off; /* at this step size a stage with looser solves took more Newton iterations than the last */
+  PetscInt    off_stages, off_wait; /* stages since, and stages until the looser solves are tried again */
 } SNES_Reduced;
 
 /* why a scene or an integrator (NULL: a stage without a TS) cannot use the reduced Newton (empty: it can) */
@@ -191,6 +214,7 @@ static PetscErrorCode SNESSetUp_Reduced(SNES snes)
   PetscCall(KSPGetPC(c->ksp, &pc));
   PetscCall(PCSetType(pc, "phlexbordered"));
   PetscCall(KSPSetFromOptions(c->ksp));
+  PetscCall(KSPGetTolerances(c->ksp, &c->ksp_rtol, NULL, NULL, NULL));
   /* B, G^T and K = G^T B per body, cell by cell from the element structure (nothing assembled). K is the stress rows'
      elimination as the final Sigma = Sigma_p + B (v - v0) / s sees it: the same cell sums as G^T (B v) (the
      element-assembled condensed stiffness differs from it by about 1e-11 relative, which the velocity rows, held to
@@ -283,8 +307,10 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   SNES_Reduced      *c   = (SNES_Reduced *)snes->data;
   PhlexSystem        sys = c->sys;
   Vec                X   = snes->vec_sol, X0, s0, v0, xs, xv, xu, u0;
-  PetscReal          t, dt, theta, a, s, tstage, fnorm, xnorm, snorm = 0.0, fv, fv0, fvprev = 0.0;
-  PetscInt           its = 0;
+  PetscReal          t, dt, theta, a, s, tstage, fnorm, xnorm, snorm = 0.0, fv, fv0, fvprev = 0.0, f0 = 0.0, fprev = 0.0;
+  PetscReal          rho[PHLEX_REDUCED_HISTORY], rhov[PHLEX_REDUCED_HISTORY];
+  PetscInt           its = 0, nrho = 0;
+  PetscBool          loose = PETSC_FALSE, loosened = PETSC_FALSE, history, kept;
   KSPConvergedReason kreason;
 
   PetscFunctionBeginUser;
@@ -305,6 +331,13 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   }
   a      = 1.0 / (theta * dt);
   s      = a * sys->units->time;
+  /* the last stage's contractions predict this one's if it has the same length (not across the consistent start's
+     vanishing steps and the steps, nor a change of step size) */
+  history = (PetscBool)(c->nrho > 0 && c->rho_dt == dt && c->rho_theta == theta);
+  if (!(c->rho_dt == dt && c->rho_theta == theta)) {
+    c->forcing_off = PETSC_FALSE;
+    c->off_wait    = 0;
+  }
   tstage = t + theta * dt;
   c->shift = s;
 
@@ -358,7 +391,15 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
       PetscCall(VecGetSubVector(c->Z, c->isv, &zv));
       PetscCall(VecNorm(zv, NORM_2, &fv));
       PetscCall(VecRestoreSubVector(c->Z, c->isv, &zv));
-      if (fv0 < 0) fv0 = fv;
+      if (fv0 < 0) {
+        fv0 = fv;
+        f0  = fnorm;
+      }
+    }
+    if (snes->iter > 0 && snes->iter <= PHLEX_REDUCED_HISTORY) {
+      rho[snes->iter - 1]  = fprev > 0 ? fnorm / fprev : 0.0;
+      rhov[snes->iter - 1] = fvprev > 0 ? fv / fvprev : 0.0;
+      nrho                 = snes->iter;
     }
     PetscCall(PetscInfo(snes, "Newton iteration %" PetscInt_FMT ": residual %g, of its velocity rows %g (%g of their initial value)\n", snes->iter, (double)fnorm, (double)fv, (double)(fv0 > 0 ? fv / fv0 : 0.0)));
     PetscCall(VecNorm(X, NORM_2, &xnorm));
@@ -375,10 +416,36 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
     /* the velocity rows are orders of magnitude smaller than the discrete ones (mass-matrix entries, elastic
        velocities): the norm of the whole residual does not see them, so they are also held to their own scale */
     if (snes->reason > 0 && fv > c->vrtol * fv0 && !(snes->iter > 0 && fv > 0.5 * fvprev)) snes->reason = SNES_CONVERGED_ITERATING;
+    /* Newton's last step is always solved to the linear tolerance: the multipliers' accuracy, which the residual's
+       norm does not show, is that step's; so a looser step is followed by one more (kept to the tolerance) */
+    kept = (PetscBool)(snes->reason > 0 && loose && snes->iter < snes->max_its);
+    if (kept) snes->reason = SNES_CONVERGED_ITERATING;
     if (!snes->reason && snes->iter >= snes->max_its) snes->reason = SNES_DIVERGED_MAX_IT;
     fvprev = fv;
+    fprev  = fnorm;
     if (snes->reason) break;
-    /* the Newton step: Jred dz = Z */
+    /* the Newton step: Jred dz = Z, to the linear tolerance, or to a share of the next residual when the last stage's
+       contraction says that another Newton iteration follows anyway */
+    {
+      PetscReal rtol = c->ksp_rtol;
+      loose          = PETSC_FALSE;
+      /* not in a stage without a TS (the consistent start: its two stages are different problems), not at the
+         iteration that ended the last stage, nor at one whose successor max_its would end */
+      if (c->forcing > 0 && c->ts && history && !c->forcing_off && !kept && snes->iter < c->nrho && snes->iter + 1 < c->niter && snes->iter + 1 < snes->max_its) {
+        const PetscReal fnext = c->rho[snes->iter] * fnorm, fvnext = c->rhov[snes->iter] * fv;
+        const PetscReal ftarget = PetscMax(snes->abstol, snes->rtol * f0);
+        if (fnext > 100.0 * ftarget || fvnext > 100.0 * c->vrtol * fv0) {
+          /* a share of the whole residual's predicted contraction; one that is not clearly looser saves nothing */
+          const PetscReal share = c->forcing * PetscMin(c->rho[snes->iter], 1.0);
+          if (share >= 10.0 * c->ksp_rtol) {
+            rtol     = share;
+            loose    = PETSC_TRUE;
+            loosened = PETSC_TRUE;
+          }
+        }
+      }
+      PetscCall(KSPSetTolerances(c->ksp, rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+    }
     PetscCall(PhlexSystemIJacobian(c->ts, tstage, X, c->Xd, a, sys->J, sys->J, sys));
     PetscCall(KSPSolve(c->ksp, c->Z, c->Dz));
     PetscCall(KSPGetIterationNumber(c->ksp, &its));
@@ -393,6 +460,24 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
     PetscCall(Update(c, X, X0, s));
     snes->iter++;
   }
+  /* a looser solve whose error the next Newton step could not absorb (the bilinear gyroscopic terms turn it into a
+     larger quadratic residual) cost a Newton iteration, more than it saved: not again at this step size */
+  if (loosened && (snes->reason <= 0 || snes->iter > c->niter)) {
+    /* tried again after 50 stages, then after twice as many each time it costs again (the motion changes) */
+    c->forcing_off = PETSC_TRUE;
+    c->off_stages  = 0;
+    c->off_wait    = c->off_wait ? 2 * c->off_wait : 50;
+  } else if (c->forcing_off && ++c->off_stages >= c->off_wait) c->forcing_off = PETSC_FALSE;
+  if (snes->reason > 0) {
+    for (PetscInt k = 0; k < nrho; k++) {
+      c->rho[k]  = rho[k];
+      c->rhov[k] = rhov[k];
+    }
+    c->nrho      = nrho;
+    c->niter     = snes->iter;
+    c->rho_dt    = dt;
+    c->rho_theta = theta;
+  } else c->nrho = 0;
   PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
   /* Sigma = Sigma_p + B (v - v0) / s: the stress whose resultant the momentum rows saw (through K) */
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
@@ -441,8 +526,10 @@ static PetscErrorCode SNESSetFromOptions_Reduced(SNES snes, PetscOptionItems *Pe
   PetscFunctionBeginUser;
   PetscOptionsHeadBegin(PetscOptionsObject, "SNES phlexreduced options");
   PetscCall(PetscOptionsReal("-snes_phlexreduced_velocity_rtol", "Newton converges when also the velocity rows' residual is below this share of its value at the initial guess", "SNESPHLEXREDUCED", c->vrtol, &c->vrtol, NULL));
+  PetscCall(PetscOptionsReal("-snes_phlexreduced_forcing", "A Newton step that the last stage's contraction says is not the last is solved to this share of the predicted next residual (0: every step to -reduced_ksp_rtol)", "SNESPHLEXREDUCED", c->forcing, &c->forcing, NULL));
   PetscOptionsHeadEnd();
   PetscCheck(c->vrtol > 0 && c->vrtol < 1, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT, "-snes_phlexreduced_velocity_rtol must be in (0, 1), got %g", (double)c->vrtol);
+  PetscCheck(c->forcing >= 0 && c->forcing < 1, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT, "-snes_phlexreduced_forcing must be in [0, 1), got %g", (double)c->forcing);
   PetscFunctionReturn(0);
 }
 
@@ -479,7 +566,67 @@ static PetscErrorCode SNESCreate_Reduced(SNES snes)
   snes->alwayscomputesfinalresidual = PETSC_FALSE;
   PetscCall(PetscNew(&c));
   c->vrtol   = 1e-10;
+  c->forcing = 1e-2;
   snes->data = (void *)c;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESReducedGetContractions - the contractions of the last stage's Newton iterations, which set the next
+  stage's linear tolerances (-snes_phlexreduced_forcing): a checkpoint keeps them so that a restart repeats the run
+  that wrote it; all zero for another SNES type
+
+  Not collective
+@*/
+PetscErrorCode PhlexSNESReducedGetContractions(SNES snes, PetscReal rec[PHLEX_REDUCED_NCONTRACTIONS])
+{
+  PetscBool reduced;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < PHLEX_REDUCED_NCONTRACTIONS; i++) rec[i] = 0.0;
+  PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &reduced));
+  if (reduced) {
+    SNES_Reduced *c = (SNES_Reduced *)snes->data;
+    rec[0]          = (PetscReal)c->nrho;
+    rec[1]          = c->rho_dt;
+    rec[2]          = c->rho_theta;
+    rec[3]          = c->forcing_off ? 1.0 : 0.0;
+    rec[4]          = (PetscReal)c->niter;
+    rec[5]          = (PetscReal)c->off_stages;
+    rec[6]          = (PetscReal)c->off_wait;
+    for (PetscInt k = 0; k < c->nrho; k++) {
+      rec[7 + k]                         = c->rho[k];
+      rec[7 + PHLEX_REDUCED_HISTORY + k] = c->rhov[k];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSNESReducedSetContractions - restores what PhlexSNESReducedGetContractions gave (nothing for another SNES type)
+
+  Not collective
+@*/
+PetscErrorCode PhlexSNESReducedSetContractions(SNES snes, const PetscReal rec[PHLEX_REDUCED_NCONTRACTIONS])
+{
+  PetscBool reduced;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &reduced));
+  if (reduced) {
+    SNES_Reduced *c = (SNES_Reduced *)snes->data;
+    c->nrho         = PetscMin(PetscMax((PetscInt)rec[0], 0), PHLEX_REDUCED_HISTORY);
+    c->rho_dt       = rec[1];
+    c->rho_theta    = rec[2];
+    c->forcing_off  = rec[3] != 0.0 ? PETSC_TRUE : PETSC_FALSE;
+    c->niter        = PetscMax((PetscInt)rec[4], 0);
+    c->off_stages   = PetscMax((PetscInt)rec[5], 0);
+    c->off_wait     = PetscMax((PetscInt)rec[6], 0);
+    for (PetscInt k = 0; k < c->nrho; k++) {
+      c->rho[k]  = rec[7 + k];
+      c->rhov[k] = rec[7 + PHLEX_REDUCED_HISTORY + k];
+    }
+  }
   PetscFunctionReturn(0);
 }
 
