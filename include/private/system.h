@@ -129,7 +129,7 @@ PETSC_INTERN PetscErrorCode PhlexSNESReducedApplicable(PhlexSystem, TS, PetscBoo
 PETSC_INTERN PetscErrorCode PhlexSNESReducedSetSystem(SNES, PhlexSystem, TS);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedSetStage(SNES, PhlexSystem, Vec, PetscReal, PetscReal, PetscReal);
 #define PHLEX_REDUCED_HISTORY 8                                  /* Newton iterations whose contraction a stage keeps */
-#define PHLEX_REDUCED_NCONTRACTIONS (7 + 2 * PHLEX_REDUCED_HISTORY) /* their record: count, dt, theta, the looser solves' state (off, iterations, stages off, wait), two ratios each */
+#define PHLEX_REDUCED_NCONTRACTIONS (6 + 2 * PHLEX_REDUCED_HISTORY) /* their record: iterations, dt, theta, the looser solves' state (off, stages off, wait), two ratios each */
 PETSC_INTERN PetscErrorCode PhlexSNESReducedGetContractions(SNES, PetscReal[PHLEX_REDUCED_NCONTRACTIONS]);
 PETSC_INTERN PetscErrorCode PhlexSNESReducedSetContractions(SNES, const PetscReal[PHLEX_REDUCED_NCONTRACTIONS]);
 

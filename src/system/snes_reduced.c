@@ -70,7 +70,7 @@ typedef struct {
   /* the contractions of the last stage's Newton iterations (residual after / before, the whole and the velocity rows),
      which predict the next stage's when it has the same length */
   PetscReal   rho[PHLEX_REDUCED_HISTORY], rhov[PHLEX_REDUCED_HISTORY], rho_dt, rho_theta;
-  PetscInt    nrho, niter; /* the contractions kept (at most PHLEX_REDUCED_HISTORY), the last stage's Newton iterations */
+  PetscInt    niter;    /* the last stage's Newton iterations (0: none to predict from); its first contractions are kept */
   PetscBool   forcing_off; /* at this step size a stage with looser solves took more Newton iterations than the last */
   PetscInt    off_stages, off_wait; /* stages since, and stages until the looser solves are tried again */
 } SNES_Reduced;
@@ -309,7 +309,7 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   Vec                X   = snes->vec_sol, X0, s0, v0, xs, xv, xu, u0;
   PetscReal          t, dt, theta, a, s, tstage, fnorm, xnorm, snorm = 0.0, fv, fv0, fvprev = 0.0, f0 = 0.0, fprev = 0.0;
   PetscReal          rho[PHLEX_REDUCED_HISTORY], rhov[PHLEX_REDUCED_HISTORY];
-  PetscInt           its = 0, nrho = 0;
+  PetscInt           its = 0;
   PetscBool          loose = PETSC_FALSE, loosened = PETSC_FALSE, history, kept;
   KSPConvergedReason kreason;
 
@@ -333,7 +333,7 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
   s      = a * sys->units->time;
   /* the last stage's contractions predict this one's if it has the same length (not across the consistent start's
      vanishing steps and the steps, nor a change of step size) */
-  history = (PetscBool)(c->nrho > 0 && c->rho_dt == dt && c->rho_theta == theta);
+  history = (PetscBool)(c->niter > 0 && c->rho_dt == dt && c->rho_theta == theta);
   if (!(c->rho_dt == dt && c->rho_theta == theta)) {
     c->forcing_off = PETSC_FALSE;
     c->off_wait    = 0;
@@ -399,7 +399,6 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
     if (snes->iter > 0 && snes->iter <= PHLEX_REDUCED_HISTORY) {
       rho[snes->iter - 1]  = fprev > 0 ? fnorm / fprev : 0.0;
       rhov[snes->iter - 1] = fvprev > 0 ? fv / fvprev : 0.0;
-      nrho                 = snes->iter;
     }
     PetscCall(PetscInfo(snes, "Newton iteration %" PetscInt_FMT ": residual %g, of its velocity rows %g (%g of their initial value)\n", snes->iter, (double)fnorm, (double)fv, (double)(fv0 > 0 ? fv / fv0 : 0.0)));
     PetscCall(VecNorm(X, NORM_2, &xnorm));
@@ -431,7 +430,7 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
       loose          = PETSC_FALSE;
       /* not in a stage without a TS (the consistent start: its two stages are different problems), not at the
          iteration that ended the last stage, nor at one whose successor max_its would end */
-      if (c->forcing > 0 && c->ts && history && !c->forcing_off && !kept && snes->iter < c->nrho && snes->iter + 1 < c->niter && snes->iter + 1 < snes->max_its) {
+      if (c->forcing > 0 && c->ts && history && !c->forcing_off && !kept && snes->iter < PHLEX_REDUCED_HISTORY && snes->iter + 1 < c->niter && snes->iter + 1 < snes->max_its) {
         const PetscReal fnext = c->rho[snes->iter] * fnorm, fvnext = c->rhov[snes->iter] * fv;
         const PetscReal ftarget = PetscMax(snes->abstol, snes->rtol * f0);
         if (fnext > 100.0 * ftarget || fvnext > 100.0 * c->vrtol * fv0) {
@@ -469,15 +468,14 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
     c->off_wait    = c->off_wait ? 2 * c->off_wait : 50;
   } else if (c->forcing_off && ++c->off_stages >= c->off_wait) c->forcing_off = PETSC_FALSE;
   if (snes->reason > 0) {
-    for (PetscInt k = 0; k < nrho; k++) {
+    for (PetscInt k = 0; k < PetscMin(snes->iter, PHLEX_REDUCED_HISTORY); k++) {
       c->rho[k]  = rho[k];
       c->rhov[k] = rhov[k];
     }
-    c->nrho      = nrho;
     c->niter     = snes->iter;
     c->rho_dt    = dt;
     c->rho_theta = theta;
-  } else c->nrho = 0;
+  } else c->niter = 0;
   PetscCall(VecRestoreSubVector(X0, sys->is[PHLEX_FIELD_VELOCITY], &v0));
   /* Sigma = Sigma_p + B (v - v0) / s: the stress whose resultant the momentum rows saw (through K) */
   PetscCall(VecGetSubVector(X, sys->is[PHLEX_FIELD_STRESS], &xs));
@@ -587,16 +585,15 @@ PetscErrorCode PhlexSNESReducedGetContractions(SNES snes, PetscReal rec[PHLEX_RE
   PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &reduced));
   if (reduced) {
     SNES_Reduced *c = (SNES_Reduced *)snes->data;
-    rec[0]          = (PetscReal)c->nrho;
+    rec[0]          = (PetscReal)c->niter;
     rec[1]          = c->rho_dt;
     rec[2]          = c->rho_theta;
     rec[3]          = c->forcing_off ? 1.0 : 0.0;
-    rec[4]          = (PetscReal)c->niter;
-    rec[5]          = (PetscReal)c->off_stages;
-    rec[6]          = (PetscReal)c->off_wait;
-    for (PetscInt k = 0; k < c->nrho; k++) {
-      rec[7 + k]                         = c->rho[k];
-      rec[7 + PHLEX_REDUCED_HISTORY + k] = c->rhov[k];
+    rec[4]          = (PetscReal)c->off_stages;
+    rec[5]          = (PetscReal)c->off_wait;
+    for (PetscInt k = 0; k < PetscMin(c->niter, PHLEX_REDUCED_HISTORY); k++) {
+      rec[6 + k]                         = c->rho[k];
+      rec[6 + PHLEX_REDUCED_HISTORY + k] = c->rhov[k];
     }
   }
   PetscFunctionReturn(0);
@@ -615,16 +612,15 @@ PetscErrorCode PhlexSNESReducedSetContractions(SNES snes, const PetscReal rec[PH
   PetscCall(PetscObjectTypeCompare((PetscObject)snes, "phlexreduced", &reduced));
   if (reduced) {
     SNES_Reduced *c = (SNES_Reduced *)snes->data;
-    c->nrho         = PetscMin(PetscMax((PetscInt)rec[0], 0), PHLEX_REDUCED_HISTORY);
+    c->niter        = PetscMax((PetscInt)rec[0], 0);
     c->rho_dt       = rec[1];
     c->rho_theta    = rec[2];
     c->forcing_off  = rec[3] != 0.0 ? PETSC_TRUE : PETSC_FALSE;
-    c->niter        = PetscMax((PetscInt)rec[4], 0);
-    c->off_stages   = PetscMax((PetscInt)rec[5], 0);
-    c->off_wait     = PetscMax((PetscInt)rec[6], 0);
-    for (PetscInt k = 0; k < c->nrho; k++) {
-      c->rho[k]  = rec[7 + k];
-      c->rhov[k] = rec[7 + PHLEX_REDUCED_HISTORY + k];
+    c->off_stages   = PetscMax((PetscInt)rec[4], 0);
+    c->off_wait     = PetscMax((PetscInt)rec[5], 0);
+    for (PetscInt k = 0; k < PetscMin(c->niter, PHLEX_REDUCED_HISTORY); k++) {
+      c->rho[k]  = rec[6 + k];
+      c->rhov[k] = rec[6 + PHLEX_REDUCED_HISTORY + k];
     }
   }
   PetscFunctionReturn(0);
