@@ -71,7 +71,7 @@ typedef struct {
      which predict the next stage's when it has the same length */
   PetscReal   rho[PHLEX_REDUCED_HISTORY], rhov[PHLEX_REDUCED_HISTORY], rho_dt, rho_theta;
   PetscInt    niter;    /* the last stage's Newton iterations (0: none to predict from); its first contractions are kept */
-  PetscBool   forcing_off; /* at this step size a stage with looser solves took more Newton iterations than the last */
+  PetscBool   forcing_off; /* paused: at this step size a stage with looser solves took more Newton iterations */
   PetscInt    off_stages, off_wait; /* stages since, and stages until the looser solves are tried again */
 } SNES_Reduced;
 
@@ -460,9 +460,9 @@ static PetscErrorCode SNESSolve_Reduced(SNES snes)
     snes->iter++;
   }
   /* a looser solve whose error the next Newton step could not absorb (the bilinear gyroscopic terms turn it into a
-     larger quadratic residual) cost a Newton iteration, more than it saved: not again at this step size */
+     larger quadratic residual) cost a Newton iteration, more than it saved: the looser solves pause, and are tried
+     again after 50 stages, then after twice as many each time they cost again (the motion changes) */
   if (loosened && (snes->reason <= 0 || snes->iter > c->niter)) {
-    /* tried again after 50 stages, then after twice as many each time it costs again (the motion changes) */
     c->forcing_off = PETSC_TRUE;
     c->off_stages  = 0;
     c->off_wait    = c->off_wait ? 2 * c->off_wait : 50;
