@@ -870,21 +870,42 @@ static PetscErrorCode FlexBorderMult(PhlexPart part, const PetscReal *x, Vec y)
 
 /* Mom_j (3 x nin, column-major, at Mom + 3 nin j) = sum_l Y_j(l) P_l^T: the moments with the node inputs of the k
    columns Y_j (3 values per node) of a dense matrix (leading dimension ldy; k = 1: a vector), node block by node block
-   so that the block of node inputs stays in cache while every column takes its moments (one pass over the inputs
-   instead of one per column) */
+   so that the block of node inputs stays in cache (one pass over the inputs instead of one per column). Several
+   columns are packed node-major first (3k x block), so that one product with 3k rows takes the moments of all of them:
+   with a product of 3 rows per column, PC phlexbordered's set-up at every Newton step took 2.2 times as long */
 static PetscErrorCode BorderMomentsColumns(PhlexFlexible b, const PetscScalar *Y, PetscInt ldy, PetscInt k, PetscScalar *Mom)
 {
-  const PetscInt nnode = b->nv_local / 3, nin = b->border_nin, chunk = 2048;
-  PetscBLASInt   bnode, bnin, blen, three = 3;
-  PetscScalar    one = 1.0;
+  const PetscInt nnode = b->nv_local / 3, nin = b->border_nin, chunk = 1024;
+  PetscBLASInt   bnode, bnin, blen, bm;
+  PetscScalar    one = 1.0, *pack = NULL, *acc;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscArrayzero(Mom, 3 * nin * k));
+  if (k < 1) PetscFunctionReturn(0);
   PetscCall(PetscBLASIntCast(nnode, &bnode));
   PetscCall(PetscBLASIntCast(nin, &bnin));
+  PetscCall(PetscBLASIntCast(3 * k, &bm));
+  if (k > 1) PetscCall(PetscMalloc2(3 * k * chunk, &pack, 3 * k * nin, &acc));
+  else acc = Mom;
+  PetscCall(PetscArrayzero(acc, 3 * nin * k));
   for (PetscInt l0 = 0; l0 < nnode; l0 += chunk) {
-    PetscCall(PetscBLASIntCast(PetscMin(chunk, nnode - l0), &blen));
-    for (PetscInt j = 0; j < k; j++) PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &three, &bnin, &blen, &one, Y + j * ldy + 3 * l0, &three, b->border_P + l0, &bnode, &one, Mom + 3 * nin * j, &three));
+    const PetscInt len = PetscMin(chunk, nnode - l0);
+    PetscCall(PetscBLASIntCast(len, &blen));
+    if (k > 1) {
+      /* pack[3 j + c + 3 k l] = Y_j(3 (l0 + l) + c) */
+      for (PetscInt j = 0; j < k; j++) {
+        const PetscScalar *y = Y + j * ldy + 3 * l0;
+        for (PetscInt l = 0; l < len; l++)
+          for (PetscInt c = 0; c < 3; c++) pack[3 * j + c + 3 * k * l] = y[3 * l + c];
+      }
+      PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &bm, &bnin, &blen, &one, pack, &bm, b->border_P + l0, &bnode, &one, acc, &bm));
+    } else PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &bm, &bnin, &blen, &one, Y + 3 * l0, &bm, b->border_P + l0, &bnode, &one, acc, &bm));
+  }
+  if (k > 1) {
+    /* acc (3k x nin, column-major) to Mom_j (3 x nin each) */
+    for (PetscInt j = 0; j < k; j++)
+      for (PetscInt i = 0; i < nin; i++)
+        for (PetscInt c = 0; c < 3; c++) Mom[3 * nin * j + c + 3 * i] = acc[3 * j + c + 3 * k * i];
+    PetscCall(PetscFree2(pack, acc));
   }
   PetscFunctionReturn(0);
 }
