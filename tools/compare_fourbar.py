@@ -46,6 +46,7 @@ def main():
     if not rows:
         sys.exit("%s: no configuration" % a.sweep)
     worst = [(0.0, None)] * 3
+    maxdev = [0.0] * 3  # the pass/fail test: every angle, 360 deg too
     out = []
     for r in rows:
         ang = float(r["position"])
@@ -53,17 +54,18 @@ def main():
         wr = interpolate(ref, ang)
         dev = [(w[k] - wr[k]) / wr[k] for k in range(3)]
         out.append([ang] + w + wr + dev)
+        # 360 deg repeats the configuration of 0 deg, whose frequencies it matches only to their precision (they move by
+        # up to 1.8e-6 with the BLAS kernels: fourbar_link_modes_coupler): it is reported as the worst angle only when it
+        # exceeds the worst so far by more than that; other ties: the first angle
+        twin = any(o[0] == ang - 360 for o in out[:-1])
         for k in range(3):
-            # ties (0 and 360 deg): the first angle. 360 deg is the configuration of 0 deg, whose frequencies agree only
-            # to their precision, about 6e-7 (fourbar_link_modes_coupler): it never replaces 0 deg as the worst
-            if ang is not None and ang >= 360 and any(r[0] == ang - 360 for r in out):
-                continue
-            if abs(dev[k]) > abs(worst[k][0]) * (1 + 1e-9):
+            if abs(dev[k]) > abs(worst[k][0]) * (1 + 1e-9) + (5e-6 if twin else 0.0):
                 worst[k] = (dev[k], ang)
+            maxdev[k] = max(maxdev[k], abs(dev[k]))
     ok = True
     for k in range(3):
         d, ang = worst[k]
-        status = "PASS" if abs(d) <= a.rtol else "FAIL"
+        status = "PASS" if maxdev[k] <= a.rtol else "FAIL"
         ok = ok and status == "PASS"
         print("%s omega%d: max |deviation| %.3f %% at %g deg over %d angles (tolerance %g %%): %s" % (a.label, k + 1, 100 * abs(d), ang if ang is not None else 0, len(rows), 100 * a.rtol, status))
     if a.out:

@@ -884,7 +884,7 @@ static PetscErrorCode BorderMomentsColumns(PhlexFlexible b, const PetscScalar *Y
   PetscCall(PetscBLASIntCast(nnode, &bnode));
   PetscCall(PetscBLASIntCast(nin, &bnin));
   PetscCall(PetscBLASIntCast(3 * k, &bm));
-  if (k > 1) PetscCall(PetscMalloc2(3 * k * chunk, &pack, 3 * k * nin, &acc));
+  if (k > 1) PetscCall(PetscMalloc2(3 * k * PetscMin(chunk, nnode), &pack, 3 * k * nin, &acc));
   else acc = Mom;
   PetscCall(PetscArrayzero(acc, 3 * nin * k));
   for (PetscInt l0 = 0; l0 < nnode; l0 += chunk) {
