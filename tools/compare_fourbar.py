@@ -56,7 +56,7 @@ def main():
         out.append([ang] + w + wr + dev)
         # 360 deg repeats the configuration of 0 deg, whose frequencies it matches only to their precision (they move by
         # up to 1.8e-6 with the BLAS kernels: fourbar_link_modes_coupler): it is reported as the worst angle only when it
-        # exceeds the worst so far by more than that; other ties: the first angle
+        # exceeds the worst so far by more than 5e-6 (about three times that); other ties: the first angle
         twin = any(o[0] == ang - 360 for o in out[:-1])
         for k in range(3):
             if abs(dev[k]) > abs(worst[k][0]) * (1 + 1e-9) + (5e-6 if twin else 0.0):
