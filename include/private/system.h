@@ -26,6 +26,7 @@ typedef struct {
   PetscErrorCode (*coefficients)(void *, PetscInt, PetscReal *);    /* beta_i with B_i ~ W_i beta_i: k x m column-major */
   PetscErrorCode (*rowsvec)(void *, PetscInt, Vec, PetscReal *);    /* y += C_i x (m values) */
   PetscErrorCode (*blockprefix)(void *, PetscInt, const char **);  /* name used in the options of block i */
+  PetscErrorCode (*blockoptions)(void *, PetscInt, const char **); /* options prefix of block i's body (body<k>_) */
 } PhlexBorderedData;
 
 typedef struct _p_PhlexSystem *PhlexSystem;

@@ -207,6 +207,13 @@ static PetscErrorCode BlockPrefix(void *ctx, PetscInt i, const char **name)
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode BlockOptions(void *ctx, PetscInt i, const char **prefix)
+{
+  PetscFunctionBeginUser;
+  *prefix = ((PhlexSystem)ctx)->fparts[i]->prefix;
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSystemSetUpBorder - the data of PC phlexbordered: the sparse blocks (condensed velocity operators), their
   border bases, the dense discrete block and the callbacks
@@ -227,6 +234,7 @@ PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem sys)
   bd->coefficients = BorderCoefficients;
   bd->rowsvec      = BorderRowsVec;
   bd->blockprefix  = BlockPrefix;
+  bd->blockoptions = BlockOptions;
   PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &bd->A));
   PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &bd->W));
   PetscCall(PetscCalloc2(PetscMax(sys->nfparts, 1), &bd->off, PetscMax(sys->nfparts, 1), &bd->n));

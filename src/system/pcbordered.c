@@ -16,9 +16,18 @@
    with full inertia (u-dependent borders, node-wise gyroscopic terms) it preconditions an outer Krylov method.
    The system composes what the PC needs on the preconditioning matrix ("phlex_border", system.h). Options of the
    solves with A_i: -<prefix>bordered_ksp_type, -<prefix>bordered_pc_type, ... (default preonly + Cholesky), and
-   per body -<prefix>bordered_<body>_ksp_type ... */
+   per body -<prefix>bordered_<body>_ksp_type ...; a body whose A_i is not symmetric (its frame's rate factored with
+   it) takes LU where Cholesky was asked, with the package of -<prefix>bordered_[<body>_]lu_mat_solver_type (default
+   the Cholesky's; CHOLMOD has none) */
 #include <phlex_impl.h>
 #include <petsc/private/pcimpl.h>
+
+/* per block: the factorization asked for; a Cholesky takes LU where the body's operator is not symmetric */
+typedef struct {
+  PetscBool chol;            /* Cholesky was asked for */
+  char      package[64];     /* its package as asked (empty: PETSc's default) */
+  char      lu_package[64];  /* -<prefix>bordered_[<body>_]lu_mat_solver_type: the LU's (empty: the Cholesky's) */
+} BlockFactor;
 
 typedef struct {
   PhlexBorderedData *bd;
@@ -30,6 +39,7 @@ typedef struct {
   PetscScalar       *S;      /* LU of the Schur complement, m x m column-major */
   PetscBLASInt      *S_piv;
   IS                *is;     /* per block: its rows in the PC's vector */
+  BlockFactor       *fact;   /* per block */
   PetscInt           nfactor;
   PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
   char             **copy_from, **copy_to;
@@ -177,6 +187,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   pb->m  = bd->m;
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->ksp, PetscMax(pb->nb, 1), &pb->Y, PetscMax(pb->nb, 1), &pb->Astate, PetscMax(pb->nb, 1), &pb->Wstate, PetscMax(pb->nb, 1), &pb->beta));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
+  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->fact));
   PetscCall(PetscMalloc2(PetscMax(pb->m * pb->m, 1), &pb->S, PetscMax(pb->m, 1), &pb->S_piv));
   PetscCall(MatGetOwnershipRange(pc->pmat, &rstart, NULL));
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
@@ -203,8 +214,56 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
     PetscCall(PetscSNPrintf(bprefix, sizeof(bprefix), "%s_", name));
     PetscCall(KSPAppendOptionsPrefix(pb->ksp[i], bprefix));
     PetscCall(KSPSetFromOptions(pb->ksp[i]));
+    /* what was asked; a Cholesky takes LU where the body's operator is not symmetric (BlockFactorType) */
+    PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCCHOLESKY, &pb->fact[i].chol));
+    if (pb->fact[i].chol) {
+      MatSolverType type;
+      const char   *kprefix;
+      PetscCall(PCFactorGetMatSolverType(inner, &type));
+      if (type) PetscCall(PetscStrncpy(pb->fact[i].package, type, sizeof(pb->fact[i].package)));
+      PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
+      PetscOptionsBegin(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", "PC");
+      PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", pb->fact[i].lu_package, pb->fact[i].lu_package, sizeof(pb->fact[i].lu_package), NULL));
+      PetscOptionsEnd();
+    }
   }
   PetscCall(RefuseSharedSuperLUDist(pc, pb));
+  PetscFunctionReturn(0);
+}
+
+/* Block i's factorization for its operator A: where Cholesky was asked for, LU from the first time A is known not to
+   be symmetric (a body's condensed operator with the node-wise inertia of its frame's rate), with the package of
+   -<prefix>bordered_[<body>_]lu_mat_solver_type or else the Cholesky's. An LU package that cannot factor A is named
+   with the options (CHOLMOD, the Cholesky of the one-process preset bordered_serial.opts, has no LU) */
+static PetscErrorCode BlockFactorType(PC pc, PC_Bordered *pb, PetscInt i, Mat A)
+{
+  BlockFactor *f = &pb->fact[i];
+  PC           inner;
+  PetscBool    set, symm, want_lu, is_lu, avail = PETSC_TRUE;
+  const char  *package, *name;
+
+  PetscFunctionBeginUser;
+  if (!f->chol) PetscFunctionReturn(0);
+  PetscCall(KSPGetPC(pb->ksp[i], &inner));
+  PetscCall(MatIsSymmetricKnown(A, &set, &symm));
+  want_lu = (PetscBool)(set && !symm);
+  PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCLU, &is_lu));
+  if (!want_lu || is_lu) PetscFunctionReturn(0);
+  package = f->lu_package[0] ? f->lu_package : f->package;
+  PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
+  if (package[0]) PetscCall(MatGetFactorAvailable(A, package, MAT_FACTOR_LU, &avail));
+  if (!avail) {
+    const char *prefix, *body;
+    MatType     type;
+    PetscCall(PCGetOptionsPrefix(pc, &prefix));
+    PetscCall((*pb->bd->blockoptions)(pb->bd->ctx, i, &body));
+    PetscCall(MatGetType(A, &type));
+    PetscCheck(!f->lu_package[0], PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and -%sbordered_lu_mat_solver_type %s has no LU of its matrix type %s: use mumps, or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, prefix ? prefix : "", package, type, body);
+    SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and %s, the package of its Cholesky (-%sbordered_pc_factor_mat_solver_type), has no LU of its matrix type %s: give -%sbordered_lu_mat_solver_type mumps (as options/solver/bordered_serial.opts does), or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, package, prefix ? prefix : "", type, prefix ? prefix : "", body);
+  }
+  PetscCall(PCSetType(inner, PCLU));
+  if (package[0]) PetscCall(PCFactorSetMatSolverType(inner, package));
+  PetscCall(PetscInfo(pc, "block %s: not symmetric, LU instead of Cholesky, with %s\n", name, package[0] ? package : "PETSc's default package"));
   PetscFunctionReturn(0);
 }
 
@@ -232,24 +291,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     if (pb->Astate[i] == sa && pb->Wstate[i] == sw && (pb->Y[i] || !bd->W[i])) continue;
     PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pc, 0, 0, 0));
     PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
-    {
-      /* a body whose condensed operator is not symmetric (the node-wise inertia of its frame's rate) takes LU where
-         Cholesky was asked for, with the same factorization package */
-      PC        inner;
-      PetscBool chol, set, symm;
-      PetscCall(KSPGetPC(pb->ksp[i], &inner));
-      PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCCHOLESKY, &chol));
-      PetscCall(MatIsSymmetricKnown(bd->A[i], &set, &symm));
-      if (chol && set && !symm) {
-        MatSolverType type;
-        char          package[64] = "";
-        PetscCall(PCFactorGetMatSolverType(inner, &type));
-        if (type) PetscCall(PetscStrncpy(package, type, sizeof(package)));
-        PetscCall(PCSetType(inner, PCLU));
-        if (package[0]) PetscCall(PCFactorSetMatSolverType(inner, package));
-        PetscCall(PetscInfo(pc, "block %" PetscInt_FMT ": not symmetric, LU instead of Cholesky\n", i));
-      }
-    }
+    PetscCall(BlockFactorType(pc, pb, i, bd->A[i]));
     PetscCall(KSPSetUp(pb->ksp[i]));
     PetscCall(MatDestroy(&pb->Y[i]));
     if (bd->W[i]) {
@@ -385,6 +427,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   }
   PetscCall(PetscFree5(pb->ksp, pb->Y, pb->Astate, pb->Wstate, pb->beta));
   PetscCall(PetscFree(pb->is));
+  PetscCall(PetscFree(pb->fact));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
   PetscCall(BorderedCopiesFree(pb));
   pb->bd = NULL;
