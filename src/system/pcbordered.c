@@ -214,15 +214,18 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
     PetscCall(PetscSNPrintf(bprefix, sizeof(bprefix), "%s_", name));
     PetscCall(KSPAppendOptionsPrefix(pb->ksp[i], bprefix));
     PetscCall(KSPSetFromOptions(pb->ksp[i]));
-    /* what was asked; a Cholesky takes LU where the body's operator is not symmetric (BlockFactorType) */
+    /* what was asked; a Cholesky takes LU where the body's operator is not symmetric (BlockFactorType). The LU's
+       package is read whatever was asked, so that a preset's value is used where its Cholesky is replaced */
     PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCCHOLESKY, &pb->fact[i].chol));
     if (pb->fact[i].chol) {
       MatSolverType type;
-      const char   *kprefix;
       PetscCall(PCFactorGetMatSolverType(inner, &type));
       if (type) PetscCall(PetscStrncpy(pb->fact[i].package, type, sizeof(pb->fact[i].package)));
+    }
+    {
+      const char *kprefix;
       PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
-      PetscOptionsBegin(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", "PC");
+      PetscOptionsBegin(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", NULL);
       PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", pb->fact[i].lu_package, pb->fact[i].lu_package, sizeof(pb->fact[i].lu_package), NULL));
       PetscOptionsEnd();
     }
@@ -258,8 +261,8 @@ static PetscErrorCode BlockFactorType(PC pc, PC_Bordered *pb, PetscInt i, Mat A)
     PetscCall(PCGetOptionsPrefix(pc, &prefix));
     PetscCall((*pb->bd->blockoptions)(pb->bd->ctx, i, &body));
     PetscCall(MatGetType(A, &type));
-    PetscCheck(!f->lu_package[0], PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and -%sbordered_lu_mat_solver_type %s has no LU of its matrix type %s: use mumps, or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, prefix ? prefix : "", package, type, body);
-    SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and %s, the package of its Cholesky (-%sbordered_pc_factor_mat_solver_type), has no LU of its matrix type %s: give -%sbordered_lu_mat_solver_type mumps (as options/solver/bordered_serial.opts does), or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, package, prefix ? prefix : "", type, prefix ? prefix : "", body);
+    PetscCheck(!f->lu_package[0], PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and -%sbordered_[%s_]lu_mat_solver_type %s has no LU of its matrix type %s: use mumps, or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, prefix ? prefix : "", name, package, type, body);
+    SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and %s, the package of its Cholesky (-%sbordered_[%s_]pc_factor_mat_solver_type), has no LU of its matrix type %s: give -%sbordered_lu_mat_solver_type mumps (as options/solver/bordered_serial.opts does), or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, package, prefix ? prefix : "", name, type, prefix ? prefix : "", body);
   }
   PetscCall(PCSetType(inner, PCLU));
   if (package[0]) PetscCall(PCFactorSetMatSolverType(inner, package));
