@@ -23,6 +23,8 @@ rotating_linearized|-options_file options/rotating_cantilever.yaml -body0_dm_ple
 rotating_transient|-options_file options/rotating_cantilever.yaml -analysis transient -body0_dm_plex_filename meshes/rotating_beam_nx8.msh -body0_spin 0,0,300 -ts_dt 1e-3 -ts_max_steps 2|0
 checkpoint|-options_file options/flexible_double_pendulum.yaml -body0_dm_plex_filename meshes/bar_struct_n1.msh -body1_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1 -body1_petscspace_degree 1 -ts_max_steps 3 -output_interval 1 -checkpoint_interval 2|0
 restart|-options_file options/flexible_double_pendulum.yaml -body0_dm_plex_filename meshes/bar_struct_n1.msh -body1_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1 -body1_petscspace_degree 1 -ts_max_steps 5 -output_interval 1 -checkpoint_interval 2 -restart build/memcheck/checkpoint/run/checkpoint.h5|0
+bordered_serial|-options_file options/flexible_double_pendulum.yaml -body0_dm_plex_filename meshes/bar_struct_n1.msh -body1_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1 -body1_petscspace_degree 1 -ts_max_steps 2 -output_fields 0 -solver_options_file options/solver/bordered_serial.opts|0
+bordered_lu_error|-options_file options/floating_tumbling.yaml -body0_dm_plex_filename meshes/bar_struct_n2.msh -ts_max_steps 2 -output_fields 0 -reduced_bordered_pc_factor_mat_solver_type cholmod|2
 adaptive_retry|-options_file options/pendulum.yaml -ts_dt 2.75 -ts_max_time 6 -ts_adapt_type basic|0
 help|-help|0
 help_scene|-options_file options/cantilever.yaml -help|0
