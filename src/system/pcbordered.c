@@ -22,13 +22,6 @@
 #include <phlex_impl.h>
 #include <petsc/private/pcimpl.h>
 
-/* per block: the factorization asked for; a Cholesky takes LU where the body's operator is not symmetric */
-typedef struct {
-  PetscBool chol;            /* Cholesky was asked for */
-  char      package[64];     /* its package as asked (empty: PETSc's default) */
-  char      lu_package[64];  /* -<prefix>bordered_[<body>_]lu_mat_solver_type: the LU's (empty: the Cholesky's) */
-} BlockFactor;
-
 typedef struct {
   PhlexBorderedData *bd;
   PetscInt           nb, m;
@@ -39,7 +32,7 @@ typedef struct {
   PetscScalar       *S;      /* LU of the Schur complement, m x m column-major */
   PetscBLASInt      *S_piv;
   IS                *is;     /* per block: its rows in the PC's vector */
-  BlockFactor       *fact;   /* per block */
+  char             (*lu_package)[64]; /* per block: -<prefix>bordered_[<body>_]lu_mat_solver_type (empty: the Cholesky's) */
   PetscInt           nfactor;
   PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
   char             **copy_from, **copy_to;
@@ -187,7 +180,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   pb->m  = bd->m;
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->ksp, PetscMax(pb->nb, 1), &pb->Y, PetscMax(pb->nb, 1), &pb->Astate, PetscMax(pb->nb, 1), &pb->Wstate, PetscMax(pb->nb, 1), &pb->beta));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
-  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->fact));
+  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->lu_package));
   PetscCall(PetscMalloc2(PetscMax(pb->m * pb->m, 1), &pb->S, PetscMax(pb->m, 1), &pb->S_piv));
   PetscCall(MatGetOwnershipRange(pc->pmat, &rstart, NULL));
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
@@ -214,19 +207,13 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
     PetscCall(PetscSNPrintf(bprefix, sizeof(bprefix), "%s_", name));
     PetscCall(KSPAppendOptionsPrefix(pb->ksp[i], bprefix));
     PetscCall(KSPSetFromOptions(pb->ksp[i]));
-    /* what was asked; a Cholesky takes LU where the body's operator is not symmetric (BlockFactorType). The LU's
-       package is read whatever was asked, so that a preset's value is used where its Cholesky is replaced */
-    PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCCHOLESKY, &pb->fact[i].chol));
-    if (pb->fact[i].chol) {
-      MatSolverType type;
-      PetscCall(PCFactorGetMatSolverType(inner, &type));
-      if (type) PetscCall(PetscStrncpy(pb->fact[i].package, type, sizeof(pb->fact[i].package)));
-    }
+    /* the package of the LU that a Cholesky takes where the body's operator is not symmetric (BlockFactorType),
+       read whatever was asked, so that a preset's value is used where its Cholesky is replaced */
     {
       const char *kprefix;
       PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
       PetscOptionsBegin(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", NULL);
-      PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", pb->fact[i].lu_package, pb->fact[i].lu_package, sizeof(pb->fact[i].lu_package), NULL));
+      PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", pb->lu_package[i], pb->lu_package[i], sizeof(pb->lu_package[i]), NULL));
       PetscOptionsEnd();
     }
   }
@@ -240,19 +227,20 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
    with the options (CHOLMOD, the Cholesky of the one-process preset bordered_serial.opts, has no LU) */
 static PetscErrorCode BlockFactorType(PC pc, PC_Bordered *pb, PetscInt i, Mat A)
 {
-  BlockFactor *f = &pb->fact[i];
-  PC           inner;
-  PetscBool    set, symm, want_lu, is_lu, avail = PETSC_TRUE;
-  const char  *package, *name;
+  PC            inner;
+  PetscBool     chol, set, symm, avail = PETSC_TRUE;
+  MatSolverType asked;
+  char          package[64] = "";
+  const char   *name;
 
   PetscFunctionBeginUser;
-  if (!f->chol) PetscFunctionReturn(0);
   PetscCall(KSPGetPC(pb->ksp[i], &inner));
+  PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCCHOLESKY, &chol));
   PetscCall(MatIsSymmetricKnown(A, &set, &symm));
-  want_lu = (PetscBool)(set && !symm);
-  PetscCall(PetscObjectTypeCompare((PetscObject)inner, PCLU, &is_lu));
-  if (!want_lu || is_lu) PetscFunctionReturn(0);
-  package = f->lu_package[0] ? f->lu_package : f->package;
+  if (!chol || !set || symm) PetscFunctionReturn(0);
+  PetscCall(PCFactorGetMatSolverType(inner, &asked));
+  if (pb->lu_package[i][0]) PetscCall(PetscStrncpy(package, pb->lu_package[i], sizeof(package)));
+  else if (asked) PetscCall(PetscStrncpy(package, asked, sizeof(package))); /* copied: PCSetType frees it */
   PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
   if (package[0]) PetscCall(MatGetFactorAvailable(A, package, MAT_FACTOR_LU, &avail));
   if (!avail) {
@@ -261,7 +249,7 @@ static PetscErrorCode BlockFactorType(PC pc, PC_Bordered *pb, PetscInt i, Mat A)
     PetscCall(PCGetOptionsPrefix(pc, &prefix));
     PetscCall((*pb->bd->blockoptions)(pb->bd->ctx, i, &body));
     PetscCall(MatGetType(A, &type));
-    PetscCheck(!f->lu_package[0], PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and -%sbordered_[%s_]lu_mat_solver_type %s has no LU of its matrix type %s: use mumps, or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, prefix ? prefix : "", name, package, type, body);
+    PetscCheck(!pb->lu_package[i][0], PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and -%sbordered_[%s_]lu_mat_solver_type %s has no LU of its matrix type %s: use mumps, or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, prefix ? prefix : "", name, package, type, body);
     SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "body %s: its condensed operator is not symmetric (its frame's rate is factored with it, -%spreconditioner_rate_tol), and %s, the package of its Cholesky (-%sbordered_[%s_]pc_factor_mat_solver_type), has no LU of its matrix type %s: give -%sbordered_lu_mat_solver_type mumps (as options/solver/bordered_serial.opts does), or keep the rate out of the factorization with -%spreconditioner_rate_tol 0", name, body, package, prefix ? prefix : "", name, type, prefix ? prefix : "", body);
   }
   PetscCall(PCSetType(inner, PCLU));
@@ -430,7 +418,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   }
   PetscCall(PetscFree5(pb->ksp, pb->Y, pb->Astate, pb->Wstate, pb->beta));
   PetscCall(PetscFree(pb->is));
-  PetscCall(PetscFree(pb->fact));
+  PetscCall(PetscFree(pb->lu_package));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
   PetscCall(BorderedCopiesFree(pb));
   pb->bd = NULL;
