@@ -76,6 +76,7 @@ struct _p_PhlexScene {
   PetscReal            assembly_tol;    /* position-level closure tolerance, relative to the reference length */
   PetscInt             assembly_max_it;
   PetscInt             project_interval; /* drift projection every n steps (0: never) */
+  PetscBool            whole_bodies;     /* each flexible body whole on one process (-whole_bodies) */
 };
 
 #include <private/flexible.h>

@@ -158,6 +158,8 @@ struct _p_PhlexFlexible {
   PetscInt            degree;            /* velocity P_k, stress P_{k-1} discontinuous */
   PetscBool           rcm;               /* the mesh's points renumbered by reverse Cuthill-McKee (-node_order rcm) */
   PetscInt            extra_refinements; /* uniform refinements on top of -dm_refine (convergence studies) */
+  PetscInt            process;           /* the process that holds the whole body (-process, -whole_bodies); -1: its
+                                            cells are split over all processes */
   char                frame_patch[PHLEX_NAME_LEN]; /* Dirichlet patch Gamma_D ("" for none) */
   PetscInt            frame_tag;
   PetscReal           frame_area, frame_centroid[3], frame_inertia[9]; /* SI geometry of the frame patch */

@@ -148,6 +148,8 @@ struct _p_PhlexPart {
                                       fingerprint */
   PhlexPartOps      ops;
   void             *data;
+  PetscInt64       *process_cells; /* with -whole_bodies: the scene's count of cells per process of the bodies placed
+                                      so far (a flexible body goes whole to the process with the fewest); else NULL */
   const PhlexUnits *units;
   PetscReal         gravity[3]; /* non-dimensional, inertial frame */
 

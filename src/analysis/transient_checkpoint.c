@@ -313,7 +313,7 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
       SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);
     }
     if (numbering) {
-      PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for this scene with its field unknowns numbered otherwise (its parts '%s', this scene's '%s'; after '@' a hash of where each body's unknowns are in its mesh): restart with the same mesh files, their nodes in the same order, the same -body<k>_node_order and partitioner", file, ck_parts, parts));
+      PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for this scene with its field unknowns numbered otherwise (its parts '%s', this scene's '%s'; after '@' a hash of where each body's unknowns are in its mesh): restart with the same mesh files, their nodes in the same order, the same -body<k>_node_order and partitioner (-body<k>_petscpartitioner_type, -whole_bodies, -body<k>_process)", file, ck_parts, parts));
       PetscCall(PetscFree(parts));
       PetscCall(PetscFree(ck_parts));
       SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);
@@ -356,7 +356,7 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
   {
     PetscInt mine = 0;
     for (PetscInt i = 0; i < m->sys->nparts; i++)
-      if (m->sys->parts[i]->nv) mine++;
+      if (m->sys->parts[i]->Nv) mine++;
     if (!m->scene->output->fields) mine = 0;
     PetscCheck(mine == fields, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written %s field output (-output_fields %d): restart with the same", file, fields ? "with" : "without", fields ? 1 : 0);
   }

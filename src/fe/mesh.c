@@ -231,6 +231,43 @@ PetscErrorCode PhlexMeshFindGroup(PhlexFlexible body, const char name[], PetscIn
   PetscFunctionReturn(0);
 }
 
+/* The whole body on one process (-<prefix>process, or -whole_bodies: the process with the fewest cells of the bodies
+   placed so far, the lowest such): a shell partition that sends every cell of the reading rank there. The body's
+   sparse solves can then be sequential and run concurrently with the other processes' bodies (PC phlexbordered). */
+static PetscErrorCode PlaceWhole(PhlexFlexible body, DM dm, PetscPartitioner part)
+{
+  PetscInt   *sizes, *points, cStart, cEnd, n;
+  PetscInt64  total, local;
+  PetscMPIInt size;
+  PetscBool   given;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(body->comm, &size));
+  PetscCall(PetscOptionsHasName(NULL, body->prefix, "-petscpartitioner_type", &given));
+  PetscCheck(!given, body->comm, PETSC_ERR_USER_INPUT, "body %s: -%spetscpartitioner_type splits the body's cells over the processes, while %s%s puts the whole body on one process: give one of them", body->name, body->prefix, body->process >= 0 ? "-" : "-whole_bodies", body->process >= 0 ? body->prefix : "");
+  if (body->process >= 0) {
+    PetscCheck(body->process < size, body->comm, PETSC_ERR_USER_INPUT, "body %s: -%sprocess %" PetscInt_FMT ": the run has %d processes, numbered 0 to %d", body->name, body->prefix, body->process, (int)size, (int)size - 1);
+  } else {
+    body->process = 0;
+    for (PetscMPIInt r = 1; r < size; r++)
+      if (body->part->process_cells[r] < body->part->process_cells[body->process]) body->process = r;
+  }
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  n     = cEnd - cStart;
+  local = n;
+  PetscCallMPI(MPI_Allreduce(&local, &total, 1, MPIU_INT64, MPI_SUM, body->comm));
+  if (body->part->process_cells) body->part->process_cells[body->process] += total;
+  PetscCall(PetscCalloc1(size, &sizes));
+  PetscCall(PetscMalloc1(PetscMax(n, 1), &points));
+  sizes[body->process] = n;
+  for (PetscInt c = 0; c < n; c++) points[c] = c;
+  PetscCall(PetscPartitionerSetType(part, PETSCPARTITIONERSHELL));
+  PetscCall(PetscPartitionerShellSetPartition(part, size, sizes, points));
+  PetscCall(PetscFree(sizes));
+  PetscCall(PetscFree(points));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexMeshLoad - reads the body's gmsh file into a distributed, interpolated DMPlex and checks its cells
 
@@ -242,7 +279,8 @@ PetscErrorCode PhlexMeshFindGroup(PhlexFlexible body, const char name[], PetscIn
   Options Database Keys (body prefix):
 + -dm_refine <n>          - uniform refinements after distribution
 . -dm_plex_check_all      - DMPlex consistency checks
-- -petscpartitioner_type  - partitioner: phlexmetis (default), ptscotch
+. -petscpartitioner_type  - partitioner: phlexmetis (default), ptscotch
+- -process <r>            - the whole body on process r (also -whole_bodies, scene.c)
 
   Notes:
   Tetrahedra only. Hexahedra are refused: with discontinuous Q_{k-1} stress the stress space does not contain the
@@ -313,6 +351,7 @@ PetscErrorCode PhlexMeshLoad(PhlexFlexible body)
      varies), so that a checkpoint's layout is found again at restart */
   PetscCall(PetscPartitionerSetType(part, "phlexmetis"));
   PetscCall(PetscPartitionerSetFromOptions(part));
+  if (size > 1 && (body->process >= 0 || body->part->process_cells)) PetscCall(PlaceWhole(body, dm, part));
   if (size > 1) {
     PetscCall(DMPlexDistribute(dm, 0, NULL, &dmdist));
     if (dmdist) {

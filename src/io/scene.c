@@ -57,6 +57,7 @@ PetscErrorCode PhlexSceneFindPart(PhlexScene s, const char name[], PhlexPart *pa
 . -scale_density <kg/m^3>           - reference density (default: the largest density of the flexible bodies)
 . -scale_modulus <Pa>               - reference modulus (default: the largest Young's modulus)
 . -gravity gx,gy,gz                 - gravitational acceleration (inertial frame) [m/s^2]
+. -whole_bodies                     - each flexible body whole on one process (its solves sequential, concurrent with the others')
 . -joints_redundant <error,drop,keep> - redundant constraint components found at set-up: an error, dropped, or kept
 . -assembly_tol <r>                 - tolerance of the position-level closure of the loops (relative to the reference length)
 - -joints_project_interval <n>      - project the positions back onto the joints every n steps (0: never)
@@ -78,6 +79,7 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
   PetscCall(PetscOptionsEList("-joints_redundant", "Redundant constraint components (for the rigid motion) found at set-up: error, drop them, or keep them (a flexible body on each such joint takes up the over-constraint)", "PhlexSceneSetFromOptions", PhlexRedundantPolicies, 3, PhlexRedundantPolicies[policy], &policy, NULL));
   PetscCall(PetscOptionsReal("-assembly_tol", "Position-level closure of the joints before the first step, relative to the reference length", "PhlexSceneSetFromOptions", s->assembly_tol, &s->assembly_tol, NULL));
   PetscCall(PetscOptionsInt("-assembly_max_it", "Newton iterations of the position-level closure", "PhlexSceneSetFromOptions", s->assembly_max_it, &s->assembly_max_it, NULL));
+  PetscCall(PetscOptionsBool("-whole_bodies", "Each flexible body whole on one process, the next body on the process with the fewest cells so far (-<body>_process places one body): a mechanism's bodies factor and solve concurrently, each with a sequential solver (PC phlexbordered); default: every body split over all processes", "PhlexSceneSetFromOptions", s->whole_bodies, &s->whole_bodies, NULL));
   PetscCall(PetscOptionsInt("-joints_project_interval", "Project the positions back onto the joints every n steps (0: never); the energy change is reported", "PhlexSceneSetFromOptions", s->project_interval, &s->project_interval, NULL));
   PetscOptionsEnd();
   s->redundant = (PhlexRedundantPolicy)policy;
@@ -199,7 +201,17 @@ PetscErrorCode PhlexSceneSetUp(PhlexScene s)
   PetscFunctionBeginUser;
   if (s->setup) PetscFunctionReturn(0);
   PetscCall(PetscCalloc1(s->nparts, &h));
-  for (PetscInt k = 0; k < s->nparts; k++) PetscCall((*s->parts[k]->ops.geometry)(s->parts[k], &h[k]));
+  {
+    /* -whole_bodies: the meshes are read in turn, each body to the process with the fewest cells so far */
+    PetscInt64 *cells = NULL;
+    PetscMPIInt size;
+    PetscCallMPI(MPI_Comm_size(s->comm, &size));
+    if (s->whole_bodies && size > 1) PetscCall(PetscCalloc1(size, &cells));
+    for (PetscInt k = 0; k < s->nparts; k++) s->parts[k]->process_cells = cells;
+    for (PetscInt k = 0; k < s->nparts; k++) PetscCall((*s->parts[k]->ops.geometry)(s->parts[k], &h[k]));
+    for (PetscInt k = 0; k < s->nparts; k++) s->parts[k]->process_cells = NULL;
+    PetscCall(PetscFree(cells));
+  }
   PetscCall(SceneSetUnits(s, h, s->nparts));
   PetscCall(PetscFree(h));
   for (PetscInt k = 0; k < s->nparts; k++) {

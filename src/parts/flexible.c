@@ -40,6 +40,7 @@ static PetscErrorCode MaterialSetFromOptions(PhlexFlexible b, PhlexMaterial *m, 
    -dm_plex_filename <file>  gmsh mesh (.msh 2.2 or 4.1, ASCII or binary)
    -petscspace_degree <k>    velocity degree k (1 or 2); the stress is discontinuous of degree k-1
    -node_order rcm|file      numbering of the mesh's points (and unknowns): reverse Cuthill-McKee, or as read
+   -process <r>              the whole body on process r (else split over all, or placed by -whole_bodies)
    -motion fixed|floating    the frame is held (clamped on the frame patch) or moves
    -frame patch|mean_axes    how the frame of a floating body is fixed to it
    -frame_patch <group>      physical surface where u_f = v_f = 0 (fixed: the clamp; floating: the frame)
@@ -52,7 +53,8 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   char         *rptr[PHLEX_MAX_MATERIALS + 1], **pptr; /* room for one more region: too many are refused, not cut */
   PetscInt      nregions = PHLEX_MAX_MATERIALS + 1, nports;
   PetscBool     flg, flg_mesh = PETSC_FALSE, has_body_material, fcond = PETSC_FALSE, ff = PETSC_FALSE, fm = PETSC_FALSE;
-  PetscBool     spin_given = PETSC_FALSE, center_given = PETSC_FALSE, rate_given = PETSC_FALSE;
+  PetscBool     spin_given = PETSC_FALSE, center_given = PETSC_FALSE, rate_given = PETSC_FALSE, process_given = PETSC_FALSE;
+  PetscMPIInt   size;
   PetscInt      motion = 0, inertia = 0, cond = PHLEX_FRAME_PATCH, order = b->rcm ? 1 : 0;
   const char   *given = NULL;
   char          who[PHLEX_NAME_LEN + 8];
@@ -69,6 +71,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   /* rcm: the unknowns of neighbouring nodes close in memory; the sparse products gather their vectors from cache
      (a mass matrix times 8 vectors: 2.2 x faster, BENCHMARKS.md section 14), the factorizations order for themselves */
   PetscCall(PetscOptionsEList("-node_order", "Numbering of the mesh's points and so of the unknowns: rcm (reverse Cuthill-McKee, neighbours close in memory: faster sparse products) or file (as read)", "PhlexFlexibleSetFromOptions", PhlexNodeOrders, 2, PhlexNodeOrders[order], &order, NULL));
+  PetscCall(PetscOptionsInt("-process", "The process that holds the whole body (its solves sequential there, concurrent with the other processes' bodies in PC phlexbordered); default: split over all processes, or placed by -whole_bodies", "PhlexFlexibleSetFromOptions", b->process, &b->process, &process_given));
   PetscCall(PetscOptionsEList("-motion", "Rigid motion of the body frame: fixed (clamped patch held) or floating (the frame moves)", "PhlexFlexibleSetFromOptions", PhlexMotionTypes, 2, PhlexMotionTypes[motion], &motion, NULL));
   PetscCall(PetscOptionsString("-frame_patch", "Physical surface where u_f = v_f = 0: the clamp of a fixed body, the frame patch of a floating one", "PhlexFlexibleSetFromOptions", b->frame_patch, b->frame_patch, sizeof(b->frame_patch), NULL));
   PetscCall(PetscOptionsEList("-frame", "Floating body: frame fixed by a patch (-frame_patch, a rigid inclusion) or by mean axes (Tisserand: int rho u_f = 0, int rho (x - P) x u_f = 0)", "PhlexFlexibleSetFromOptions", PhlexFrameConditions, 2, PhlexFrameConditions[cond], &cond, &fcond));
@@ -116,6 +119,8 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   b->gyroscopic     = inertia == 1 ? PETSC_TRUE : PETSC_FALSE;
   b->inertia_model  = PhlexInertiaTypes[inertia];
   b->frame_loaded   = (ff || fm) ? PETSC_TRUE : PETSC_FALSE;
+  PetscCallMPI(MPI_Comm_size(b->comm, &size));
+  PetscCheck(!process_given || (b->process >= 0 && b->process < size), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sprocess %" PetscInt_FMT ": the run has %d process%s, numbered 0 to %d", b->name, b->prefix, b->process, (int)size, size == 1 ? "" : "es", (int)size - 1);
   PetscCheck(b->pc_rate_tol >= 0 && !PetscIsInfOrNanReal(b->pc_rate_tol), b->comm, PETSC_ERR_USER_INPUT, "body %s: -%spreconditioner_rate_tol must be >= 0 (0: off), got %g", b->name, b->prefix, (double)b->pc_rate_tol);
   /* a fixed body has no rigid state: its rigid options would be silently ignored */
   if (!b->floating) {
@@ -351,6 +356,11 @@ static PetscErrorCode FlexView(PhlexPart part, PetscViewer viewer)
   PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: mesh %s, %" PetscInt_FMT " tetrahedra, velocity P%" PetscInt_FMT " (%" PetscInt_FMT " dofs), stress P%" PetscInt_FMT " discontinuous (%" PetscInt_FMT " dofs)\n", b->name, b->mesh_file, gcells, b->degree, b->nv_global, b->degree - 1, b->ns_global));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PetscViewerASCIIPrintf(viewer, "volume %.6g m^3, mass %.6g kg, centre of mass (%.6g, %.6g, %.6g) m\n", (double)b->volume, (double)b->mass, (double)b->center_of_mass[0], (double)b->center_of_mass[1], (double)b->center_of_mass[2]));
+  if (b->process >= 0) {
+    PetscMPIInt size;
+    PetscCallMPI(MPI_Comm_size(b->comm, &size));
+    if (size > 1) PetscCall(PetscViewerASCIIPrintf(viewer, "whole on process %" PetscInt_FMT " (of %d)\n", b->process, (int)size));
+  }
   if (b->floating) {
     PetscReal q[4];
     if (b->frame_condition == PHLEX_FRAME_PATCH) PetscCall(PetscViewerASCIIPrintf(viewer, "floating frame on patch %s (origin P at (%.6g, %.6g, %.6g) m), %s inertia\n", b->frame_patch, (double)b->origin[0], (double)b->origin[1], (double)b->origin[2], b->inertia_model));
@@ -597,6 +607,7 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   b->prefix    = part->prefix;
   b->degree    = 2;
   b->rcm       = PETSC_TRUE;
+  b->process   = -1;
   b->frame_tag = -1;
   b->ic_velocity.amplitude = b->ic_displacement.amplitude = b->ic_stress.amplitude = 1.0;
   b->ic_velocity.mode = b->ic_displacement.mode = b->ic_stress.mode = 1;

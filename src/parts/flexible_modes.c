@@ -515,6 +515,7 @@ PetscErrorCode PhlexFlexibleRefine(PhlexPart part, PetscInt level, PhlexPart *fi
   PetscCall(PhlexPartCreate(part->comm, part->index, fine));
   PetscCall(PhlexPartSetFromOptions(*fine));
   ((PhlexFlexible)(*fine)->data)->extra_refinements = level;
+  ((PhlexFlexible)(*fine)->data)->process           = ((PhlexFlexible)part->data)->process; /* where -whole_bodies put it */
   (*fine)->units = part->units;
   for (PetscInt k = 0; k < 3; k++) (*fine)->gravity[k] = part->gravity[k];
   PetscCall((*(*fine)->ops.geometry)(*fine, &h));

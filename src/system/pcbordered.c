@@ -18,7 +18,10 @@
    solves with A_i: -<prefix>bordered_ksp_type, -<prefix>bordered_pc_type, ... (default preonly + Cholesky), and
    per body -<prefix>bordered_<body>_ksp_type ...; a body whose A_i is not symmetric (its frame's rate factored with
    it) takes LU where Cholesky was asked, with the package of -<prefix>bordered_[<body>_]lu_mat_solver_type (default
-   the Cholesky's; CHOLMOD has none) */
+   the Cholesky's; CHOLMOD has none).
+   A body whole on one process (-whole_bodies, -<body>_process) is solved by a sequential KSP there, on the rows of its
+   MPIAIJ operator's diagonal block (no copy): the processes factor and solve their bodies concurrently, and with a
+   sequential package (CHOLMOD) as well. Between those solves nothing is collective. */
 #include <phlex_impl.h>
 #include <petsc/private/pcimpl.h>
 
@@ -32,6 +35,11 @@ typedef struct {
   PetscScalar       *S;      /* LU of the Schur complement, m x m column-major */
   PetscBLASInt      *S_piv;
   IS                *is;     /* per block: its rows in the PC's vector */
+  PetscMPIInt       *owner;  /* per block: the process that holds all its rows (-whole_bodies), whose solver is
+                                sequential there (the same KSP on every process, set up and used on the owner only);
+                                -1: its rows are split, its solver on the PC's communicator */
+  Mat               *Aseq;   /* per block on its owner: A_i's rows there, the diagonal block of its MPIAIJ matrix */
+  Vec               *fseq, *xseq; /* per block on its owner: sequential vectors placed on the rows of r and z */
   char             (*lu_package)[64]; /* per block: -<prefix>bordered_[<body>_]lu_mat_solver_type (empty: the Cholesky's) */
   PetscInt           nfactor;
   PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
@@ -58,6 +66,7 @@ static PetscErrorCode RefuseSharedSuperLUDist(PC pc, PC_Bordered *pb)
     PetscBool     factor, sld = PETSC_FALSE;
     MatSolverType type = NULL;
     const char   *name;
+    if (pb->owner[i] >= 0) continue; /* a sequential solver: a process grid of its own */
     PetscCall(KSPGetPC(pb->ksp[i], &inner));
     PetscCall(PetscObjectTypeCompareAny((PetscObject)inner, &factor, PCLU, PCCHOLESKY, ""));
     if (factor) PetscCall(PCFactorGetMatSolverType(inner, &type));
@@ -169,6 +178,55 @@ static PetscErrorCode BorderedCopiesUsed(PC_Bordered *pb)
   PetscFunctionReturn(0);
 }
 
+/* which blocks have all their rows on one process (several processes only, and an MPIAIJ operator) */
+static PetscErrorCode BorderedOwners(PC pc, PC_Bordered *pb)
+{
+  PhlexBorderedData *bd = pb->bd;
+  PetscMPIInt        size, rank;
+  PetscInt          *mine, *all;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)pc), &size));
+  PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)pc), &rank));
+  for (PetscInt i = 0; i < pb->nb; i++) pb->owner[i] = -1;
+  if (size == 1) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc2(2 * pb->nb, &mine, 2 * pb->nb, &all));
+  for (PetscInt i = 0; i < pb->nb; i++) {
+    PetscBool aij;
+    PetscCall(PetscObjectTypeCompare((PetscObject)bd->A[i], MATMPIAIJ, &aij));
+    mine[2 * i]     = bd->n[i] > 0 ? 1 : 0;                    /* processes with rows */
+    mine[2 * i + 1] = (bd->n[i] > 0 && aij) ? rank + 1 : 0;   /* the one that has them, if one */
+  }
+  PetscCallMPI(MPI_Allreduce(mine, all, (PetscMPIInt)(2 * pb->nb), MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)pc)));
+  for (PetscInt i = 0; i < pb->nb; i++)
+    if (all[2 * i] == 1 && all[2 * i + 1] > 0) pb->owner[i] = (PetscMPIInt)(all[2 * i + 1] - 1);
+  PetscCall(PetscFree2(mine, all));
+  PetscFunctionReturn(0);
+}
+
+/* Block i's sequential operator on its owner: the diagonal block of the MPIAIJ matrix A (all of A's rows and columns
+   are there), with A's symmetry flags, which the factorizations read (CHOLMOD needs them). The same object while A
+   keeps its pattern; a new one (or a new pattern) gets a new symbolic factorization */
+static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A)
+{
+  Mat       Ad;
+  PetscBool set, flg;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatMPIAIJGetSeqAIJ(A, &Ad, NULL, NULL));
+  if (pb->Aseq[i] && pb->Aseq[i] != Ad) PetscCall(KSPReset(pb->ksp[i]));
+  pb->Aseq[i] = Ad;
+  PetscCall(MatIsSPDKnown(A, &set, &flg));
+  if (set) PetscCall(MatSetOption(Ad, MAT_SPD, flg));
+  PetscCall(MatIsSymmetricKnown(A, &set, &flg));
+  if (set) PetscCall(MatSetOption(Ad, MAT_SYMMETRIC, flg));
+  PetscCall(MatIsHermitianKnown(A, &set, &flg));
+  if (set) PetscCall(MatSetOption(Ad, MAT_HERMITIAN, flg));
+  PetscCall(PetscObjectStateIncrease((PetscObject)Ad)); /* A's values changed: the KSP refactors */
+  PetscCall(KSPSetOperators(pb->ksp[i], Ad, Ad));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
 {
   PhlexBorderedData *bd = pb->bd;
@@ -181,6 +239,8 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->ksp, PetscMax(pb->nb, 1), &pb->Y, PetscMax(pb->nb, 1), &pb->Astate, PetscMax(pb->nb, 1), &pb->Wstate, PetscMax(pb->nb, 1), &pb->beta));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->lu_package));
+  PetscCall(PetscCalloc4(PetscMax(pb->nb, 1), &pb->owner, PetscMax(pb->nb, 1), &pb->Aseq, PetscMax(pb->nb, 1), &pb->fseq, PetscMax(pb->nb, 1), &pb->xseq));
+  PetscCall(BorderedOwners(pc, pb));
   PetscCall(PetscMalloc2(PetscMax(pb->m * pb->m, 1), &pb->S, PetscMax(pb->m, 1), &pb->S_piv));
   PetscCall(MatGetOwnershipRange(pc->pmat, &rstart, NULL));
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
@@ -194,7 +254,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
     char        bprefix[256];
     PC          inner;
     PetscCall(ISCreateStride(PetscObjectComm((PetscObject)pc), bd->n[i], rstart + bd->off[i], 1, &pb->is[i]));
-    PetscCall(KSPCreate(PetscObjectComm((PetscObject)pc), &pb->ksp[i]));
+    PetscCall(KSPCreate(pb->owner[i] >= 0 ? PETSC_COMM_SELF : PetscObjectComm((PetscObject)pc), &pb->ksp[i]));
     PetscCall(PetscObjectIncrementTabLevel((PetscObject)pb->ksp[i], (PetscObject)pc, 1));
     PetscCall(KSPSetType(pb->ksp[i], KSPPREONLY));
     PetscCall(KSPGetPC(pb->ksp[i], &inner));
@@ -242,6 +302,7 @@ static PetscErrorCode BlockFactorType(PC pc, PC_Bordered *pb, PetscInt i, Mat A)
   if (pb->lu_package[i][0]) PetscCall(PetscStrncpy(package, pb->lu_package[i], sizeof(package)));
   else if (asked) PetscCall(PetscStrncpy(package, asked, sizeof(package))); /* copied: PCSetType frees it */
   PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
+  if (pb->owner[i] >= 0) PetscCall(MatMPIAIJGetSeqAIJ(A, &A, NULL, NULL)); /* its solver's matrix type (every process has one) */
   if (package[0]) PetscCall(MatGetFactorAvailable(A, package, MAT_FACTOR_LU, &avail));
   if (!avail) {
     const char *prefix, *body;
@@ -265,6 +326,8 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
   PetscContainer     c;
   PetscReal         *CtY;
   PetscBLASInt       mb, info;
+  PetscMPIInt        rank;
+  PetscBool         *renew;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectQuery((PetscObject)pc->pmat, "phlex_border", (PetscObject *)&c));
@@ -274,21 +337,22 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     pb->bd = bd;
     PetscCall(BorderedSetUpBlocks(pc, pb));
   }
-  /* Y_i = A_i^{-1} W_i: only when A_i or W_i changed */
+  /* Y_i = A_i^{-1} W_i: only when A_i or W_i changed. First what is collective (the factorization's kind, Y_i's
+     storage), then the factorizations and solves: those of the blocks whole on one process each there, concurrently,
+     then those on the PC's communicator */
+  PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)pc), &rank));
+  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &renew));
   for (PetscInt i = 0; i < pb->nb; i++) {
     PetscObjectState sa, sw = 0;
     PetscCall(PetscObjectStateGet((PetscObject)bd->A[i], &sa));
     if (bd->W[i]) PetscCall(PetscObjectStateGet((PetscObject)bd->W[i], &sw));
     if (pb->Astate[i] == sa && pb->Wstate[i] == sw && (pb->Y[i] || !bd->W[i])) continue;
-    PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pc, 0, 0, 0));
-    PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
+    renew[i] = PETSC_TRUE;
     PetscCall(BlockFactorType(pc, pb, i, bd->A[i]));
-    PetscCall(KSPSetUp(pb->ksp[i]));
     PetscCall(MatDestroy(&pb->Y[i]));
     if (bd->W[i]) {
       PetscInt k;
       PetscCall(MatDuplicate(bd->W[i], MAT_DO_NOT_COPY_VALUES, &pb->Y[i]));
-      PetscCall(KSPMatSolve(pb->ksp[i], bd->W[i], pb->Y[i]));
       PetscCall(MatGetSize(bd->W[i], NULL, &k));
       PetscCall(PetscFree(pb->beta[i]));
       PetscCall(PetscMalloc1(PetscMax(k * pb->m, 1), &pb->beta[i]));
@@ -296,8 +360,26 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     pb->Astate[i] = sa;
     pb->Wstate[i] = sw;
     pb->nfactor++;
-    PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pc, 0, 0, 0));
   }
+  for (PetscInt pass = 0; pass < 2; pass++)
+    for (PetscInt i = 0; i < pb->nb; i++) {
+      const PetscBool mine = (PetscBool)(pb->owner[i] == rank);
+      if (!renew[i] || (pass == 0) != (pb->owner[i] >= 0) || (pb->owner[i] >= 0 && !mine)) continue;
+      PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pc, 0, 0, 0));
+      if (mine) PetscCall(BlockSequentialOperator(pb, i, bd->A[i]));
+      else PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
+      PetscCall(KSPSetUp(pb->ksp[i]));
+      if (pb->Y[i]) {
+        Mat Wl = bd->W[i], Yl = pb->Y[i];
+        if (mine) {
+          PetscCall(MatDenseGetLocalMatrix(bd->W[i], &Wl));
+          PetscCall(MatDenseGetLocalMatrix(pb->Y[i], &Yl));
+        }
+        PetscCall(KSPMatSolve(pb->ksp[i], Wl, Yl));
+      }
+      PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pc, 0, 0, 0));
+    }
+  PetscCall(PetscFree(renew));
   if (pb->ncopy) PetscCall(BorderedCopiesUsed(pb));
   if (!pb->m) PetscFunctionReturn(0);
   /* S = D - sum_i (C_i Y_i) beta_i */
@@ -337,9 +419,32 @@ static PetscErrorCode PCApply_Bordered(PC pc, Vec r, Vec z)
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)pc), &rank));
   PetscCall(PetscCalloc1(PetscMax(pb->m, 1), &h));
-  /* x0_i = A_i^{-1} f_i, into z */
+  /* x0_i = A_i^{-1} f_i, into z: first the blocks whole on one process, each there on the rows of r and z (nothing
+     collective in between, so that the processes solve concurrently), then those split over the processes */
+  {
+    const PetscScalar *ra;
+    PetscScalar       *za;
+    PetscCall(VecGetArrayRead(r, &ra));
+    PetscCall(VecGetArray(z, &za));
+    for (PetscInt i = 0; i < pb->nb; i++) {
+      if (pb->owner[i] != rank) continue;
+      if (!pb->fseq[i]) {
+        PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, bd->n[i], NULL, &pb->fseq[i]));
+        PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, bd->n[i], NULL, &pb->xseq[i]));
+      }
+      PetscCall(VecPlaceArray(pb->fseq[i], ra + bd->off[i]));
+      PetscCall(VecPlaceArray(pb->xseq[i], za + bd->off[i]));
+      PetscCall(KSPSolve(pb->ksp[i], pb->fseq[i], pb->xseq[i]));
+      PetscCall(KSPCheckSolve(pb->ksp[i], pc, pb->xseq[i]));
+      PetscCall(VecResetArray(pb->fseq[i]));
+      PetscCall(VecResetArray(pb->xseq[i]));
+    }
+    PetscCall(VecRestoreArray(z, &za));
+    PetscCall(VecRestoreArrayRead(r, &ra));
+  }
   for (PetscInt i = 0; i < pb->nb; i++) {
     Vec f, x;
+    if (pb->owner[i] >= 0) continue;
     PetscCall(VecGetSubVector(r, pb->is[i], &f));
     PetscCall(VecGetSubVector(z, pb->is[i], &x));
     PetscCall(KSPSolve(pb->ksp[i], f, x));
@@ -415,7 +520,12 @@ static PetscErrorCode PCReset_Bordered(PC pc)
     PetscCall(MatDestroy(&pb->Y[i]));
     PetscCall(PetscFree(pb->beta[i]));
     PetscCall(ISDestroy(&pb->is[i]));
+    if (pb->fseq) {
+      PetscCall(VecDestroy(&pb->fseq[i]));
+      PetscCall(VecDestroy(&pb->xseq[i]));
+    }
   }
+  PetscCall(PetscFree4(pb->owner, pb->Aseq, pb->fseq, pb->xseq));
   PetscCall(PetscFree5(pb->ksp, pb->Y, pb->Astate, pb->Wstate, pb->beta));
   PetscCall(PetscFree(pb->is));
   PetscCall(PetscFree(pb->lu_package));
@@ -438,18 +548,34 @@ static PetscErrorCode PCView_Bordered(PC pc, PetscViewer viewer)
 {
   PC_Bordered *pb = (PC_Bordered *)pc->data;
   PetscBool    ascii;
+  PetscMPIInt  rank;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
   if (!ascii) PetscFunctionReturn(0);
   PetscCall(PetscViewerASCIIPrintf(viewer, "  %" PetscInt_FMT " sparse block(s), %" PetscInt_FMT " discrete unknowns, A^{-1} W computed %" PetscInt_FMT " time(s)\n", pb->nb, pb->m, pb->nfactor));
+  PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)pc), &rank));
   for (PetscInt i = 0; i < pb->nb; i++) {
     const char *name;
     PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
-    PetscCall(PetscViewerASCIIPrintf(viewer, "  solver for the sparse block of %s:\n", name));
-    PetscCall(PetscViewerASCIIPushTab(viewer));
-    PetscCall(KSPView(pb->ksp[i], viewer));
-    PetscCall(PetscViewerASCIIPopTab(viewer));
+    if (pb->owner[i] < 0) {
+      PetscCall(PetscViewerASCIIPrintf(viewer, "  solver for the sparse block of %s:\n", name));
+      PetscCall(PetscViewerASCIIPushTab(viewer));
+      PetscCall(KSPView(pb->ksp[i], viewer));
+      PetscCall(PetscViewerASCIIPopTab(viewer));
+    } else {
+      /* a sequential solver on its process: printed from there */
+      PetscViewer sub;
+      PetscCall(PetscViewerASCIIPrintf(viewer, "  solver for the sparse block of %s, on process %d:\n", name, (int)pb->owner[i]));
+      PetscCall(PetscViewerASCIIPushTab(viewer));
+      PetscCall(PetscViewerASCIIPushSynchronized(viewer));
+      PetscCall(PetscViewerGetSubViewer(viewer, PETSC_COMM_SELF, &sub));
+      if (rank == pb->owner[i]) PetscCall(KSPView(pb->ksp[i], sub));
+      PetscCall(PetscViewerRestoreSubViewer(viewer, PETSC_COMM_SELF, &sub));
+      PetscCall(PetscViewerFlush(viewer));
+      PetscCall(PetscViewerASCIIPopSynchronized(viewer));
+      PetscCall(PetscViewerASCIIPopTab(viewer));
+    }
   }
   PetscFunctionReturn(0);
 }

@@ -277,7 +277,7 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
   PetscCall(PetscMalloc1(PetscMax(sys->nparts, 1), &sys->fparts));
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
-    if (p->nv) sys->fparts[sys->nfparts++] = p;
+    if (p->Nv) sys->fparts[sys->nfparts++] = p;
     if (p->nonlinear) sys->nonlinear = PETSC_TRUE;
   }
   if (sys->njoints) sys->nonlinear = PETSC_TRUE; /* joint directions turn with the bodies */
@@ -591,8 +591,8 @@ static PetscErrorCode EvaluateAll(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot,
       for (PetscInt c = 0; c < 6; c++) p->wrench[k][c] = 0.0;
     PetscCall(PhlexPartGetVec(p, X, sys->q, &pX[i]));
     if (Xdot) PetscCall(PhlexPartGetVec(p, Xdot, sys->qd, &pXd[i]));
-    if (P && p->nv) PetscCall(VecGetSubVector(P, sys->fis[PHLEX_FIELD_VELOCITY][f], &pX[i].p));
-    if (p->nv) f++;
+    if (P && p->Nv) PetscCall(VecGetSubVector(P, sys->fis[PHLEX_FIELD_VELOCITY][f], &pX[i].p));
+    if (p->Nv) f++;
     PetscCall((*p->ops.evaluate)(p, t, &pX[i], Xdot ? &pXd[i] : NULL));
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
@@ -637,8 +637,8 @@ static PetscErrorCode RestoreAll(PhlexSystem sys, Vec X, Vec Xdot, Vec P, PhlexP
 {
   PetscFunctionBeginUser;
   for (PetscInt i = 0, f = 0; i < sys->nparts; i++) {
-    if (P && sys->parts[i]->nv) PetscCall(VecRestoreSubVector(P, sys->fis[PHLEX_FIELD_VELOCITY][f], &pX[i].p));
-    if (sys->parts[i]->nv) f++;
+    if (P && sys->parts[i]->Nv) PetscCall(VecRestoreSubVector(P, sys->fis[PHLEX_FIELD_VELOCITY][f], &pX[i].p));
+    if (sys->parts[i]->Nv) f++;
     PetscCall(PhlexPartRestoreVec(sys->parts[i], X, &pX[i]));
     if (Xdot) PetscCall(PhlexPartRestoreVec(sys->parts[i], Xdot, &pXd[i]));
   }
@@ -950,7 +950,7 @@ PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem sys, Vec X, PetscReal dt)
   /* only a flexible port turns relative to its body frame */
   for (PetscInt k = 0; k < sys->njoints; k++)
     for (PetscInt s = 0; s < 2; s++)
-      if (sys->joints[k]->side[s].part->nv) flexible = PETSC_TRUE;
+      if (sys->joints[k]->side[s].part->Nv) flexible = PETSC_TRUE;
   if (!flexible) PetscFunctionReturn(0);
   sys->eval_id[0] = 0; /* the joints' geometry changes */
   if (!sys->Xwork) PetscCall(VecDuplicate(X, &sys->Xwork));

@@ -137,7 +137,8 @@ static void NameFactorPackage(const char *mess, char *out, size_t len)
     snprintf(out, len, "option%s %s: the package has %s; choose another package (mumps has LU and Cholesky) or factorization (%s)", count + cut > 1 ? "s" : "", names, what, pctype);
     return;
   }
-  snprintf(out, len, "option%s %s: the package has %s (it factors on one process only); on several processes use mumps (options/solver/exact.opts, bordered.opts; exact_serial.opts and bordered_serial.opts are for one process)", count + cut > 1 ? "s" : "", names, what);
+  /* PC phlexbordered factors a body whole on one process with a sequential solver there (-whole_bodies) */
+  snprintf(out, len, "option%s %s: the package has %s (it factors on one process only); on several processes use mumps (options/solver/exact.opts, bordered.opts; exact_serial.opts and bordered_serial.opts are for one process)%s", count + cut > 1 ? "s" : "", names, what, strstr(names, "bordered_") ? ", or put each body whole on one process (-whole_bodies), where its solver is sequential" : "");
 }
 
 static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun, const char *file, PetscErrorCode n, PetscErrorType p, const char *mess, void *ctx)
