@@ -222,6 +222,33 @@ static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A
   if (set) PetscCall(MatSetOption(Ad, MAT_SYMMETRIC, flg));
   PetscCall(MatIsHermitianKnown(A, &set, &flg));
   if (set) PetscCall(MatSetOption(Ad, MAT_HERMITIAN, flg));
+  {
+    /* A's near null space (the rigid motions, for GAMG: bordered_iterative.opts) on the rows there: sequential
+       vectors on the parallel ones' arrays, which live as long as A */
+    MatNullSpace nsp, snsp;
+    PetscCall(MatGetNearNullSpace(A, &nsp));
+    PetscCall(MatGetNearNullSpace(Ad, &snsp));
+    if (nsp && !snsp) {
+      PetscBool          has_const;
+      PetscInt           n, nloc;
+      const Vec         *vecs;
+      Vec               *svecs;
+      const PetscScalar *a;
+      PetscCall(MatNullSpaceGetVecs(nsp, &has_const, &n, &vecs));
+      PetscCall(MatGetLocalSize(Ad, &nloc, NULL));
+      PetscCall(PetscMalloc1(PetscMax(n, 1), &svecs));
+      for (PetscInt k = 0; k < n; k++) {
+        PetscCall(VecGetArrayRead(vecs[k], &a));
+        PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, nloc, a, &svecs[k]));
+        PetscCall(VecRestoreArrayRead(vecs[k], &a));
+      }
+      PetscCall(MatNullSpaceCreate(PETSC_COMM_SELF, has_const, n, svecs, &snsp));
+      PetscCall(MatSetNearNullSpace(Ad, snsp));
+      PetscCall(MatNullSpaceDestroy(&snsp));
+      for (PetscInt k = 0; k < n; k++) PetscCall(VecDestroy(&svecs[k]));
+      PetscCall(PetscFree(svecs));
+    }
+  }
   PetscCall(PetscObjectStateIncrease((PetscObject)Ad)); /* A's values changed: the KSP refactors */
   PetscCall(KSPSetOperators(pb->ksp[i], Ad, Ad));
   PetscFunctionReturn(0);
