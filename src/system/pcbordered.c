@@ -47,40 +47,48 @@ typedef struct {
 } PC_Bordered;
 
 /* PETSc 3.18's SuperLU_DIST interface keeps one process grid per communicator for "the" factorization on it; with
-   the factors of two bodies on one communicator a run on several processes crashed (segmentation fault in
-   pdgssvx's Allgather, abort, or MPI_Comm_free at PetscFinalize) once the consistent start's factors were destroyed
-   and the steps' made; one body on SuperLU_DIST (the others on MUMPS) ran. Refused with the alternatives rather than
-   left to crash. */
+   the factors of two bodies on one communicator a run crashed (segmentation fault in pdgssvx's Allgather, abort, or
+   MPI_Comm_free at PetscFinalize; on several processes once the consistent start's factors were destroyed and the
+   steps' made, on one process at once); one body on SuperLU_DIST (the others on MUMPS) ran. The bodies split over
+   the processes share the PC's communicator, those whole on one process (-whole_bodies) that process's
+   PETSC_COMM_SELF. Refused with the alternatives rather than left to crash. */
 static PetscErrorCode RefuseSharedSuperLUDist(PC pc, PC_Bordered *pb)
 {
   PetscMPIInt size;
-  PetscInt    count = 0;
-  char        names[256] = "";
   const char *prefix;
 
   PetscFunctionBeginUser;
+  if (pb->nb < 2) PetscFunctionReturn(0);
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)pc), &size));
-  if (pb->nb < 2 || size < 2) PetscFunctionReturn(0);
-  for (PetscInt i = 0; i < pb->nb; i++) {
-    PC            inner;
-    PetscBool     factor, sld = PETSC_FALSE;
-    MatSolverType type = NULL;
-    const char   *name;
-    if (pb->owner[i] >= 0) continue; /* a sequential solver: a process grid of its own */
-    PetscCall(KSPGetPC(pb->ksp[i], &inner));
-    PetscCall(PetscObjectTypeCompareAny((PetscObject)inner, &factor, PCLU, PCCHOLESKY, ""));
-    if (factor) PetscCall(PCFactorGetMatSolverType(inner, &type));
-    if (type) PetscCall(PetscStrcmp(type, MATSOLVERSUPERLU_DIST, &sld));
-    if (!sld) continue;
-    PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
-    if (count++) PetscCall(PetscStrlcat(names, ", ", sizeof(names)));
-    PetscCall(PetscStrlcat(names, name, sizeof(names)));
+  /* the communicators: -1 the PC's, r >= 0 process r's own */
+  for (PetscMPIInt key = -1; key < size; key++) {
+    PetscInt count = 0;
+    char     names[256] = "";
+    for (PetscInt i = 0; i < pb->nb; i++) {
+      PC            inner;
+      PetscBool     factor, sld = PETSC_FALSE;
+      MatSolverType type = NULL;
+      const char   *name;
+      if (pb->owner[i] != key) continue;
+      PetscCall(KSPGetPC(pb->ksp[i], &inner));
+      PetscCall(PetscObjectTypeCompareAny((PetscObject)inner, &factor, PCLU, PCCHOLESKY, ""));
+      if (factor) PetscCall(PCFactorGetMatSolverType(inner, &type));
+      if (type) PetscCall(PetscStrcmp(type, MATSOLVERSUPERLU_DIST, &sld));
+      if (!sld) continue;
+      PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
+      if (count++) PetscCall(PetscStrlcat(names, ", ", sizeof(names)));
+      PetscCall(PetscStrlcat(names, name, sizeof(names)));
+    }
+    if (count < 2) continue;
+    PetscCall(PCGetOptionsPrefix(pc, &prefix));
+    if (key < 0)
+      SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT,
+              "-%sbordered_[<body>_]pc_factor_mat_solver_type superlu_dist for %" PetscInt_FMT " bodies (%s) on %d process%s: SuperLU_DIST cannot hold the factors of two bodies at once (PETSc 3.18 shares one SuperLU_DIST process grid per communicator and crashes); use mumps (the preset's) for all but one, or -%sbordered_pc_type redundant for a sequential solver per body",
+              prefix ? prefix : "", count, names, (int)size, size == 1 ? "" : "es", prefix ? prefix : "");
+    SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT,
+            "-%sbordered_[<body>_]pc_factor_mat_solver_type superlu_dist for %" PetscInt_FMT " bodies (%s) whole on process %d: SuperLU_DIST cannot hold the factors of two bodies at once on one process (PETSc 3.18 shares one SuperLU_DIST process grid per communicator and crashes); use mumps (the preset's) for all but one, or put the bodies on different processes (-<body>_process)",
+            prefix ? prefix : "", count, names, (int)key);
   }
-  if (count < 2) PetscFunctionReturn(0);
-  PetscCall(PCGetOptionsPrefix(pc, &prefix));
-  SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT,
-          "-%sbordered_[<body>_]pc_factor_mat_solver_type superlu_dist for %" PetscInt_FMT " bodies (%s) on %d processes: SuperLU_DIST cannot hold the factors of two bodies at once (PETSc 3.18 shares one SuperLU_DIST process grid per communicator and crashes); use mumps (the preset's) for all but one, or -%sbordered_pc_type redundant for a sequential solver per body",
-          prefix ? prefix : "", count, names, (int)size, prefix ? prefix : "");
   PetscFunctionReturn(0);
 }
 
@@ -206,8 +214,9 @@ static PetscErrorCode BorderedOwners(PC pc, PC_Bordered *pb)
 
 /* Block i's sequential operator on its owner: the diagonal block of the MPIAIJ matrix A (all of A's rows and columns
    are there), with A's symmetry flags, which the factorizations read (CHOLMOD needs them). The same object while A
-   keeps its pattern; a new one (or a new pattern) gets a new symbolic factorization */
-static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A)
+   keeps its pattern; a new one (or a new pattern) gets a new symbolic factorization. 'changed': A's values changed
+   since the last factorization (not only W) */
+static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A, PetscBool changed)
 {
   Mat       Ad;
   PetscBool set, flg;
@@ -249,7 +258,7 @@ static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A
       PetscCall(PetscFree(svecs));
     }
   }
-  PetscCall(PetscObjectStateIncrease((PetscObject)Ad)); /* A's values changed: the KSP refactors */
+  if (changed) PetscCall(PetscObjectStateIncrease((PetscObject)Ad)); /* A's values changed: the KSP refactors */
   PetscCall(KSPSetOperators(pb->ksp[i], Ad, Ad));
   PetscFunctionReturn(0);
 }
@@ -354,7 +363,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
   PetscReal         *CtY;
   PetscBLASInt       mb, info;
   PetscMPIInt        rank;
-  PetscBool         *renew;
+  PetscBool         *renew, *Achanged;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectQuery((PetscObject)pc->pmat, "phlex_border", (PetscObject *)&c));
@@ -368,13 +377,14 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
      storage), then the factorizations and solves: those of the blocks whole on one process each there, concurrently,
      then those on the PC's communicator */
   PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)pc), &rank));
-  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &renew));
+  PetscCall(PetscCalloc2(PetscMax(pb->nb, 1), &renew, PetscMax(pb->nb, 1), &Achanged));
   for (PetscInt i = 0; i < pb->nb; i++) {
     PetscObjectState sa, sw = 0;
     PetscCall(PetscObjectStateGet((PetscObject)bd->A[i], &sa));
     if (bd->W[i]) PetscCall(PetscObjectStateGet((PetscObject)bd->W[i], &sw));
     if (pb->Astate[i] == sa && pb->Wstate[i] == sw && (pb->Y[i] || !bd->W[i])) continue;
-    renew[i] = PETSC_TRUE;
+    renew[i]    = PETSC_TRUE;
+    Achanged[i] = (PetscBool)(pb->Astate[i] != sa);
     PetscCall(BlockFactorType(pc, pb, i, bd->A[i]));
     PetscCall(MatDestroy(&pb->Y[i]));
     if (bd->W[i]) {
@@ -392,8 +402,9 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     for (PetscInt i = 0; i < pb->nb; i++) {
       const PetscBool mine = (PetscBool)(pb->owner[i] == rank);
       if (!renew[i] || (pass == 0) != (pb->owner[i] >= 0) || (pb->owner[i] >= 0 && !mine)) continue;
-      PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pc, 0, 0, 0));
-      if (mine) PetscCall(BlockSequentialOperator(pb, i, bd->A[i]));
+      /* logged on the solver's communicator (-log_sync: a barrier there, on one process for a body whole on it) */
+      PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pb->ksp[i], 0, 0, 0));
+      if (mine) PetscCall(BlockSequentialOperator(pb, i, bd->A[i], Achanged[i]));
       else PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
       PetscCall(KSPSetUp(pb->ksp[i]));
       if (pb->Y[i]) {
@@ -404,9 +415,9 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
         }
         PetscCall(KSPMatSolve(pb->ksp[i], Wl, Yl));
       }
-      PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pc, 0, 0, 0));
+      PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pb->ksp[i], 0, 0, 0));
     }
-  PetscCall(PetscFree(renew));
+  PetscCall(PetscFree2(renew, Achanged));
   if (pb->ncopy) PetscCall(BorderedCopiesUsed(pb));
   if (!pb->m) PetscFunctionReturn(0);
   /* S = D - sum_i (C_i Y_i) beta_i */

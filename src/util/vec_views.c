@@ -89,8 +89,11 @@ static PetscErrorCode ViewGet(Vec X, IS is, Vec *Y)
       p->used  = used;
       p->state = state;
     }
+    PetscMPIInt size;
     PetscCall(ISGetBlockSize(is, &bs));
-    PetscCall(VecCreateMPIWithArray(PetscObjectComm((PetscObject)X), bs, n, N, NULL, &p->view[k]));
+    PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)X), &size));
+    if (size == 1) PetscCall(VecCreateSeqWithArray(PetscObjectComm((PetscObject)X), bs, n, NULL, &p->view[k])); /* as PETSc's */
+    else PetscCall(VecCreateMPIWithArray(PetscObjectComm((PetscObject)X), bs, n, N, NULL, &p->view[k]));
     p->n++;
   }
   PetscCall(VecGetArrayRead(X, &x));
@@ -98,7 +101,10 @@ static PetscErrorCode ViewGet(Vec X, IS is, Vec *Y)
   PetscCall(VecRestoreArrayRead(X, &x));
   PetscCall(PetscObjectStateGet((PetscObject)p->view[k], &p->state[k]));
   p->used[k] = PETSC_TRUE;
-  *Y         = p->view[k];
+  /* a reference for the caller: a view handed back through PETSc's default restore (another vector's) is then only
+     dereferenced, never freed under the pool */
+  PetscCall(PetscObjectReference((PetscObject)p->view[k]));
+  *Y = p->view[k];
   PetscFunctionReturn(0);
 }
 
@@ -117,7 +123,7 @@ static PetscErrorCode ViewRestore(Vec X, IS is, Vec *Y)
     if (s != p->state[k]) PetscCall(PetscObjectStateIncrease((PetscObject)X)); /* written through the view */
     PetscCall(VecResetArray(*Y));
     p->used[k] = PETSC_FALSE;
-    *Y         = NULL;
+    PetscCall(VecDestroy(Y)); /* the caller's reference */
     PetscFunctionReturn(0);
   }
   /* taken by PETSc's default */
