@@ -245,9 +245,7 @@ static PetscErrorCode PlaceWhole(PhlexFlexible body, DM dm, PetscPartitioner par
   PetscCallMPI(MPI_Comm_size(body->comm, &size));
   PetscCall(PetscOptionsHasName(NULL, body->prefix, "-petscpartitioner_type", &given));
   PetscCheck(!given, body->comm, PETSC_ERR_USER_INPUT, "body %s: -%spetscpartitioner_type splits the body's cells over the processes, while %s%s puts the whole body on one process: give one of them", body->name, body->prefix, body->process >= 0 ? "-" : "-whole_bodies", body->process >= 0 ? body->prefix : "");
-  if (body->process >= 0) {
-    PetscCheck(body->process < size, body->comm, PETSC_ERR_USER_INPUT, "body %s: -%sprocess %" PetscInt_FMT ": the run has %d processes, numbered 0 to %d", body->name, body->prefix, body->process, (int)size, (int)size - 1);
-  } else {
+  if (body->process < 0) { /* -whole_bodies (a given -process was checked with the body's options) */
     body->process = 0;
     for (PetscMPIInt r = 1; r < size; r++)
       if (body->part->process_cells[r] < body->part->process_cells[body->process]) body->process = r;

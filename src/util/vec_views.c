@@ -29,14 +29,14 @@ static PetscErrorCode ViewPoolDestroy(void *ctx)
 static PetscErrorCode ViewGet(Vec X, IS is, Vec *Y);
 static PetscErrorCode ViewRestore(Vec X, IS is, Vec *Y);
 
-/* whether the block of is is taken as a view: a stride of step 1 (the same answer on every process) */
-static PetscErrorCode ViewApplies(IS is, PetscBool *yes)
+/* whether the block of is is taken as a view: a stride of step 1 (the same answer on every process), from first */
+static PetscErrorCode ViewApplies(IS is, PetscBool *yes, PetscInt *first)
 {
-  PetscInt first, step = 0;
+  PetscInt step = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectTypeCompare((PetscObject)is, ISSTRIDE, yes));
-  if (*yes) PetscCall(ISStrideGetInfo(is, &first, &step));
+  if (*yes) PetscCall(ISStrideGetInfo(is, first, &step));
   *yes = (PetscBool)(*yes && step == 1);
   PetscFunctionReturn(0);
 }
@@ -46,11 +46,11 @@ static PetscErrorCode ViewGet(Vec X, IS is, Vec *Y)
   PetscContainer     c;
   ViewPool          *p;
   PetscBool          yes;
-  PetscInt           first, step, n, N, rstart, rend, k, bs;
+  PetscInt           first, n, N, rstart, rend, k, bs;
   const PetscScalar *x;
 
   PetscFunctionBeginUser;
-  PetscCall(ViewApplies(is, &yes));
+  PetscCall(ViewApplies(is, &yes, &first));
   if (!yes) {
     /* PETSc's default */
     X->ops->getsubvector = NULL;
@@ -58,7 +58,6 @@ static PetscErrorCode ViewGet(Vec X, IS is, Vec *Y)
     X->ops->getsubvector = ViewGet;
     PetscFunctionReturn(0);
   }
-  PetscCall(ISStrideGetInfo(is, &first, &step));
   PetscCall(ISGetLocalSize(is, &n));
   PetscCall(ISGetSize(is, &N));
   PetscCall(VecGetOwnershipRange(X, &rstart, &rend));
