@@ -145,9 +145,6 @@ PETSC_INTERN PetscErrorCode PhlexOptionsListLength(const char[], const char[], P
 PETSC_INTERN PetscErrorCode PhlexExpectMax(MPI_Comm, const char[], const char[], PetscReal, PetscReal, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexExpectValues(MPI_Comm, const char[], const char[], PetscInt, const PetscReal[], PetscInt, const PetscReal[], PetscReal);
 
-/* vec_views.c: the blocks of a state vector as views, nothing collective */
-PETSC_INTERN PetscErrorCode PhlexVecUseViews(Vec);
-
 /* mat_shell.c: shell matrices without a transpose */
 PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, PetscInt, PetscInt, void *, PetscErrorCode (*)(Mat, Vec, Vec), Mat *);
 

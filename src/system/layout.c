@@ -166,7 +166,6 @@ static PetscErrorCode LayoutCreateDM(PhlexLayout L, DM *dm)
   PetscCall(DMShellSetContext(*dm, L));
   PetscCall(DMShellSetDestroyContext(*dm, LayoutDestroyContext));
   PetscCall(VecCreateMPI(L->comm, n, PETSC_DETERMINE, &X));
-  PetscCall(PhlexVecUseViews(X)); /* the DM's vectors are its duplicates: their parts' blocks without collectives */
   PetscCall(DMShellSetGlobalVector(*dm, X));
   PetscCall(VecDestroy(&X));
   PetscCall(DMShellSetCreateFieldDecomposition(*dm, LayoutCreateFieldDecomposition));
