@@ -34,7 +34,7 @@ ROOT = os.path.dirname(TESTS_DIR)
 
 MAX_DIFFS = 5          # differences listed per compared file
 TAIL_LINES = 40        # stdout/stderr lines shown on failure in verbose mode
-SHORT_TAIL_LINES = 10  # stderr lines shown on exit-status failures otherwise
+SHORT_TAIL_LINES = 10  # stderr lines shown on exit-status failures otherwise (the first and the last as many)
 REASON_WIDTH = 160     # maximum width of the reason on a "not ok" line
 
 # --------------------------------------------------------------------------
@@ -717,6 +717,15 @@ def tail(text: str, n: int) -> List[str]:
     return text.splitlines()[-n:]
 
 
+def head_and_tail(text: str, n: int) -> List[str]:
+    """The first and the last n lines of text (a failed run's cause is often at the top, e.g. a library's message
+    before PETSc's trace, whose configure line and call stack fill the end)."""
+    lines = text.splitlines()
+    if len(lines) <= 2 * n:
+        return lines
+    return lines[:n] + [f"... ({len(lines) - 2 * n} lines)"] + lines[-n:]
+
+
 class Checker:
     """Collects the problems found while checking one test run."""
 
@@ -874,7 +883,7 @@ def run_test(spec: Spec, cfg: Config) -> Result:
     elif not exit_ok(spec.exit, run.returncode):
         expected = "a nonzero exit status" if spec.exit == "nonzero" else f"exit status {spec.exit}"
         chk.fail(f"{describe_exit(run.returncode)}, expected {expected}",
-                 [] if cfg.verbose else ["  stderr: " + l for l in tail(run.stderr, SHORT_TAIL_LINES)])
+                 [] if cfg.verbose else ["  stderr: " + l for l in head_and_tail(run.stderr, SHORT_TAIL_LINES)])
     else:
         check_stderr(spec, run, chk)
         if spec.output is not None:

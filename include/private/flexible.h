@@ -64,9 +64,13 @@ typedef struct {
   Vec       Mu, Mvv, Mud, Mvd;      /* Mv u, Mv v, Mv u', Mv v' (field only) */
   Vec       bext, barm;             /* elastic load; its part whose moment arm about P moves with u (forces, not the
                                        moment distributions of ports: a port turns by its mean rotation) */
+  PetscReal   sums_loc[84], sums[84]; /* the field's integrals: this process's part, their sums over the processes */
+  MPI_Request sums_req;               /* the sums' reduction between PhlexFrameEvaluateBegin and End */
 } PhlexFrameState;
 
 PETSC_INTERN PetscErrorCode PhlexFrameEvaluate(PhlexFrame *, Vec, Vec, Vec, Vec, const PetscReal[18], const PetscReal[18], PhlexFrameState *);
+PETSC_INTERN PetscErrorCode PhlexFrameEvaluateBegin(PhlexFrame *, Vec, Vec, Vec, Vec, PhlexFrameState *);
+PETSC_INTERN PetscErrorCode PhlexFrameEvaluateEnd(PhlexFrame *, const PetscReal[18], const PetscReal[18], PhlexFrameState *);
 PETSC_INTERN PetscErrorCode PhlexFrameAddLoadArms(PhlexFrame *, Vec, PhlexFrameState *);
 PETSC_INTERN PetscErrorCode PhlexFrameResidual(PhlexFrame *, PhlexFrameState *, Vec, Vec, Vec, Vec, PetscReal[18]);
 /* The node inputs of a frame's field borders (PhlexFrameJacobian): t(l), z(l) = w(l) + (Mv u)(l), (Mv u')(l), (Mv v)(l),
@@ -83,7 +87,7 @@ enum {
 };
 PETSC_INTERN PetscErrorCode PhlexFrameJacobian(PhlexFrame *, PhlexFrameState *, PetscReal, PetscScalar *, PetscScalar *, PetscScalar *, PetscInt, PetscReal[9], PetscReal[9], PetscReal[324]);
 PETSC_INTERN PetscErrorCode PhlexFrameNodeInputs(PhlexFrame *, PhlexFrameState *, PetscScalar *, PetscInt);
-PETSC_INTERN PetscErrorCode PhlexFrameEnergy(PhlexFrame *, PhlexFrameState *, Vec, PetscReal *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFrameEnergy(PhlexFrame *, PhlexFrameState *, PetscReal, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFrameMomenta(PhlexFrameState *, PetscReal[3], PetscReal[3]);
 PETSC_INTERN PetscErrorCode PhlexFrameStateDestroy(PhlexFrameState *);
 PETSC_INTERN PetscErrorCode PhlexFrameRigidMass(const PhlexInertia *, PetscReal[36]);
@@ -244,6 +248,10 @@ struct _p_PhlexFlexible {
   Vec       load, work;       /* velocity-space work vectors */
   Vec       ud, vd;           /* non-dimensional rates (floating) */
   Vec       ewv;              /* the kinetic energy's work vector, made at its first call */
+  PetscBool   frame_begun;    /* FlexEvaluateBegin has started the frame's integrals of the state being evaluated */
+  PetscBool   energy_begun;   /* FlexEnergyBegin has started the energy's sums */
+  PetscReal   energy_loc[3], energy_sums[3]; /* v^T Mv v, s^T Ms s, b_g . u: this process's parts, their sums */
+  MPI_Request energy_req;
   PetscReal (*port_ext)[6];   /* external port wrenches at the evaluated time (body frame) */
   PetscReal (*port_y)[6];     /* port outputs at the evaluated state */
   PetscReal (*port_ubar)[3];  /* full model: mean displacement of each port (the arm of its force beyond the drawn point) */
@@ -300,7 +308,6 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible, const PhlexUn
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpInertia(PhlexFlexible, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleGetBasis(PhlexFlexible, PetscBool, PhlexElementBasis *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleRestoreBasis(PhlexElementBasis *);
-PETSC_INTERN PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible, Vec, Vec, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexiblePlacement(PhlexFlexible, uint64_t *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
@@ -308,7 +315,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
 /* flexible_stress_maps.c: B = Ms^{-1} G, G^T and K cell by cell, a linear stage's fused stress passes, the strain energy */
 PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible);
-PETSC_INTERN PetscErrorCode PhlexFlexibleStrainEnergy(PhlexFlexible, Vec, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleStrainEnergyLocal(PhlexFlexible, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexStressMapsPredict(Mat, Vec, Vec, PetscReal, Vec, Vec);
 PETSC_INTERN PetscErrorCode PhlexStressMapsCorrect(Mat, Vec, Vec, PetscReal, Vec);
 

@@ -96,6 +96,10 @@ typedef struct {
   /* state */
   PetscErrorCode (*prepareinitialstate)(PhlexPart); /* the heavy part of initialstate (an eigensolve), before the system's operators exist; NULL: none */
   PetscErrorCode (*initialstate)(PhlexPart, PhlexPartVec *);
+  /* split phases (split_sum.c): the system calls evaluatebegin (energybegin) of every part, with the arguments of its
+     evaluate (energy), before the evaluate (energy) of any, so that parts on different processes do their local work
+     at the same time; NULL: a part without sums over the processes */
+  PetscErrorCode (*evaluatebegin)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *);
   PetscErrorCode (*evaluate)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *); /* t, X, X' (or NULL: rest) */
   PetscErrorCode (*residual)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PhlexPartVec *);
   PetscErrorCode (*jacobian)(PhlexPart, PetscReal, const PhlexPartVec *, PetscReal *, PetscInt); /* shift, X, its block of the dense discrete Jacobian (row-major, leading dim) */
@@ -120,6 +124,7 @@ typedef struct {
   PetscErrorCode (*portbasiscolumn)(PhlexPart, PetscInt, PetscInt *);                          /* first of the 6 columns of W spanning its field force */
   PetscErrorCode (*portplacement)(PhlexPart, PetscInt, const PhlexPartVec *, PetscReal[3], PetscReal[9]); /* inertial position, orientation */
   /* energy, inputs, outputs */
+  PetscErrorCode (*energybegin)(PhlexPart, const PhlexPartVec *); /* see evaluatebegin */
   PetscErrorCode (*energy)(PhlexPart, const PhlexPartVec *, PetscReal *, PetscReal *, PetscReal *); /* kinetic, strain, potential at the evaluated state X */
   PetscErrorCode (*momenta)(PhlexPart, PetscReal[3], PetscReal[3]);         /* inertial linear and angular momentum (about the origin), evaluated state */
   PetscErrorCode (*inputpower)(PhlexPart, PetscReal *);                       /* power of its external inputs at the evaluated state */

@@ -436,20 +436,49 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
 /* Energy and outputs                                                                                             */
 
 /* kinetic, strain and gravity energy at the evaluated state X (non-dimensional) */
-static PetscErrorCode FlexEnergy(PhlexPart part, const PhlexPartVec *X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
+/* the energy's first phase (split_sum.c): this process's parts of v^T Mv v (a floating body: with the frame's product
+   Mv v of the evaluated state), of s^T Ms s and, with gravity on a fixed body, of b_g . u, each formed as VecDot and
+   the monitor's strain energy form it, and their sums started */
+static PetscErrorCode FlexEnergyBegin(PhlexPart part, const PhlexPartVec *X)
 {
-  PhlexFlexible b = (PhlexFlexible)part->data;
+  PhlexFlexible b   = (PhlexFlexible)part->data;
+  PetscReal    *loc = b->energy_loc;
 
   PetscFunctionBeginUser;
-  PetscCall(PhlexFlexibleEnergy(b, X->v, X->s, kin, strain));
-  *pot = 0.0;
-  if (b->floating) PetscCall(PhlexFrameEnergy(&b->frame, &b->fs, X->v, kin, pot));
+  loc[0] = loc[1] = loc[2] = 0.0;
+  if (b->floating) PetscCall(PhlexLocalDot(X->v, b->fs.Mvv, &loc[0]));
+  else {
+    /* kept: the monitor calls this every step, and a fresh vector costs its page faults each time */
+    if (!b->ewv) PetscCall(VecDuplicate(X->v, &b->ewv));
+    PetscCall(MatMult(b->Mvp ? b->Mvp : b->Mv, X->v, b->ewv));
+    PetscCall(PhlexLocalDot(b->ewv, X->v, &loc[0]));
+    if (!b->spinning && b->bgrav) PetscCall(PhlexLocalDot(b->bgrav, X->u, &loc[2]));
+  }
+  PetscCall(PhlexFlexibleStrainEnergyLocal(b, X->s, &loc[1]));
+  PetscCall(PhlexSplitSumBegin(b->comm, loc, b->energy_sums, 3, &b->energy_req));
+  b->energy_begun = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/* kinetic 1/2 v^T Mv v (floating: the frame's, which holds it), strain 1/2 s^T Ms s, and the potential of gravity or
+   of a spin's centrifugal field */
+static PetscErrorCode FlexEnergy(PhlexPart part, const PhlexPartVec *X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
+{
+  PhlexFlexible    b    = (PhlexFlexible)part->data;
+  const PetscReal *sums = b->energy_sums;
+
+  PetscFunctionBeginUser;
+  if (!b->energy_begun) PetscCall(FlexEnergyBegin(part, X));
+  b->energy_begun = PETSC_FALSE;
+  PetscCall(PhlexSplitSumEnd(&b->energy_req));
+  *kin    = 0.5 * sums[0];
+  *strain = 0.5 * sums[1];
+  *pot    = 0.0;
+  if (b->floating) PetscCall(PhlexFrameEnergy(&b->frame, &b->fs, sums[0], kin, pot));
   else if (b->spinning) PetscCall(PhlexFlexibleSpinEnergy(b, X->u, pot)); /* centrifugal potential */
   else if (b->bgrav) {
     /* V = -g . int rho (x + u) */
-    PetscScalar gu;
-    PetscCall(VecDot(b->bgrav, X->u, &gu));
-    *pot = -(PhlexDot3(part->gravity, b->inertia.s0) + PetscRealPart(gu));
+    *pot = -(PhlexDot3(part->gravity, b->inertia.s0) + sums[2]);
   }
   PetscFunctionReturn(0);
 }
@@ -619,6 +648,7 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   part->ops.destroy        = FlexDestroy;
   part->ops.prepareinitialstate = PhlexFlexiblePrepareInitialState;
   part->ops.initialstate   = PhlexFlexibleInitialState;
+  part->ops.energybegin    = FlexEnergyBegin;
   part->ops.energy         = FlexEnergy;
   part->ops.inputpower     = FlexInputPower;
   part->ops.momenta        = FlexMomenta;

@@ -336,6 +336,24 @@ static PetscErrorCode FlexPortPlacement(PhlexPart part, PetscInt q, const PhlexP
 /* ------------------------------------------------------------------------------------------------------------ */
 /* State, residual                                                                                                */
 
+/* the evaluation's first phase (split_sum.c): a floating body's rates and its frame's integrals, their sums started */
+static PetscErrorCode FlexEvaluateBegin(PhlexPart part, PetscReal t, const PhlexPartVec *X, const PhlexPartVec *Xdot)
+{
+  PhlexFlexible   b = (PhlexFlexible)part->data;
+  const PetscReal T = part->units->time;
+
+  PetscFunctionBeginUser;
+  if (!b->floating) PetscFunctionReturn(0);
+  if (Xdot) {
+    PetscCall(VecAXPBY(b->ud, T, 0.0, Xdot->u));
+    PetscCall(VecAXPBY(b->vd, T, 0.0, Xdot->v));
+  }
+  /* a reduced state (X->p) has T u' = v exactly: the frame takes v as u' and saves a product with Mv */
+  PetscCall(PhlexFrameEvaluateBegin(&b->frame, X->u, X->v, Xdot ? (X->p ? X->v : b->ud) : NULL, Xdot ? b->vd : NULL, &b->fs));
+  b->frame_begun = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode FlexEvaluate(PhlexPart part, PetscReal t, const PhlexPartVec *X, const PhlexPartVec *Xdot)
 {
   PhlexFlexible   b = (PhlexFlexible)part->data;
@@ -347,12 +365,9 @@ static PetscErrorCode FlexEvaluate(PhlexPart part, PetscReal t, const PhlexPartV
   if (b->floating) {
     PetscReal qd[18];
     for (PetscInt k = 0; k < 18; k++) qd[k] = Xdot ? T * Xdot->q[k] : 0.0;
-    if (Xdot) {
-      PetscCall(VecAXPBY(b->ud, T, 0.0, Xdot->u));
-      PetscCall(VecAXPBY(b->vd, T, 0.0, Xdot->v));
-    }
-    /* a reduced state (X->p) has T u' = v exactly: the frame takes v as u' and saves a product with Mv */
-    PetscCall(PhlexFrameEvaluate(&b->frame, X->u, X->v, Xdot ? (X->p ? X->v : b->ud) : NULL, Xdot ? b->vd : NULL, X->q, qd, &b->fs));
+    if (!b->frame_begun) PetscCall(FlexEvaluateBegin(part, t, X, Xdot));
+    b->frame_begun = PETSC_FALSE;
+    PetscCall(PhlexFrameEvaluateEnd(&b->frame, X->q, qd, &b->fs));
   }
   PetscCall(ExternalLoads(part, t, X));
   PetscCall(PortOutputs(part, X, PETSC_FALSE));
@@ -1097,6 +1112,7 @@ static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, Pe
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
 {
   PetscFunctionBeginUser;
+  part->ops.evaluatebegin       = FlexEvaluateBegin;
   part->ops.evaluate            = FlexEvaluate;
   part->ops.residual            = FlexResidual;
   part->ops.jacobian            = FlexJacobian;

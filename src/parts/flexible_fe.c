@@ -555,25 +555,6 @@ PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible b, const PhlexUnits *units)
 }
 
 /*@C
-  PhlexFlexibleEnergy - kinetic and strain energy 1/2 v^T Mv v, 1/2 s^T Ms s (non-dimensional)
-
-  Collective
-@*/
-PetscErrorCode PhlexFlexibleEnergy(PhlexFlexible b, Vec v, Vec s, PetscReal *kinetic, PetscReal *strain)
-{
-  PetscScalar e;
-
-  PetscFunctionBeginUser;
-  /* kept: the monitor calls this every step, and a fresh vector costs its page faults each time */
-  if (!b->ewv) PetscCall(VecDuplicate(v, &b->ewv));
-  PetscCall(MatMult(b->Mvp ? b->Mvp : b->Mv, v, b->ewv));
-  PetscCall(VecDot(b->ewv, v, &e));
-  *kinetic = 0.5 * PetscRealPart(e);
-  PetscCall(PhlexFlexibleStrainEnergy(b, s, strain));
-  PetscFunctionReturn(0);
-}
-
-/*@C
   PhlexFlexibleSetUpInertia - inertia invariants of a floating body about its frame origin P (non-dimensional):
   m, s0 = int rho x, E0 = int rho x x^T, the volume, int x dV, and the nodal vectors t, w of the elastic space
 

@@ -16,7 +16,7 @@
    local offsets. The condensed stiffness K = G^T Ms^{-1} G (SNES phlexreduced's residual and Jacobian) is the two in
    one pass per cell, the stress kept in the cell; a linear stage's predicted stress with its resultant, and its final
    stress, are one pass each (PhlexStressMapsPredict, PhlexStressMapsCorrect), and the monitor's strain energy 1/2
-   Sigma^T Ms Sigma comes from the same structure (PhlexFlexibleStrainEnergy). The sums are not those of the assembled
+   Sigma^T Ms Sigma comes from the same structure (PhlexFlexibleStrainEnergyLocal). The sums are not those of the assembled
    products: results differ from them in the last bits (BENCHMARKS.md section 18). For the body's undeformed geometry only: geometric stiffening's G(u) is assembled
    (flexible_stiffening.c). */
 #include <phlex_impl.h>
@@ -287,7 +287,7 @@ PHLEX_KERNEL_CLONES static void CorrectCells(PhlexFlexible b, PetscInt rstart, c
   }
 }
 
-/* the energies 1/2 detJ_c sum_ij smass_ij s_i . A_m s_j of the batch's cells (PhlexFlexibleStrainEnergy) */
+/* the energies 1/2 detJ_c sum_ij smass_ij s_i . A_m s_j of the batch's cells (PhlexFlexibleStrainEnergyLocal) */
 CELL_INLINE void CellStrainEnergy(PetscInt nn, const PetscReal *smass, const PhlexLane *A, const PhlexLane *sc, PhlexLane *e)
 {
   *e = LANE_ZERO;
@@ -508,7 +508,8 @@ PetscErrorCode PhlexStressMapsCorrect(Mat B, Vec v, Vec sp, PetscReal a, Vec s)
 }
 
 /*@C
-  PhlexFlexibleStrainEnergy - 1/2 s^T Ms s from Ms's structure (non-dimensional): the block of cell c is
+  PhlexFlexibleStrainEnergyLocal - this process's part of s^T Ms s (twice the strain energy, non-dimensional; the
+  caller sums it over the processes, split_sum.c), from Ms's structure: the block of cell c is
   detJ_c (smass (x) A_m) (PhlexElementComplianceMass), smass the reference mass of the stress basis, A_m the compliance
   of the cell's material, so a cell's energy is 1/2 detJ_c sum_ij smass_ij s_i . A_m s_j over its stress nodes i, j
   (6 components each). The monitor needs it every step: a product with the assembled Ms streamed its 224 MB at 2.2e5
@@ -517,24 +518,21 @@ PetscErrorCode PhlexStressMapsCorrect(Mat B, Vec v, Vec sp, PetscReal a, Vec s)
   order). The sums are not dgemv's: the
   energy differs from 1/2 s^T (Ms s) in its last bits.
 
-  Collective
+  Not collective
 @*/
-PetscErrorCode PhlexFlexibleStrainEnergy(PhlexFlexible b, Vec s, PetscReal *strain)
+PetscErrorCode PhlexFlexibleStrainEnergyLocal(PhlexFlexible b, Vec s, PetscReal *local)
 {
   const PetscInt     nn = b->ref.ns;
   const PetscScalar *sa;
   PetscInt           rstart;
-  PetscReal          local, global;
 
   PetscFunctionBeginUser;
   PetscCheck(nn <= 4, b->comm, PETSC_ERR_SUP, "body %s: the strain energy takes at most 4 stress nodes per cell (P1 stress), not %" PetscInt_FMT, b->name, nn);
   PetscCall(VecGetOwnershipRange(s, &rstart, NULL));
   PetscCall(VecGetArrayRead(s, &sa));
-  local = StrainEnergyCells(b, rstart, sa);
+  *local = StrainEnergyCells(b, rstart, sa);
   PetscCall(VecRestoreArrayRead(s, &sa));
   PetscCall(PetscLogFlops((2.0 * 6 * nn * nn + 2.0 * 42 * nn + 1) * (b->cEnd - b->cStart)));
-  PetscCall(MPIU_Allreduce(&local, &global, 1, MPIU_REAL, MPIU_SUM, b->comm));
-  *strain = 0.5 * global;
   PetscFunctionReturn(0);
 }
 

@@ -78,6 +78,7 @@ static inline void InertiaFromE(const PetscReal E[9], PetscReal J[9])
 
 /*@C
   PhlexFrameEvaluate - the inertia quantities and momenta of a moving frame at a state and its rates
+  (PhlexFrameEvaluateBegin() and PhlexFrameEvaluateEnd() in one)
 
   Collective (a frame without a field: not collective)
 
@@ -96,14 +97,33 @@ static inline void InertiaFromE(const PetscReal E[9], PetscReal J[9])
 @*/
 PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, const PetscReal q[18], const PetscReal qd[18], PhlexFrameState *f)
 {
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFrameEvaluateBegin(fr, u, v, ud, vd, f));
+  PetscCall(PhlexFrameEvaluateEnd(fr, q, qd, f));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFrameEvaluateBegin - the first phase of PhlexFrameEvaluate(): the field's products with Mv and this process's
+  part of its integrals, whose sum over the processes it starts (split_sum.c: the system begins every part before it
+  ends any, so that bodies on different processes form their integrals at the same time)
+
+  Collective (non-blocking; a frame without a field: not collective)
+@*/
+PetscErrorCode PhlexFrameEvaluateBegin(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, PhlexFrameState *f)
+{
   const PetscBool    full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
   const PetscScalar *ta, *wa, *ua, *va, *uda = NULL, *vda = NULL, *Mua, *Mvva, *Mvda = NULL;
   PetscInt           n, nloc;
-  PetscReal          loc[3 + 3 + 3 + 3 + 9 + 9 + 9 + 9 + 9 + 9 + 9 + 9], glob[84];
+  PetscReal         *loc = f->sums_loc;
   PetscReal         *U = loc, *Ud = loc + 3, *Vf = loc + 6, *Vfd = loc + 9, *Wu = loc + 12, *Wud = loc + 21, *Wv = loc + 30, *Wvd = loc + 39, *Nuu = loc + 48, *Nudu = loc + 57, *Nuv = loc + 66, *Nuvd = loc + 75;
 
   PetscFunctionBeginUser;
-  if (fr->tnode && !f->Mu) {
+  PetscCall(PetscArrayzero(loc, 84));
+  PetscCall(PetscArrayzero(f->sums, 84));
+  f->sums_req = MPI_REQUEST_NULL;
+  if (!fr->tnode) PetscFunctionReturn(0);
+  if (!f->Mu) {
     PetscCall(VecDuplicate(u, &f->Mu));
     PetscCall(VecDuplicate(u, &f->Mvv));
     PetscCall(VecDuplicate(u, &f->Mud));
@@ -111,21 +131,6 @@ PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, 
     PetscCall(VecDuplicate(u, &f->bext));
     PetscCall(VecDuplicate(u, &f->barm));
   }
-  for (PetscInt k = 0; k < 3; k++) {
-    f->r[k]  = q[k];
-    f->vP[k] = q[12 + k];
-    f->w[k]  = q[15 + k];
-    f->rd[k] = qd ? qd[k] : 0.0;
-    f->vPd[k] = qd ? qd[12 + k] : 0.0;
-    f->wd[k]  = qd ? qd[15 + k] : 0.0;
-  }
-  for (PetscInt k = 0; k < 9; k++) {
-    f->R[k]  = q[3 + k];
-    f->Rd[k] = qd ? qd[3 + k] : 0.0;
-  }
-  PetscCall(PetscArrayzero(loc, 84));
-  PetscCall(PetscArrayzero(glob, 84));
-  if (fr->tnode) {
   /* Mv-products needed by the inertia terms */
   if (full) PetscCall(MatMult(fr->Mv, u, f->Mu));
   else PetscCall(VecSet(f->Mu, 0.0));
@@ -172,7 +177,35 @@ PetscErrorCode PhlexFrameEvaluate(PhlexFrame *fr, Vec u, Vec v, Vec ud, Vec vd, 
   PetscCall(VecRestoreArrayRead(f->Mu, &Mua));
   PetscCall(VecRestoreArrayRead(f->Mvv, &Mvva));
   PetscCall(VecRestoreArrayRead(f->Mvd, &Mvda));
-  PetscCall(MPIU_Allreduce(loc, glob, 84, MPIU_REAL, MPI_SUM, fr->comm));
+  PetscCall(PhlexSplitSumBegin(fr->comm, loc, f->sums, 84, &f->sums_req));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFrameEvaluateEnd - the second phase of PhlexFrameEvaluate(): the rigid state and its rate, and with the
+  field's integrals (their sum awaited) the inertia quantities and momenta
+
+  Collective (a frame without a field: not collective)
+@*/
+PetscErrorCode PhlexFrameEvaluateEnd(PhlexFrame *fr, const PetscReal q[18], const PetscReal qd[18], PhlexFrameState *f)
+{
+  const PetscBool  full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
+  const PetscReal *glob = f->sums;
+  const PetscReal *U, *Ud, *Vf, *Vfd, *Wu, *Wud, *Wv, *Wvd, *Nuu, *Nudu, *Nuv, *Nuvd;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexSplitSumEnd(&f->sums_req));
+  for (PetscInt k = 0; k < 3; k++) {
+    f->r[k]  = q[k];
+    f->vP[k] = q[12 + k];
+    f->w[k]  = q[15 + k];
+    f->rd[k] = qd ? qd[k] : 0.0;
+    f->vPd[k] = qd ? qd[12 + k] : 0.0;
+    f->wd[k]  = qd ? qd[15 + k] : 0.0;
+  }
+  for (PetscInt k = 0; k < 9; k++) {
+    f->R[k]  = q[3 + k];
+    f->Rd[k] = qd ? qd[3 + k] : 0.0;
   }
   U = glob; Ud = glob + 3; Vf = glob + 6; Vfd = glob + 9; Wu = glob + 12; Wud = glob + 21; Wv = glob + 30; Wvd = glob + 39; Nuu = glob + 48; Nudu = glob + 57; Nuv = glob + 66; Nuvd = glob + 75;
 
@@ -668,20 +701,20 @@ PetscErrorCode PhlexFrameNodeInputs(PhlexFrame *fr, PhlexFrameState *f, PetscSca
 }
 
 /*@C
-  PhlexFrameEnergy - kinetic energy T = 1/2 int rho |V|^2 and gravity potential -g . (m r + R s) (non-dimensional)
+  PhlexFrameEnergy - kinetic energy T = 1/2 int rho |V|^2 and gravity potential -g . (m r + R s) (non-dimensional),
+  given vMv = v^T Mv v of the field at the evaluated state, summed over the processes (0 without a field; the caller
+  sums it with its own integrals: split_sum.c)
 
-  Collective with a field (uses an evaluated state)
+  Not collective (uses an evaluated state)
 @*/
-PetscErrorCode PhlexFrameEnergy(PhlexFrame *fr, PhlexFrameState *f, Vec v, PetscReal *kinetic, PetscReal *potential)
+PetscErrorCode PhlexFrameEnergy(PhlexFrame *fr, PhlexFrameState *f, PetscReal vMv, PetscReal *kinetic, PetscReal *potential)
 {
-  PetscScalar vMv = 0.0;
-  PetscReal   a[3], Jw[3], Rs[3];
+  PetscReal a[3], Jw[3], Rs[3];
 
   PetscFunctionBeginUser;
-  if (fr->tnode) PetscCall(VecDot(v, f->Mvv, &vMv));
   PhlexCross(f->w, f->s, a);
   PhlexMatVec3(f->J, f->w, Jw);
-  *kinetic = 0.5 * f->m * PhlexDot3(f->vP, f->vP) + PhlexDot3(f->vP, a) + 0.5 * PhlexDot3(f->w, Jw) + PhlexDot3(f->vP, f->Vf) + PhlexDot3(f->w, f->L) + 0.5 * PetscRealPart(vMv);
+  *kinetic = 0.5 * f->m * PhlexDot3(f->vP, f->vP) + PhlexDot3(f->vP, a) + 0.5 * PhlexDot3(f->w, Jw) + PhlexDot3(f->vP, f->Vf) + PhlexDot3(f->w, f->L) + 0.5 * vMv;
   PhlexMatVec3(f->R, f->sgrav, Rs);
   *potential = -(f->m * PhlexDot3(fr->gravity, f->r) + PhlexDot3(fr->gravity, Rs));
   PetscFunctionReturn(0);

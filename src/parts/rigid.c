@@ -331,7 +331,7 @@ static PetscErrorCode RigidEnergy(PhlexPart part, const PhlexPartVec *X, PetscRe
 
   PetscFunctionBeginUser;
   *strain = 0.0;
-  PetscCall(PhlexFrameEnergy(&r->frame, &r->fs, NULL, kin, pot));
+  PetscCall(PhlexFrameEnergy(&r->frame, &r->fs, 0.0, kin, pot));
   PetscFunctionReturn(0);
 }
 

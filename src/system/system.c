@@ -593,6 +593,14 @@ static PetscErrorCode EvaluateAll(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot,
     if (Xdot) PetscCall(PhlexPartGetVec(p, Xdot, sys->qd, &pXd[i]));
     if (P && p->Nv) PetscCall(VecGetSubVector(P, sys->fis[PHLEX_FIELD_VELOCITY][f], &pX[i].p));
     if (p->Nv) f++;
+  }
+  /* every part's local work first, then the sums (split_sum.c): bodies whole on different processes in parallel */
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
+    if (p->ops.evaluatebegin) PetscCall((*p->ops.evaluatebegin)(p, t, &pX[i], Xdot ? &pXd[i] : NULL));
+  }
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
     PetscCall((*p->ops.evaluate)(p, t, &pX[i], Xdot ? &pXd[i] : NULL));
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
@@ -674,12 +682,14 @@ static PetscErrorCode Residual(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot, Ve
   PetscCall(PetscMalloc3(PetscMax(sys->nparts, 1), &pX, PetscMax(sys->nparts, 1), &pXd, PetscMax(sys->nparts, 1), &pF));
   PetscCall(EvaluateAll(sys, t, X, Xdot, P, pX, pXd));
   for (PetscInt k = 0; k < sys->nq; k++) sys->fq[k] = 0.0;
+  /* every part's rows of F taken (collective) before any part's residual (local): parts whole on different processes
+     compute theirs at the same time (split_sum.c) */
+  for (PetscInt i = 0; i < sys->nparts; i++) PetscCall(PhlexPartGetVec(sys->parts[i], F, sys->fq, &pF[i]));
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
-    PetscCall(PhlexPartGetVec(p, F, sys->fq, &pF[i]));
     PetscCall((*p->ops.residual)(p, t, &pX[i], &pXd[i], &pF[i]));
-    PetscCall(PhlexPartRestoreVec(p, F, &pF[i]));
   }
+  for (PetscInt i = 0; i < sys->nparts; i++) PetscCall(PhlexPartRestoreVec(sys->parts[i], F, &pF[i]));
   PetscCall(PetscLogEventBegin(PHLEX_JointResidual, 0, 0, 0, 0));
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointResidual(sys->joints[k], t, sys->fq));
   PetscCall(PetscLogEventEnd(PHLEX_JointResidual, 0, 0, 0, 0));
@@ -882,18 +892,26 @@ PetscErrorCode PhlexSystemInitialState(PhlexSystem sys, Vec X)
 @*/
 PetscErrorCode PhlexSystemEnergy(PhlexSystem sys, PetscReal t, Vec X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
 {
+  PhlexPartVec *pv;
+
   PetscFunctionBeginUser;
   PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
   *kin = *strain = *pot = 0.0;
+  PetscCall(PetscMalloc1(PetscMax(sys->nparts, 1), &pv));
+  for (PetscInt i = 0; i < sys->nparts; i++) PetscCall(PhlexPartGetVec(sys->parts[i], X, sys->q, &pv[i]));
+  /* every part's local sums first, then their reductions (split_sum.c) */
   for (PetscInt i = 0; i < sys->nparts; i++) {
-    PhlexPart    p = sys->parts[i];
-    PhlexPartVec pv;
-    PetscReal    k, s, v;
-    PetscCall(PhlexPartGetVec(p, X, sys->q, &pv));
-    PetscCall((*p->ops.energy)(p, &pv, &k, &s, &v));
-    PetscCall(PhlexPartRestoreVec(p, X, &pv));
+    PhlexPart p = sys->parts[i];
+    if (p->ops.energybegin) PetscCall((*p->ops.energybegin)(p, &pv[i]));
+  }
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p = sys->parts[i];
+    PetscReal k, s, v;
+    PetscCall((*p->ops.energy)(p, &pv[i], &k, &s, &v));
     *kin += k, *strain += s, *pot += v;
   }
+  for (PetscInt i = 0; i < sys->nparts; i++) PetscCall(PhlexPartRestoreVec(sys->parts[i], X, &pv[i]));
+  PetscCall(PetscFree(pv));
   PetscFunctionReturn(0);
 }
 
