@@ -49,21 +49,25 @@ static PetscErrorCode MatMult_Bvq(Mat A, Vec x, Vec y)
 {
   PhlexSystem sys;
   PetscReal  *xq;
+  Vec        *yi;
 
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &sys));
   PetscCall(PetscMalloc1(PetscMax(sys->nq, 1), &xq));
   PetscCall(GatherQ(sys, x, xq));
   PetscCall(VecSet(y, 0.0));
+  /* every body's block taken (collective) before any body's columns (local): bodies whole on different processes
+     work at the same time (split_sum.c) */
+  PetscCall(PetscMalloc1(PetscMax(sys->nfparts, 1), &yi));
+  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, y, &yi[i]));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexPart p = sys->fparts[i];
-    Vec       yi;
-    PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, y, &yi));
-    PetscCall((*p->ops.bordermult)(p, xq + p->qoff, yi));
+    PetscCall((*p->ops.bordermult)(p, xq + p->qoff, yi[i]));
     for (PetscInt k = 0; k < sys->njoints; k++)
-      if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMult(sys->joints[k], sys->shift, xq, p, yi));
-    PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, y, &yi));
+      if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMult(sys->joints[k], sys->shift, xq, p, yi[i]));
   }
+  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, y, &yi[i]));
+  PetscCall(PetscFree(yi));
   PetscCall(PetscFree(xq));
   PetscFunctionReturn(0);
 }
@@ -72,21 +76,28 @@ static PetscErrorCode MatMult_Bvq(Mat A, Vec x, Vec y)
 static PetscErrorCode BorderRowsApply(PhlexSystem sys, Vec xU, PetscReal au, Vec xV, Vec y)
 {
   PetscReal *yq;
+  Vec       *ui, *vi;
 
   PetscFunctionBeginUser;
   PetscCall(PetscCalloc1(PetscMax(sys->nq, 1), &yq));
+  /* every body's blocks taken (collective) before any body's rows (as in MatMult_Bvq) */
+  PetscCall(PetscCalloc2(PetscMax(sys->nfparts, 1), &ui, PetscMax(sys->nfparts, 1), &vi));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexPart p  = sys->fparts[i];
-    Vec       ui = NULL, vi = NULL;
-    if (xU) PetscCall(FieldBlock(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui));
-    if (xV && xV != xU) PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi));
-    if (xV == xU) vi = ui;
-    PetscCall((*p->ops.bordermulttranspose)(p, ui, au, vi, yq + p->qoff));
-    for (PetscInt k = 0; k < sys->njoints; k++)
-      if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMultTranspose(sys->joints[k], p, ui, au, vi, yq));
-    if (xU) PetscCall(FieldBlockRestore(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui));
-    if (xV && xV != xU) PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi));
+    if (xU) PetscCall(FieldBlock(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui[i]));
+    if (xV && xV != xU) PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi[i]));
+    if (xV == xU) vi[i] = ui[i];
   }
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexPart p = sys->fparts[i];
+    PetscCall((*p->ops.bordermulttranspose)(p, ui[i], au, vi[i], yq + p->qoff));
+    for (PetscInt k = 0; k < sys->njoints; k++)
+      if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMultTranspose(sys->joints[k], p, ui[i], au, vi[i], yq));
+  }
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    if (xU) PetscCall(FieldBlockRestore(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui[i]));
+    if (xV && xV != xU) PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi[i]));
+  }
+  PetscCall(PetscFree2(ui, vi));
   PetscCall(ScatterQ(sys, yq, y));
   PetscCall(PetscFree(yq));
   PetscFunctionReturn(0);

@@ -494,13 +494,12 @@ static PetscErrorCode PCApply_Bordered(PC pc, Vec r, Vec z)
     const PetscScalar *ra;
     PetscScalar       *za;
     PetscReal         *c;
-    /* h = g - sum_i C_i x0_i */
-    for (PetscInt i = 0; i < pb->nb; i++) {
-      Vec x;
-      PetscCall(VecGetSubVector(z, pb->is[i], &x));
-      PetscCall((*bd->rowsvec)(bd->ctx, i, x, h));
-      PetscCall(VecRestoreSubVector(z, pb->is[i], &x));
-    }
+    Vec               *xb;
+    /* h = g - sum_i C_i x0_i; every block taken (collective) before any block's local work, here and below: blocks
+       whole on different processes are worked on at the same time */
+    PetscCall(PetscMalloc1(pb->nb, &xb));
+    for (PetscInt i = 0; i < pb->nb; i++) PetscCall(VecGetSubVector(z, pb->is[i], &xb[i]));
+    for (PetscInt i = 0; i < pb->nb; i++) PetscCall((*bd->rowsvec)(bd->ctx, i, xb[i], h));
     PetscCall(VecGetArrayRead(r, &ra));
     {
       PetscReal *g;
@@ -524,25 +523,24 @@ static PetscErrorCode PCApply_Bordered(PC pc, Vec r, Vec z)
       const PetscScalar *Ya;
       PetscScalar       *xa;
       PetscInt           k, nloc, ld;
-      Vec                x;
       if (!pb->Y[i]) continue;
       PetscCall(MatGetSize(pb->Y[i], NULL, &k));
       PetscCall(PetscCalloc1(k, &c));
       for (PetscInt l = 0; l < k; l++)
         for (PetscInt j = 0; j < pb->m; j++) c[l] -= pb->beta[i][l + k * j] * h[j];
-      PetscCall(VecGetSubVector(z, pb->is[i], &x));
-      PetscCall(VecGetLocalSize(x, &nloc));
+      PetscCall(VecGetLocalSize(xb[i], &nloc));
       PetscCall(MatDenseGetLDA(pb->Y[i], &ld));
       PetscCall(MatDenseGetArrayRead(pb->Y[i], &Ya));
-      PetscCall(VecGetArray(x, &xa));
+      PetscCall(VecGetArray(xb[i], &xa));
       for (PetscInt l = 0; l < k; l++)
         if (c[l] != 0.0)
           for (PetscInt n = 0; n < nloc; n++) xa[n] += c[l] * Ya[l * ld + n];
-      PetscCall(VecRestoreArray(x, &xa));
+      PetscCall(VecRestoreArray(xb[i], &xa));
       PetscCall(MatDenseRestoreArrayRead(pb->Y[i], &Ya));
-      PetscCall(VecRestoreSubVector(z, pb->is[i], &x));
       PetscCall(PetscFree(c));
     }
+    for (PetscInt i = 0; i < pb->nb; i++) PetscCall(VecRestoreSubVector(z, pb->is[i], &xb[i]));
+    PetscCall(PetscFree(xb));
   }
   PetscCall(PetscFree(h));
   PetscFunctionReturn(0);
