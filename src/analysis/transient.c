@@ -703,10 +703,22 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     if (!m.condensed && !m.reduced) PetscCall(PhlexSystemCompleteJacobian(sys));
     if ((m.condensed || m.reduced) && PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
       /* what the stage's own solve will read (it is made at the first step) */
-      KSP ksp;
+      KSP       ksp;
+      PC        pc;
+      PetscBool bordered;
       PetscCall(KSPCreate(scene->comm, &ksp));
       PetscCall(KSPSetOptionsPrefix(ksp, m.condensed ? "condensed_" : "reduced_"));
       PetscCall(KSPSetFromOptions(ksp));
+      PetscCall(KSPGetPC(ksp, &pc));
+      PetscCall(PetscObjectTypeCompare((PetscObject)pc, "phlexbordered", &bordered));
+      if (bordered && sys->nfparts) {
+        /* and the bodies' solvers inside PC phlexbordered, made at its first set-up */
+        const char **names;
+        PetscCall(PetscMalloc1(sys->nfparts, &names));
+        for (PetscInt i = 0; i < sys->nfparts; i++) names[i] = sys->fparts[i]->name;
+        PetscCall(PhlexPCBorderedHelp(pc, sys->nfparts, names));
+        PetscCall(PetscFree(names));
+      }
       PetscCall(KSPDestroy(&ksp));
     }
   }

@@ -616,6 +616,42 @@ static PetscErrorCode PCView_Bordered(PC pc, PetscViewer viewer)
   PetscFunctionReturn(0);
 }
 
+/*@C
+  PhlexPCBorderedHelp - lists, for -help solvers, the options of the bodies' solvers of a PC phlexbordered (they are
+  made at its first set-up, which needs the operator and which a help run does not reach): a solver with their
+  common prefix reads them here; names are the flexible bodies' names (each also has -<prefix>bordered_<name>_...)
+
+  Not collective (every process lists; PETSc prints from the first)
+@*/
+PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const names[])
+{
+  KSP         ksp;
+  PC          inner;
+  const char *prefix;
+  char        common[256], title[512], lu_package[64] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  PetscCall(PetscSNPrintf(common, sizeof(common), "%sbordered_", prefix ? prefix : ""));
+  PetscCall(KSPCreate(PETSC_COMM_SELF, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &inner));
+  PetscCall(PCSetType(inner, PCCHOLESKY));
+  PetscCall(KSPSetOptionsPrefix(ksp, common));
+  PetscCall(KSPSetFromOptions(ksp));
+  PetscCall(PetscSNPrintf(title, sizeof(title), "PC phlexbordered: the factorization of each flexible body's condensed operator (the same options per body under -%s<body>_, <body> one of", common));
+  for (PetscInt i = 0; i < nnames; i++) {
+    PetscCall(PetscStrlcat(title, i ? ", " : " ", sizeof(title)));
+    PetscCall(PetscStrlcat(title, names[i], sizeof(title)));
+  }
+  PetscCall(PetscStrlcat(title, ")", sizeof(title)));
+  PetscOptionsBegin(PETSC_COMM_SELF, common, title, NULL);
+  PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", lu_package, lu_package, sizeof(lu_package), NULL));
+  PetscOptionsEnd();
+  PetscCall(KSPDestroy(&ksp));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode PCCreate_Bordered(PC pc)
 {
   PC_Bordered *pb;
