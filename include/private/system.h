@@ -100,6 +100,8 @@ PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConvergedStage(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem, Mat *, PhlexField, PhlexField, Mat *);
+PETSC_INTERN PetscErrorCode PhlexSystemGetFieldBlocks(PhlexSystem, PhlexField, Vec, Vec[]);
+PETSC_INTERN PetscErrorCode PhlexSystemRestoreFieldBlocks(PhlexSystem, PhlexField, Vec, Vec[]);
 PETSC_INTERN PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemJacobianPmat(PhlexSystem, KSP, Mat *);

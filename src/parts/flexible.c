@@ -435,7 +435,6 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
 /* ------------------------------------------------------------------------------------------------------------ */
 /* Energy and outputs                                                                                             */
 
-/* kinetic, strain and gravity energy at the evaluated state X (non-dimensional) */
 /* the energy's first phase (split_sum.c): this process's parts of v^T Mv v (a floating body: with the frame's product
    Mv v of the evaluated state), of s^T Ms s and, with gravity on a fixed body, of b_g . u, each formed as VecDot and
    the monitor's strain energy form it, and their sums started */
@@ -461,7 +460,7 @@ static PetscErrorCode FlexEnergyBegin(PhlexPart part, const PhlexPartVec *X)
 }
 
 /* kinetic 1/2 v^T Mv v (floating: the frame's, which holds it), strain 1/2 s^T Ms s, and the potential of gravity or
-   of a spin's centrifugal field */
+   of a spin's centrifugal field, at the evaluated state X (non-dimensional) */
 static PetscErrorCode FlexEnergy(PhlexPart part, const PhlexPartVec *X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
 {
   PhlexFlexible    b    = (PhlexFlexible)part->data;

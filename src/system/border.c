@@ -5,21 +5,6 @@
    a small dense Schur complement. Also the preconditioning matrices of the field splits. */
 #include <phlex_impl.h>
 
-/* a part's block of a field vector (the velocity or displacement field numbering) */
-static PetscErrorCode FieldBlock(PhlexSystem sys, PhlexField f, PetscInt i, Vec x, Vec *xi)
-{
-  PetscFunctionBeginUser;
-  PetscCall(VecGetSubVector(x, sys->fis[f][i], xi));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode FieldBlockRestore(PhlexSystem sys, PhlexField f, PetscInt i, Vec x, Vec *xi)
-{
-  PetscFunctionBeginUser;
-  PetscCall(VecRestoreSubVector(x, sys->fis[f][i], xi));
-  PetscFunctionReturn(0);
-}
-
 /* the discrete part of a vector of the discrete field, on every rank */
 static PetscErrorCode GatherQ(PhlexSystem sys, Vec x, PetscReal *q)
 {
@@ -56,17 +41,15 @@ static PetscErrorCode MatMult_Bvq(Mat A, Vec x, Vec y)
   PetscCall(PetscMalloc1(PetscMax(sys->nq, 1), &xq));
   PetscCall(GatherQ(sys, x, xq));
   PetscCall(VecSet(y, 0.0));
-  /* every body's block taken (collective) before any body's columns (local): bodies whole on different processes
-     work at the same time (split_sum.c) */
   PetscCall(PetscMalloc1(PetscMax(sys->nfparts, 1), &yi));
-  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, y, &yi[i]));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, y, yi));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexPart p = sys->fparts[i];
     PetscCall((*p->ops.bordermult)(p, xq + p->qoff, yi[i]));
     for (PetscInt k = 0; k < sys->njoints; k++)
       if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMult(sys->joints[k], sys->shift, xq, p, yi[i]));
   }
-  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, y, &yi[i]));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_VELOCITY, y, yi));
   PetscCall(PetscFree(yi));
   PetscCall(PetscFree(xq));
   PetscFunctionReturn(0);
@@ -80,23 +63,19 @@ static PetscErrorCode BorderRowsApply(PhlexSystem sys, Vec xU, PetscReal au, Vec
 
   PetscFunctionBeginUser;
   PetscCall(PetscCalloc1(PetscMax(sys->nq, 1), &yq));
-  /* every body's blocks taken (collective) before any body's rows (as in MatMult_Bvq) */
-  PetscCall(PetscCalloc2(PetscMax(sys->nfparts, 1), &ui, PetscMax(sys->nfparts, 1), &vi));
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    if (xU) PetscCall(FieldBlock(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui[i]));
-    if (xV && xV != xU) PetscCall(FieldBlock(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi[i]));
-    if (xV == xU) vi[i] = ui[i];
-  }
+  PetscCall(PetscMalloc2(PetscMax(sys->nfparts, 1), &ui, PetscMax(sys->nfparts, 1), &vi));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, xU, ui));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, xV == xU ? NULL : xV, vi));
+  if (xV == xU)
+    for (PetscInt i = 0; i < sys->nfparts; i++) vi[i] = ui[i];
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexPart p = sys->fparts[i];
     PetscCall((*p->ops.bordermulttranspose)(p, ui[i], au, vi[i], yq + p->qoff));
     for (PetscInt k = 0; k < sys->njoints; k++)
       if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMultTranspose(sys->joints[k], p, ui[i], au, vi[i], yq));
   }
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    if (xU) PetscCall(FieldBlockRestore(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, i, xU, &ui[i]));
-    if (xV && xV != xU) PetscCall(FieldBlockRestore(sys, PHLEX_FIELD_VELOCITY, i, xV, &vi[i]));
-  }
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_VELOCITY, xV == xU ? NULL : xV, vi));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, xU, ui));
   PetscCall(PetscFree2(ui, vi));
   PetscCall(ScatterQ(sys, yq, y));
   PetscCall(PetscFree(yq));

@@ -137,32 +137,6 @@ PetscErrorCode PhlexSystemStressMapsDestroy(PhlexSystem sys, PhlexStressMaps *ma
   PetscFunctionReturn(0);
 }
 
-/* each body's blocks of the velocity vectors v[] (NULL: none) and stress vectors s[] (ns each), all taken before any
-   body's pass over its cells: taking a block is collective, and a body whole on one process would otherwise make the
-   others wait at the next body's block while its cells are passed (split_sum.c) */
-static PetscErrorCode StressBlocksGet(PhlexSystem sys, Vec v[2], Vec s[2], Vec (*vi)[2], Vec (*si)[2])
-{
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nfparts; i++)
-    for (PetscInt k = 0; k < 2; k++) {
-      vi[i][k] = si[i][k] = NULL;
-      if (v[k]) PetscCall(VecGetSubVector(v[k], sys->fis[PHLEX_FIELD_VELOCITY][i], &vi[i][k]));
-      if (s[k]) PetscCall(VecGetSubVector(s[k], sys->fis[PHLEX_FIELD_STRESS][i], &si[i][k]));
-    }
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode StressBlocksRestore(PhlexSystem sys, Vec v[2], Vec s[2], Vec (*vi)[2], Vec (*si)[2])
-{
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < sys->nfparts; i++)
-    for (PetscInt k = 0; k < 2; k++) {
-      if (v[k]) PetscCall(VecRestoreSubVector(v[k], sys->fis[PHLEX_FIELD_VELOCITY][i], &vi[i][k]));
-      if (s[k]) PetscCall(VecRestoreSubVector(s[k], sys->fis[PHLEX_FIELD_STRESS][i], &si[i][k]));
-    }
-  PetscFunctionReturn(0);
-}
-
 /*@C
   PhlexSystemStressPredict - over the bodies, the predicted stress sp = s0 + a B v and its resultant r = G^T sp
   (v, r velocity field vectors; s0, sp stress field vectors), one pass over each body's cells
@@ -171,15 +145,21 @@ static PetscErrorCode StressBlocksRestore(PhlexSystem sys, Vec v[2], Vec s[2], V
 @*/
 PetscErrorCode PhlexSystemStressPredict(PhlexSystem sys, PhlexStressMaps *maps, Vec v, Vec s0, PetscReal a, Vec sp, Vec r)
 {
-  Vec vv[2] = {v, r}, ss[2] = {s0, sp};
-  Vec (*vi)[2], (*si)[2];
+  const PetscInt n = sys->nfparts;
+  Vec           *vi, *s0i, *spi, *ri;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc2(sys->nfparts, &vi, sys->nfparts, &si));
-  PetscCall(StressBlocksGet(sys, vv, ss, vi, si));
-  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(PhlexStressMapsPredict(maps->B[i], vi[i][0], si[i][0], a, si[i][1], vi[i][1]));
-  PetscCall(StressBlocksRestore(sys, vv, ss, vi, si));
-  PetscCall(PetscFree2(vi, si));
+  PetscCall(PetscMalloc4(n, &vi, n, &s0i, n, &spi, n, &ri));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, v, vi));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_STRESS, s0, s0i));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_STRESS, sp, spi));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, r, ri));
+  for (PetscInt i = 0; i < n; i++) PetscCall(PhlexStressMapsPredict(maps->B[i], vi[i], s0i[i], a, spi[i], ri[i]));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_VELOCITY, r, ri));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_STRESS, sp, spi));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_STRESS, s0, s0i));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_VELOCITY, v, vi));
+  PetscCall(PetscFree4(vi, s0i, spi, ri));
   PetscFunctionReturn(0);
 }
 
@@ -191,15 +171,19 @@ PetscErrorCode PhlexSystemStressPredict(PhlexSystem sys, PhlexStressMaps *maps, 
 @*/
 PetscErrorCode PhlexSystemStressCorrect(PhlexSystem sys, PhlexStressMaps *maps, Vec v, Vec sp, PetscReal a, Vec s)
 {
-  Vec vv[2] = {v, NULL}, ss[2] = {sp, s};
-  Vec (*vi)[2], (*si)[2];
+  const PetscInt n = sys->nfparts;
+  Vec           *vi, *spi, *si;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc2(sys->nfparts, &vi, sys->nfparts, &si));
-  PetscCall(StressBlocksGet(sys, vv, ss, vi, si));
-  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(PhlexStressMapsCorrect(maps->B[i], vi[i][0], si[i][0], a, si[i][1]));
-  PetscCall(StressBlocksRestore(sys, vv, ss, vi, si));
-  PetscCall(PetscFree2(vi, si));
+  PetscCall(PetscMalloc3(n, &vi, n, &spi, n, &si));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, v, vi));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_STRESS, sp, spi));
+  PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_STRESS, s, si));
+  for (PetscInt i = 0; i < n; i++) PetscCall(PhlexStressMapsCorrect(maps->B[i], vi[i], spi[i], a, si[i]));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_STRESS, s, si));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_STRESS, sp, spi));
+  PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_VELOCITY, v, vi));
+  PetscCall(PetscFree3(vi, spi, si));
   PetscFunctionReturn(0);
 }
 

@@ -64,6 +64,27 @@ PetscErrorCode PhlexSystemBlockDiagonal(PhlexSystem sys, Mat *mats, PhlexField f
   PetscFunctionReturn(0);
 }
 
+/* every flexible body's block of field f of x (x NULL: NULL blocks), all taken before the caller works on any: taking a
+   block is collective, and between two bodies' local work it would make the processes of the other bodies wait
+   (bodies whole on one process; split_sum.c) */
+PetscErrorCode PhlexSystemGetFieldBlocks(PhlexSystem sys, PhlexField f, Vec x, Vec blocks[])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    blocks[i] = NULL;
+    if (x) PetscCall(VecGetSubVector(x, sys->fis[f][i], &blocks[i]));
+  }
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode PhlexSystemRestoreFieldBlocks(PhlexSystem sys, PhlexField f, Vec x, Vec blocks[])
+{
+  PetscFunctionBeginUser;
+  if (x)
+    for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall(VecRestoreSubVector(x, sys->fis[f][i], &blocks[i]));
+  PetscFunctionReturn(0);
+}
+
 /* the compliance masses of all bodies in one AIJ matrix, with the per-cell blocks as variable block sizes (so that
    point-block Jacobi inverts them exactly for any mix of element degrees) */
 static PetscErrorCode AssembleStressBlock(PhlexSystem sys, PhlexFieldOperators *ops, Mat *Ms)
