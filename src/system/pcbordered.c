@@ -263,6 +263,17 @@ static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A
   PetscFunctionReturn(0);
 }
 
+/* -lu_mat_solver_type under prefix: the package of the LU that a body's operator takes where Cholesky was asked for
+   and the operator is not symmetric (BlockFactorType) */
+static PetscErrorCode ReadLUPackage(MPI_Comm comm, const char prefix[], const char title[], char package[], size_t len)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, prefix, title, NULL);
+  PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", package, package, len, NULL));
+  PetscOptionsEnd();
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
 {
   PhlexBorderedData *bd = pb->bd;
@@ -308,9 +319,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
     {
       const char *kprefix;
       PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
-      PetscOptionsBegin(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", NULL);
-      PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", pb->lu_package[i], pb->lu_package[i], sizeof(pb->lu_package[i]), NULL));
-      PetscOptionsEnd();
+      PetscCall(ReadLUPackage(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i])));
     }
   }
   PetscCall(RefuseSharedSuperLUDist(pc, pb));
@@ -645,9 +654,7 @@ PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const nam
     PetscCall(PetscStrlcat(title, names[i], sizeof(title)));
   }
   PetscCall(PetscStrlcat(title, ")", sizeof(title)));
-  PetscOptionsBegin(PETSC_COMM_SELF, common, title, NULL);
-  PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", lu_package, lu_package, sizeof(lu_package), NULL));
-  PetscOptionsEnd();
+  PetscCall(ReadLUPackage(PETSC_COMM_SELF, common, title, lu_package, sizeof(lu_package)));
   PetscCall(KSPDestroy(&ksp));
   PetscFunctionReturn(0);
 }
