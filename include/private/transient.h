@@ -6,7 +6,8 @@
 typedef struct {
   PhlexScene  scene;
   PhlexSystem sys;
-  Vec         Xprev, Xstage, Xmid;
+  Vec         Xprev, Xmid; /* the previous state and scratch (NULL where the scheme's power needs neither) */
+  Vec         Xstage;      /* the theta method's stage (a reference to TS's vector) */
   PetscReal   tstage;
   PetscBool   have_stage;
   PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax, Emax; /* Emax: largest kinetic + strain energy */

@@ -106,7 +106,13 @@ static PetscErrorCode PostStage(TS ts, PetscReal t, PetscInt index, Vec *Y)
 
   PetscFunctionBeginUser;
   PetscCall(TSGetApplicationContext(ts, &m));
-  PetscCall(VecCopy(Y[0], m->Xstage));
+  if (m->theta && !m->endpoint && m->Xstage != Y[0]) {
+    /* the power of the step is taken at its stage: TSTHETA's own stage vector, which the step leaves as it is until
+       the next step starts, so a reference and no copy of the state per step */
+    PetscCall(PetscObjectReference((PetscObject)Y[0]));
+    PetscCall(VecDestroy(&m->Xstage));
+    m->Xstage = Y[0];
+  }
   m->tstage     = t;
   m->have_stage = PETSC_TRUE;
   if (m->adaptive) {
@@ -275,7 +281,8 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     /* the multipliers of the step: (Lambda_{n+1} - Lambda_n)/dt */
     PetscCall(PhlexSystemGather(sys, X, sys->q));
     for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dt : 0.0;
-    if (m->theta && !m->endpoint && m->have_stage) {
+    if (m->theta && !m->endpoint) {
+      PetscCheck(m->have_stage, m->scene->comm, PETSC_ERR_PLIB, "step %" PetscInt_FMT ": the theta method's step has no stage", step);
       PetscCall(InputPower(m, m->tstage, m->Xstage, 1.0, PETSC_TRUE, &power));
     } else if (m->theta && m->endpoint) {
       PetscReal P1, P0;
@@ -310,7 +317,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   if (m->monitor) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(residual * u->energy)));
   PetscCall(Watchdogs(m, step, t, H, residual - m->step_project_dH));
   m->step_project_dH = 0;
-  PetscCall(VecCopy(X, m->Xprev));
+  if (m->Xprev) PetscCall(VecCopy(X, m->Xprev));
   PetscCall(PhlexSystemGather(sys, X, m->qprev));
   m->tprev      = t;
   m->have_stage = PETSC_FALSE;
@@ -824,14 +831,17 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   m.scene    = scene;
   m.sys      = sys;
   m.interval = scene->output->interval;
-  PetscCall(VecDuplicate(X, &m.Xprev));
-  PetscCall(VecDuplicate(X, &m.Xstage));
-  PetscCall(VecDuplicate(X, &m.Xmid));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)ts, &m.theta, TSTHETA, TSCN, TSBEULER, ""));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)ts, &m.history, TSBDF, TSALPHA, ""));
   if (m.theta) {
     PetscCall(TSThetaGetTheta(ts, &m.theta_value));
     PetscCall(TSThetaGetEndpoint(ts, &m.endpoint));
+  }
+  if (!m.theta || m.endpoint || m.adaptive) {
+    /* the previous state, for the power at the ends of the step (the scheme has no stage to take it at) or for
+       the adaptive steps' check of the state a step would end at; the midpoint rule with fixed steps needs neither */
+    PetscCall(VecDuplicate(X, &m.Xprev));
+    PetscCall(VecDuplicate(X, &m.Xmid));
   }
   /* the implicit midpoint rule keeps the power balance to solver tolerance for a quadratic Hamiltonian */
   m.lossless_scheme = (m.theta && !m.endpoint && m.theta_value == 0.5) ? PETSC_TRUE : PETSC_FALSE;

@@ -425,7 +425,7 @@ PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, co
     PetscCall(TSGetTimeStep(ts, &dt));
     if (PetscAbsReal(dt - nominal) > 1e-14 * nominal) PetscCall(PetscPrintf(comm, "Restart: time step %g s (-ts_dt), the run that wrote the checkpoint had %g s\n", (double)dt, (double)nominal));
   }
-  PetscCall(VecCopy(X, m->Xprev));
+  if (m->Xprev) PetscCall(VecCopy(X, m->Xprev));
   m->first_step = step;
   m->last_step  = step;
   m->ck_step    = step;
