@@ -168,6 +168,7 @@ PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);
 
 /* split_sum.c: sums over a part's communicator in two phases (local sums of every part, then the reductions) */
 PETSC_INTERN PetscErrorCode PhlexLocalDot(Vec, Vec, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexLocalMDot(Vec, PetscInt, const Vec[], PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexSplitSumBegin(MPI_Comm, const PetscReal *, PetscReal *, PetscInt, MPI_Request *);
 PETSC_INTERN PetscErrorCode PhlexSplitSumEnd(MPI_Request *);
 

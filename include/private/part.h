@@ -87,6 +87,9 @@ typedef struct {
   PetscReal point[3]; /* port point relative to the frame origin P, body frame, non-dimensional */
 } PhlexPortInfo;
 
+/* the field products behind a port's linearized output: the six velocity moments and three displacement moments */
+#define PHLEX_PORT_SUMS 9
+
 typedef struct {
   PetscErrorCode (*setfromoptions)(PhlexPart);
   PetscErrorCode (*geometry)(PhlexPart, PhlexScaleHints *); /* read meshes, suggest scales */
@@ -113,6 +116,12 @@ typedef struct {
                                                              keeps what it has */
   PetscErrorCode (*bordermult)(PhlexPart, const PetscReal *, Vec);               /* y_v += B x_q (its own columns) */
   PetscErrorCode (*bordermulttranspose)(PhlexPart, Vec, PetscReal, Vec, PetscReal *); /* y_q += a Cu^T x_u + Cv^T x_v (its own rows; NULL vectors are zero) */
+  /* split phases of the border rows (border.c): this process's parts of bordermulttranspose's sums (nq values, set)
+     and of portlinear's field products (PHLEX_PORT_SUMS values, set), and portlinear from the summed products, so
+     that the system sums every part's and joint's products at once; NULL: a part without field unknowns */
+  PetscErrorCode (*bordermulttransposelocal)(PhlexPart, Vec, PetscReal, Vec, PetscReal *);
+  PetscErrorCode (*portlinearlocal)(PhlexPart, PetscInt, Vec, PetscReal, Vec, PetscReal[PHLEX_PORT_SUMS]);
+  PetscErrorCode (*portlinearsummed)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal[PHLEX_PORT_SUMS], const PetscReal *, PetscReal[6]);
   PetscErrorCode (*borderbasis)(PhlexPart, Mat *);                               /* W: state-independent span of its borders */
   PetscErrorCode (*borderrows)(PhlexPart, Mat, PetscReal *, PetscInt);           /* (Cv + Cu/shift)^T Y, nq x k column-major, ld */
   PetscErrorCode (*bordercoefficients)(PhlexPart, PetscReal *, PetscInt);        /* beta: own border columns ~ W beta (k x nq, ld) */

@@ -743,6 +743,46 @@ PetscErrorCode PhlexJointBorderMultTranspose(PhlexJoint j, PhlexPart part, Vec x
 }
 
 /*@C
+  PhlexJointBorderMultTransposeLocal - the first phase of PhlexJointBorderMultTranspose(): this process's parts of
+  the field products of the part's ports on the joint's sides (PHLEX_JOINT_BORDER_SUMS values in loc, set), which the
+  caller sums over the processes and hands to PhlexJointBorderMultTransposeSummed()
+
+  Not collective
+@*/
+PetscErrorCode PhlexJointBorderMultTransposeLocal(PhlexJoint j, PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *loc)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < 2; s++) {
+    PetscReal *ls = loc + s * PHLEX_PORT_SUMS;
+    if (j->side[s].part != part) {
+      for (PetscInt k = 0; k < PHLEX_PORT_SUMS; k++) ls[k] = 0.0;
+      continue;
+    }
+    PetscCall((*part->ops.portlinearlocal)(part, j->side[s].port, xu, au, xv, ls));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointBorderMultTransposeSummed - the second phase: y_q += (joint rows) x (field columns of part), from the
+  summed products of the first phase (the same xu, au, xv; the vectors are not read)
+
+  Not collective
+@*/
+PetscErrorCode PhlexJointBorderMultTransposeSummed(PhlexJoint j, PhlexPart part, Vec xu, PetscReal au, Vec xv, const PetscReal *sums, PetscReal *y)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt s = 0; s < 2; s++) {
+    PetscReal dy[6], rows[7];
+    if (j->side[s].part != part) continue;
+    PetscCall((*part->ops.portlinearsummed)(part, j->side[s].port, xu, au, xv, sums + s * PHLEX_PORT_SUMS, NULL, dy));
+    PetscCall(RowsFromPortChange(j, s, dy, rows));
+    for (PetscInt k = 0; k < j->nc; k++) y[j->qoff + k] += rows[k];
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexJointBorderRows - out += the joint's rows applied to the columns of Y (field of part, the displacement
   eliminated as Y/shift): m x k column-major
 

@@ -187,25 +187,45 @@ static PetscErrorCode FlexPortOutput(PhlexPart part, PetscInt q, PetscReal y[6])
   PetscFunctionReturn(0);
 }
 
-/* dy = d y_q for a change (a du, dv, dq) of the state */
-static PetscErrorCode FlexPortLinear(PhlexPart part, PetscInt q, Vec du, PetscReal au, Vec dv, const PetscReal *dq, PetscReal dy[6])
+/* which field terms of dy = d y_q a change (a du, dv) has: the port's velocity moments of dv, and for a frame with
+   full inertia w x (its displacement moments of a du) */
+static void PortLinearTerms(PhlexFlexible b, PetscInt q, Vec du, PetscReal au, Vec dv, PetscBool *with_v, PetscBool *with_u)
 {
-  PhlexFlexible b    = (PhlexFlexible)part->data;
-  PetscBool     full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscBool full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE;
+
+  *with_v = (q < b->nports && dv) ? PETSC_TRUE : PETSC_FALSE;
+  *with_u = (q < b->nports && du && full && au != 0.0) ? PETSC_TRUE : PETSC_FALSE;
+}
+
+/* the first phase of FlexPortLinear: this process's parts of its field products (PHLEX_PORT_SUMS values: the six
+   moments of dv, the three of du), formed as VecMDot forms them (zero where the change has no such term) */
+static PetscErrorCode FlexPortLinearLocal(PhlexPart part, PetscInt q, Vec du, PetscReal au, Vec dv, PetscReal loc[PHLEX_PORT_SUMS])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscBool     with_v, with_u;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < 6; k++) dy[k] = 0.0;
-  if (q < b->nports && dv) {
-    PetscScalar d[6];
-    PetscCall(VecMDot(dv, 6, b->ports[q].dist, d));
-    for (PetscInt k = 0; k < 6; k++) dy[k] = PetscRealPart(d[k]);
-  }
-  if (q < b->nports && du && full && au != 0.0) {
+  for (PetscInt k = 0; k < PHLEX_PORT_SUMS; k++) loc[k] = 0.0;
+  PortLinearTerms(b, q, du, au, dv, &with_v, &with_u);
+  if (with_v) PetscCall(PhlexLocalMDot(dv, 6, b->ports[q].dist, loc));
+  if (with_u) PetscCall(PhlexLocalMDot(du, 3, b->ports[q].dist, loc + 6));
+  PetscFunctionReturn(0);
+}
+
+/* the second phase: dy from the summed field products (sums; the arguments as in the first phase, du and dv only say
+   which terms there are) and the discrete change dq */
+static PetscErrorCode FlexPortLinearSummed(PhlexPart part, PetscInt q, Vec du, PetscReal au, Vec dv, const PetscReal sums[PHLEX_PORT_SUMS], const PetscReal *dq, PetscReal dy[6])
+{
+  PhlexFlexible b    = (PhlexFlexible)part->data;
+  PetscBool     full = (b->floating && !b->frozen_inertia) ? PETSC_TRUE : PETSC_FALSE, with_v, with_u;
+
+  PetscFunctionBeginUser;
+  PortLinearTerms(b, q, du, au, dv, &with_v, &with_u);
+  for (PetscInt k = 0; k < 6; k++) dy[k] = with_v ? sums[k] : 0.0;
+  if (with_u) {
     /* w x d ubar */
-    PetscScalar d[3];
-    PetscReal   dub[3], a[3];
-    PetscCall(VecMDot(du, 3, b->ports[q].dist, d));
-    for (PetscInt k = 0; k < 3; k++) dub[k] = au * PetscRealPart(d[k]);
+    PetscReal dub[3], a[3];
+    for (PetscInt k = 0; k < 3; k++) dub[k] = au * sums[6 + k];
     PhlexCross(b->fs.w, dub, a);
     for (PetscInt k = 0; k < 3; k++) dy[k] += a[k];
   }
@@ -219,6 +239,23 @@ static PetscErrorCode FlexPortLinear(PhlexPart part, PetscInt q, Vec du, PetscRe
       dy[3 + k] += dw[k];
     }
   }
+  PetscFunctionReturn(0);
+}
+
+/* dy = d y_q for a change (a du, dv, dq) of the state: both phases, its field products summed on their own */
+static PetscErrorCode FlexPortLinear(PhlexPart part, PetscInt q, Vec du, PetscReal au, Vec dv, const PetscReal *dq, PetscReal dy[6])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscReal     loc[PHLEX_PORT_SUMS], sums[PHLEX_PORT_SUMS] = {0};
+  PetscBool     with_v, with_u;
+
+  PetscFunctionBeginUser;
+  PortLinearTerms(b, q, du, au, dv, &with_v, &with_u);
+  if (with_v || with_u) {
+    PetscCall(FlexPortLinearLocal(part, q, du, au, dv, loc));
+    PetscCall(MPIU_Allreduce(loc, sums, PHLEX_PORT_SUMS, MPIU_REAL, MPI_SUM, b->comm));
+  }
+  PetscCall(FlexPortLinearSummed(part, q, du, au, dv, sums, dq, dy));
   PetscFunctionReturn(0);
 }
 
@@ -936,15 +973,16 @@ static void BorderRowsOfMoments(PetscInt nq, PetscInt nin, const PetscScalar *L,
   }
 }
 
-static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *y)
+/* the first phase of FlexBorderMultTranspose: this process's parts of its own rows (nq values in loc) */
+static PetscErrorCode FlexBorderMultTransposeLocal(PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *loc)
 {
   PhlexFlexible      b = (PhlexFlexible)part->data;
   const PetscInt     nq = part->nq, nin = b->border_nin;
   const PetscScalar *xa;
   PetscScalar       *Mom;
-  PetscReal          loc[24] = {0}, glob[24];
 
   PetscFunctionBeginUser;
+  for (PetscInt j = 0; j < nq; j++) loc[j] = 0.0;
   if (!nq) PetscFunctionReturn(0);
   PetscCall(PetscMalloc1(3 * nin, &Mom));
   if (xu && xu == xv && au != 0.0) {
@@ -969,6 +1007,18 @@ static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal 
     }
   }
   PetscCall(PetscFree(Mom));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *y)
+{
+  PhlexFlexible  b  = (PhlexFlexible)part->data;
+  const PetscInt nq = part->nq;
+  PetscReal      loc[24], glob[24];
+
+  PetscFunctionBeginUser;
+  if (!nq) PetscFunctionReturn(0);
+  PetscCall(FlexBorderMultTransposeLocal(part, xu, au, xv, loc));
   PetscCall(MPIU_Allreduce(loc, glob, nq, MPIU_REAL, MPI_SUM, b->comm));
   for (PetscInt j = 0; j < nq; j++) y[j] += glob[j];
   PetscFunctionReturn(0);
@@ -1121,11 +1171,14 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->ops.mixedoperators      = FlexMixedOperators;
   part->ops.bordermult          = FlexBorderMult;
   part->ops.bordermulttranspose = FlexBorderMultTranspose;
+  part->ops.bordermulttransposelocal = FlexBorderMultTransposeLocal;
   part->ops.borderbasis         = FlexBorderBasis;
   part->ops.borderrows          = FlexBorderRows;
   part->ops.bordercoefficients  = FlexBorderCoefficients;
   part->ops.portoutput          = FlexPortOutput;
   part->ops.portlinear          = FlexPortLinear;
+  part->ops.portlinearlocal     = FlexPortLinearLocal;
+  part->ops.portlinearsummed    = FlexPortLinearSummed;
   part->ops.portlinearblock     = FlexPortLinearBlock;
   part->ops.portforce           = FlexPortForce;
   part->ops.portbasiscolumn     = FlexPortBasisColumn;

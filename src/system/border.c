@@ -55,11 +55,16 @@ static PetscErrorCode MatMult_Bvq(Mat A, Vec x, Vec y)
   PetscFunctionReturn(0);
 }
 
-/* y_Q = a Cu^T x_U + Cv^T x_V (x_U or x_V NULL: zero): the discrete rows applied to field vectors */
+/* y_Q = a Cu^T x_U + Cv^T x_V (x_U or x_V NULL: zero): the discrete rows applied to field vectors. Every body's and
+   every joint's products are formed on each process first and summed over the processes in one reduction, then
+   added up in the order of the bodies and their joints: with the bodies whole on different processes, a reduction
+   per body and joint side would make each process wait while another forms its body's products. The same sums
+   element by element as a reduction each (on two processes, bit for bit). */
 static PetscErrorCode BorderRowsApply(PhlexSystem sys, Vec xU, PetscReal au, Vec xV, Vec y)
 {
-  PetscReal *yq;
+  PetscReal *yq, *loc, *sums;
   Vec       *ui, *vi;
+  PetscInt   n = 0, off = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PetscCalloc1(PetscMax(sys->nq, 1), &yq));
@@ -68,12 +73,36 @@ static PetscErrorCode BorderRowsApply(PhlexSystem sys, Vec xU, PetscReal au, Vec
   PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, xV == xU ? NULL : xV, vi));
   if (xV == xU)
     for (PetscInt i = 0; i < sys->nfparts; i++) vi[i] = ui[i];
+  /* the sums' slots: per body its own rows, then the products of each joint on it */
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    n += sys->fparts[i]->nq;
+    for (PetscInt k = 0; k < sys->njoints; k++)
+      if (PhlexJointTouches(sys->joints[k], sys->fparts[i])) n += PHLEX_JOINT_BORDER_SUMS;
+  }
+  PetscCall(PetscMalloc2(PetscMax(n, 1), &loc, PetscMax(n, 1), &sums));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexPart p = sys->fparts[i];
-    PetscCall((*p->ops.bordermulttranspose)(p, ui[i], au, vi[i], yq + p->qoff));
-    for (PetscInt k = 0; k < sys->njoints; k++)
-      if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMultTranspose(sys->joints[k], p, ui[i], au, vi[i], yq));
+    PetscCall((*p->ops.bordermulttransposelocal)(p, ui[i], au, vi[i], loc + off));
+    off += p->nq;
+    for (PetscInt k = 0; k < sys->njoints; k++) {
+      if (!PhlexJointTouches(sys->joints[k], p)) continue;
+      PetscCall(PhlexJointBorderMultTransposeLocal(sys->joints[k], p, ui[i], au, vi[i], loc + off));
+      off += PHLEX_JOINT_BORDER_SUMS;
+    }
   }
+  if (n) PetscCall(MPIU_Allreduce(loc, sums, n, MPIU_REAL, MPI_SUM, sys->comm));
+  off = 0;
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexPart p = sys->fparts[i];
+    for (PetscInt r = 0; r < p->nq; r++) yq[p->qoff + r] += sums[off + r];
+    off += p->nq;
+    for (PetscInt k = 0; k < sys->njoints; k++) {
+      if (!PhlexJointTouches(sys->joints[k], p)) continue;
+      PetscCall(PhlexJointBorderMultTransposeSummed(sys->joints[k], p, ui[i], au, vi[i], sums + off, yq));
+      off += PHLEX_JOINT_BORDER_SUMS;
+    }
+  }
+  PetscCall(PetscFree2(loc, sums));
   PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_VELOCITY, xV == xU ? NULL : xV, vi));
   PetscCall(PhlexSystemRestoreFieldBlocks(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, xU, ui));
   PetscCall(PetscFree2(ui, vi));

@@ -7,6 +7,7 @@
    it takes, so the results are those of MPI_Allreduce bit for bit (on more, the non-blocking reduction may add in
    another order: round-off). */
 #include <phlex_impl.h>
+#include <petsc/private/vecimpl.h>
 #include <petscblaslapack.h>
 
 /*@C
@@ -31,6 +32,25 @@ PetscErrorCode PhlexLocalDot(Vec x, Vec y, PetscReal *d)
   PetscCall(VecRestoreArrayRead(x, &xa));
   PetscCall(VecRestoreArrayRead(y, &ya));
   if (n > 0) PetscCall(PetscLogFlops(2.0 * n - 1));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexLocalMDot - this process's parts of VecMDot(x, nv, y), formed by the Vec's own local kernel (the one
+  VecMDotBegin() uses, VecMDot_Seq for standard vectors: VecMDot's sums over the processes are of these values)
+
+  Not collective
+@*/
+PetscErrorCode PhlexLocalMDot(Vec x, PetscInt nv, const Vec y[], PetscReal *d)
+{
+  PetscScalar dd[16];
+
+  PetscFunctionBeginUser;
+  PetscCheck(nv <= 16, PETSC_COMM_SELF, PETSC_ERR_PLIB, "PhlexLocalMDot: %" PetscInt_FMT " > 16 vectors", nv);
+  PetscCall(VecLockReadPush(x));
+  PetscUseTypeMethod(x, mdot_local, nv, y, dd);
+  PetscCall(VecLockReadPop(x));
+  for (PetscInt k = 0; k < nv; k++) d[k] = PetscRealPart(dd[k]);
   PetscFunctionReturn(0);
 }
 
