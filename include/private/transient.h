@@ -6,8 +6,9 @@
 typedef struct {
   PhlexScene  scene;
   PhlexSystem sys;
-  Vec         Xprev, Xmid; /* the previous state and scratch (NULL where the scheme's power needs neither) */
-  Vec         Xstage;      /* the theta method's stage (a reference to TS's vector) */
+  Vec         Xprev, Xmid; /* the previous state and scratch (NULL where neither the power nor the adaptive check reads them) */
+  Vec         Xstage;      /* the theta method's stage (a reference to TSTHETA's vector, its state at the stage kept) */
+  PetscObjectState stage_state;
   PetscReal   tstage;
   PetscBool   have_stage;
   PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax, Emax; /* Emax: largest kinetic + strain energy */

@@ -9,6 +9,7 @@
    theta methods (where the scheme enforces the constraints); for the other schemes lambda . g(t), the scheme holding
    c = g. */
 #include <phlex_impl.h>
+#include <petsc/private/petscimpl.h> /* PetscObjectStateGet: the stage vector unchanged since the stage */
 #include <private/transient.h>
 
 
@@ -113,6 +114,7 @@ static PetscErrorCode PostStage(TS ts, PetscReal t, PetscInt index, Vec *Y)
     PetscCall(VecDestroy(&m->Xstage));
     m->Xstage = Y[0];
   }
+  if (m->Xstage) PetscCall(PetscObjectStateGet((PetscObject)m->Xstage, &m->stage_state)); /* checked by the monitor */
   m->tstage     = t;
   m->have_stage = PETSC_TRUE;
   if (m->adaptive) {
@@ -282,7 +284,10 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     PetscCall(PhlexSystemGather(sys, X, sys->q));
     for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dt : 0.0;
     if (m->theta && !m->endpoint) {
+      PetscObjectState state;
       PetscCheck(m->have_stage, m->scene->comm, PETSC_ERR_PLIB, "step %" PetscInt_FMT ": the theta method's step has no stage", step);
+      PetscCall(PetscObjectStateGet((PetscObject)m->Xstage, &state));
+      PetscCheck(state == m->stage_state, m->scene->comm, PETSC_ERR_PLIB, "step %" PetscInt_FMT ": TS changed the theta method's stage vector after the stage", step);
       PetscCall(InputPower(m, m->tstage, m->Xstage, 1.0, PETSC_TRUE, &power));
     } else if (m->theta && m->endpoint) {
       PetscReal P1, P0;
@@ -837,17 +842,18 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(TSThetaGetTheta(ts, &m.theta_value));
     PetscCall(TSThetaGetEndpoint(ts, &m.endpoint));
   }
-  if (!m.theta || m.endpoint || m.adaptive) {
-    /* the previous state, for the power at the ends of the step (the scheme has no stage to take it at) or for
-       the adaptive steps' check of the state a step would end at; the midpoint rule with fixed steps needs neither */
-    PetscCall(VecDuplicate(X, &m.Xprev));
-    PetscCall(VecDuplicate(X, &m.Xmid));
-  }
   /* the implicit midpoint rule keeps the power balance to solver tolerance for a quadratic Hamiltonian */
   m.lossless_scheme = (m.theta && !m.endpoint && m.theta_value == 0.5) ? PETSC_TRUE : PETSC_FALSE;
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
   m.watch_balance   = o.watch_balance;
+  if (!m.theta || m.endpoint || (m.adaptive && m.lossless_scheme && m.watch_balance > 0)) {
+    /* the previous state, for the power at the ends of the step (a scheme without a stage to take it at) or for the
+       adaptive steps' balance check of the state a step would end at (CheckStage); the theta method's stage needs
+       neither */
+    PetscCall(VecDuplicate(X, &m.Xprev));
+    PetscCall(VecDuplicate(X, &m.Xmid));
+  }
   m.watch_gap       = o.watch_gap;
   m.watch_orth      = o.watch_orth;
   if (restarting) {

@@ -36,8 +36,9 @@ PetscErrorCode PhlexLocalDot(Vec x, Vec y, PetscReal *d)
 }
 
 /*@C
-  PhlexLocalMDot - this process's parts of VecMDot(x, nv, y), formed by the Vec's own local kernel (the one
-  VecMDotBegin() uses, VecMDot_Seq for standard vectors: VecMDot's sums over the processes are of these values)
+  PhlexLocalMDot - this process's parts of VecMDot(x, nv, y), formed by the Vec's own local kernel (its private
+  mdot_local, the one VecMDotBegin() uses, VecMDot_Seq for standard vectors: VecMDot's sums over the processes are of
+  these values); logged as VecMDot
 
   Not collective
 @*/
@@ -47,8 +48,16 @@ PetscErrorCode PhlexLocalMDot(Vec x, PetscInt nv, const Vec y[], PetscReal *d)
 
   PetscFunctionBeginUser;
   PetscCheck(nv <= 16, PETSC_COMM_SELF, PETSC_ERR_PLIB, "PhlexLocalMDot: %" PetscInt_FMT " > 16 vectors", nv);
+  for (PetscInt k = 0; k < nv; k++) {
+    PetscCheckSameTypeAndComm(x, 1, y[k], 3);
+    VecCheckSameSize(x, 1, y[k], 3);
+  }
   PetscCall(VecLockReadPush(x));
+  for (PetscInt k = 0; k < nv; k++) PetscCall(VecLockReadPush(y[k]));
+  PetscCall(PetscLogEventBegin(VEC_MDot, x, *y, 0, 0));
   PetscUseTypeMethod(x, mdot_local, nv, y, dd);
+  PetscCall(PetscLogEventEnd(VEC_MDot, x, *y, 0, 0));
+  for (PetscInt k = 0; k < nv; k++) PetscCall(VecLockReadPop(y[k]));
   PetscCall(VecLockReadPop(x));
   for (PetscInt k = 0; k < nv; k++) d[k] = PetscRealPart(dd[k]);
   PetscFunctionReturn(0);
