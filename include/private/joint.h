@@ -101,7 +101,6 @@ PETSC_INTERN PetscErrorCode PhlexJointJacobian(PhlexJoint, PetscReal, PetscReal 
 PETSC_INTERN PetscErrorCode PhlexJointBorderMult(PhlexJoint, PetscReal, const PetscReal *, PhlexPart, Vec);
 /* the field products of a joint's two sides on one part (PhlexJointBorderMultTransposeLocal) */
 #define PHLEX_JOINT_BORDER_SUMS (2 * PHLEX_PORT_SUMS)
-PETSC_INTERN PetscErrorCode PhlexJointBorderMultTranspose(PhlexJoint, PhlexPart, Vec, PetscReal, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointBorderMultTransposeLocal(PhlexJoint, PhlexPart, Vec, PetscReal, Vec, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointBorderMultTransposeSummed(PhlexJoint, PhlexPart, Vec, PetscReal, Vec, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointBorderRows(PhlexJoint, PhlexPart, Mat, PetscReal, PetscReal *, PetscInt);

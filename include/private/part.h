@@ -115,10 +115,10 @@ typedef struct {
                                                              PETSC_TRUE: assemble them again if freed. NULL: the part
                                                              keeps what it has */
   PetscErrorCode (*bordermult)(PhlexPart, const PetscReal *, Vec);               /* y_v += B x_q (its own columns) */
-  PetscErrorCode (*bordermulttranspose)(PhlexPart, Vec, PetscReal, Vec, PetscReal *); /* y_q += a Cu^T x_u + Cv^T x_v (its own rows; NULL vectors are zero) */
-  /* split phases of the border rows (border.c): this process's parts of bordermulttranspose's sums (nq values, set)
-     and of portlinear's field products (PHLEX_PORT_SUMS values, set), and portlinear from the summed products, so
-     that the system sums every part's and joint's products at once; NULL: a part without field unknowns */
+  /* the discrete rows applied to field vectors in two phases (border.c sums every part's and joint's products over
+     the processes in one reduction): this process's parts of a Cu^T x_u + Cv^T x_v, its own rows (nq values, set;
+     NULL vectors are zero), and of portlinear's field products (PHLEX_PORT_SUMS values, set), then portlinear from the
+     summed products; NULL: a part without field unknowns */
   PetscErrorCode (*bordermulttransposelocal)(PhlexPart, Vec, PetscReal, Vec, PetscReal *);
   PetscErrorCode (*portlinearlocal)(PhlexPart, PetscInt, Vec, PetscReal, Vec, PetscReal[PHLEX_PORT_SUMS]);
   PetscErrorCode (*portlinearsummed)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal[PHLEX_PORT_SUMS], const PetscReal *, PetscReal[6]);

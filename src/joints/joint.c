@@ -725,27 +725,9 @@ PetscErrorCode PhlexJointBorderMult(PhlexJoint j, PetscReal shift, const PetscRe
 }
 
 /*@C
-  PhlexJointBorderMultTranspose - y_q += (joint rows) x (field columns of part) (a xu, xv)
-
-  Collective on the part
-@*/
-PetscErrorCode PhlexJointBorderMultTranspose(PhlexJoint j, PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *y)
-{
-  PetscFunctionBeginUser;
-  for (PetscInt s = 0; s < 2; s++) {
-    PetscReal dy[6], rows[7];
-    if (j->side[s].part != part) continue;
-    PetscCall((*part->ops.portlinear)(part, j->side[s].port, xu, au, xv, NULL, dy));
-    PetscCall(RowsFromPortChange(j, s, dy, rows));
-    for (PetscInt k = 0; k < j->nc; k++) y[j->qoff + k] += rows[k];
-  }
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexJointBorderMultTransposeLocal - the first phase of PhlexJointBorderMultTranspose(): this process's parts of
-  the field products of the part's ports on the joint's sides (PHLEX_JOINT_BORDER_SUMS values in loc, set), which the
-  caller sums over the processes and hands to PhlexJointBorderMultTransposeSummed()
+  PhlexJointBorderMultTransposeLocal - the joint's rows applied to field vectors of part (a xu, xv), first phase:
+  this process's parts of the field products of the part's ports on the joint's sides (PHLEX_JOINT_BORDER_SUMS
+  values in loc, set), which the caller sums over the processes and hands to PhlexJointBorderMultTransposeSummed()
 
   Not collective
 @*/
@@ -764,8 +746,8 @@ PetscErrorCode PhlexJointBorderMultTransposeLocal(PhlexJoint j, PhlexPart part, 
 }
 
 /*@C
-  PhlexJointBorderMultTransposeSummed - the second phase: y_q += (joint rows) x (field columns of part), from the
-  summed products of the first phase (the same xu, au, xv; the vectors are not read)
+  PhlexJointBorderMultTransposeSummed - the second phase: y_q += (joint rows) x (field columns of part) (a xu, xv),
+  from the summed products of the first phase (the same xu, au, xv; the vectors are not read)
 
   Not collective
 @*/

@@ -973,7 +973,8 @@ static void BorderRowsOfMoments(PetscInt nq, PetscInt nin, const PetscScalar *L,
   }
 }
 
-/* the first phase of FlexBorderMultTranspose: this process's parts of its own rows (nq values in loc) */
+/* this process's parts of its own discrete rows applied to field vectors, a Cu^T xu + Cv^T xv (nq values in loc,
+   set; NULL vectors are zero): the system sums them over the processes (border.c) */
 static PetscErrorCode FlexBorderMultTransposeLocal(PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *loc)
 {
   PhlexFlexible      b = (PhlexFlexible)part->data;
@@ -1007,20 +1008,6 @@ static PetscErrorCode FlexBorderMultTransposeLocal(PhlexPart part, Vec xu, Petsc
     }
   }
   PetscCall(PetscFree(Mom));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode FlexBorderMultTranspose(PhlexPart part, Vec xu, PetscReal au, Vec xv, PetscReal *y)
-{
-  PhlexFlexible  b  = (PhlexFlexible)part->data;
-  const PetscInt nq = part->nq;
-  PetscReal      loc[24], glob[24];
-
-  PetscFunctionBeginUser;
-  if (!nq) PetscFunctionReturn(0);
-  PetscCall(FlexBorderMultTransposeLocal(part, xu, au, xv, loc));
-  PetscCall(MPIU_Allreduce(loc, glob, nq, MPIU_REAL, MPI_SUM, b->comm));
-  for (PetscInt j = 0; j < nq; j++) y[j] += glob[j];
   PetscFunctionReturn(0);
 }
 
@@ -1170,7 +1157,6 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->ops.fieldoperators      = FlexFieldOperators;
   part->ops.mixedoperators      = FlexMixedOperators;
   part->ops.bordermult          = FlexBorderMult;
-  part->ops.bordermulttranspose = FlexBorderMultTranspose;
   part->ops.bordermulttransposelocal = FlexBorderMultTransposeLocal;
   part->ops.borderbasis         = FlexBorderBasis;
   part->ops.borderrows          = FlexBorderRows;

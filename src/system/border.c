@@ -55,16 +55,56 @@ static PetscErrorCode MatMult_Bvq(Mat A, Vec x, Vec y)
   PetscFunctionReturn(0);
 }
 
-/* y_Q = a Cu^T x_U + Cv^T x_V (x_U or x_V NULL: zero): the discrete rows applied to field vectors. Every body's and
-   every joint's products are formed on each process first and summed over the processes in one reduction, then
-   added up in the order of the bodies and their joints: with the bodies whole on different processes, a reduction
-   per body and joint side would make each process wait while another forms its body's products. The same sums
-   element by element as a reduction each (on two processes, bit for bit). */
+/* y_Q += the discrete rows of the bodies i0 <= i < i1 applied to their field blocks, a Cu^T u[i - i0] + Cv^T v[i - i0]
+   (NULL blocks: zero). Every body's and every joint's products are formed on each process first and summed over the
+   processes in one reduction, then added up in the order of the bodies and their joints: with the bodies whole on
+   different processes, a reduction per body and joint side would make each process wait while another forms its
+   body's products. The same sums element by element as a reduction each (on two processes, bit for bit). */
+static PetscErrorCode BorderRowsSum(PhlexSystem sys, PetscInt i0, PetscInt i1, Vec u[], PetscReal au, Vec v[], PetscReal *yq)
+{
+  PetscReal *loc, *sums;
+  PetscInt   n = 0, off = 0;
+
+  PetscFunctionBeginUser;
+  /* the sums' slots: per body its own rows, then the products of each joint on it */
+  for (PetscInt i = i0; i < i1; i++) {
+    n += sys->fparts[i]->nq;
+    for (PetscInt k = 0; k < sys->njoints; k++)
+      if (PhlexJointTouches(sys->joints[k], sys->fparts[i])) n += PHLEX_JOINT_BORDER_SUMS;
+  }
+  if (!n) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc2(n, &loc, n, &sums));
+  for (PetscInt i = i0; i < i1; i++) {
+    PhlexPart p = sys->fparts[i];
+    PetscCall((*p->ops.bordermulttransposelocal)(p, u[i - i0], au, v[i - i0], loc + off));
+    off += p->nq;
+    for (PetscInt k = 0; k < sys->njoints; k++) {
+      if (!PhlexJointTouches(sys->joints[k], p)) continue;
+      PetscCall(PhlexJointBorderMultTransposeLocal(sys->joints[k], p, u[i - i0], au, v[i - i0], loc + off));
+      off += PHLEX_JOINT_BORDER_SUMS;
+    }
+  }
+  PetscCall(MPIU_Allreduce(loc, sums, n, MPIU_REAL, MPI_SUM, sys->comm));
+  off = 0;
+  for (PetscInt i = i0; i < i1; i++) {
+    PhlexPart p = sys->fparts[i];
+    for (PetscInt r = 0; r < p->nq; r++) yq[p->qoff + r] += sums[off + r];
+    off += p->nq;
+    for (PetscInt k = 0; k < sys->njoints; k++) {
+      if (!PhlexJointTouches(sys->joints[k], p)) continue;
+      PetscCall(PhlexJointBorderMultTransposeSummed(sys->joints[k], p, u[i - i0], au, v[i - i0], sums + off, yq));
+      off += PHLEX_JOINT_BORDER_SUMS;
+    }
+  }
+  PetscCall(PetscFree2(loc, sums));
+  PetscFunctionReturn(0);
+}
+
+/* y_Q = a Cu^T x_U + Cv^T x_V (x_U or x_V NULL: zero): the discrete rows applied to field vectors */
 static PetscErrorCode BorderRowsApply(PhlexSystem sys, Vec xU, PetscReal au, Vec xV, Vec y)
 {
-  PetscReal *yq, *loc, *sums;
+  PetscReal *yq;
   Vec       *ui, *vi;
-  PetscInt   n = 0, off = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PetscCalloc1(PetscMax(sys->nq, 1), &yq));
@@ -73,36 +113,7 @@ static PetscErrorCode BorderRowsApply(PhlexSystem sys, Vec xU, PetscReal au, Vec
   PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, xV == xU ? NULL : xV, vi));
   if (xV == xU)
     for (PetscInt i = 0; i < sys->nfparts; i++) vi[i] = ui[i];
-  /* the sums' slots: per body its own rows, then the products of each joint on it */
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    n += sys->fparts[i]->nq;
-    for (PetscInt k = 0; k < sys->njoints; k++)
-      if (PhlexJointTouches(sys->joints[k], sys->fparts[i])) n += PHLEX_JOINT_BORDER_SUMS;
-  }
-  PetscCall(PetscMalloc2(PetscMax(n, 1), &loc, PetscMax(n, 1), &sums));
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexPart p = sys->fparts[i];
-    PetscCall((*p->ops.bordermulttransposelocal)(p, ui[i], au, vi[i], loc + off));
-    off += p->nq;
-    for (PetscInt k = 0; k < sys->njoints; k++) {
-      if (!PhlexJointTouches(sys->joints[k], p)) continue;
-      PetscCall(PhlexJointBorderMultTransposeLocal(sys->joints[k], p, ui[i], au, vi[i], loc + off));
-      off += PHLEX_JOINT_BORDER_SUMS;
-    }
-  }
-  if (n) PetscCall(MPIU_Allreduce(loc, sums, n, MPIU_REAL, MPI_SUM, sys->comm));
-  off = 0;
-  for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PhlexPart p = sys->fparts[i];
-    for (PetscInt r = 0; r < p->nq; r++) yq[p->qoff + r] += sums[off + r];
-    off += p->nq;
-    for (PetscInt k = 0; k < sys->njoints; k++) {
-      if (!PhlexJointTouches(sys->joints[k], p)) continue;
-      PetscCall(PhlexJointBorderMultTransposeSummed(sys->joints[k], p, ui[i], au, vi[i], sums + off, yq));
-      off += PHLEX_JOINT_BORDER_SUMS;
-    }
-  }
-  PetscCall(PetscFree2(loc, sums));
+  PetscCall(BorderRowsSum(sys, 0, sys->nfparts, ui, au, vi, yq));
   PetscCall(PhlexSystemRestoreFieldBlocks(sys, PHLEX_FIELD_VELOCITY, xV == xU ? NULL : xV, vi));
   PetscCall(PhlexSystemRestoreFieldBlocks(sys, xV ? PHLEX_FIELD_VELOCITY : PHLEX_FIELD_DISPLACEMENT, xU, ui));
   PetscCall(PetscFree2(ui, vi));
@@ -210,12 +221,9 @@ static PetscErrorCode BorderCoefficients(void *ctx, PetscInt i, PetscReal *beta)
 static PetscErrorCode BorderRowsVec(void *ctx, PetscInt i, Vec x, PetscReal *y)
 {
   PhlexSystem sys = (PhlexSystem)ctx;
-  PhlexPart   p   = sys->fparts[i];
 
   PetscFunctionBeginUser;
-  PetscCall((*p->ops.bordermulttranspose)(p, x, 1.0 / sys->shift, x, y + p->qoff));
-  for (PetscInt j = 0; j < sys->njoints; j++)
-    if (PhlexJointTouches(sys->joints[j], p)) PetscCall(PhlexJointBorderMultTranspose(sys->joints[j], p, x, 1.0 / sys->shift, x, y));
+  PetscCall(BorderRowsSum(sys, i, i + 1, &x, 1.0 / sys->shift, &x, y));
   PetscFunctionReturn(0);
 }
 
