@@ -3,9 +3,10 @@
    the database; phlex strips -help from the command line (so that PETSc does not print its own banner and the
    options of every PETSc program), sets it after initialisation, and filters what goes to stdout (PETSc's
    PetscVFPrintf, through which every PETSc print passes): one line per option, "<value; default d>" instead of
-   "<now v : formerly d>", no bytes that are not printable (PETSc 3.18 prints an uninitialised buffer for
-   -dm_plex_boundary_label), no repeated option line, no man-page reference ("(TSSetType)"). "-help solvers" also
-   sets the scene up and reads the solver objects' options (TS, SNES, KSP, PC, EPS, ST), still without a step.
+   "<now v : formerly d>", no bytes that are not printable and an empty value for -dm_plex_boundary_label (PETSc
+   3.18 prints an uninitialised buffer as its value), no repeated option line, no man-page reference ("(TSSetType)").
+   "-help solvers" also sets the scene up and reads the solver objects' options (TS, SNES, KSP, PC, EPS, ST), still
+   without a step.
    The same filter collects the names of the valid options for the unused-option check (capture mode). */
 #include <phlex_impl.h>
 #include <ctype.h>
@@ -159,6 +160,16 @@ static PetscErrorCode EmitLine(const char *line)
   for (c = line; *c; c++)
     if ((*c >= 0x20 && *c < 0x7f) || *c == '\t' || *c == '\n') clean[n++] = *c;
   clean[n] = 0;
+  if (option && strstr(clean, "dm_plex_boundary_label <now ")) {
+    /* PETSc 3.18 prints this option's uninitialised value buffer as its value (now and formerly): whatever an earlier
+       call left on the stack, text of another option's line included; unless given, its value is empty */
+    const char *name  = clean + strspn(clean, " ");
+    char       *open  = strchr(clean, '<'), *close = strstr(clean, ">: Label to mark the mesh boundary"), opt[256];
+    PetscBool   given = PETSC_FALSE;
+    PetscCall(PetscSNPrintf(opt, sizeof(opt), "%.*s", (int)strcspn(name, " <"), name));
+    PetscCall(PetscOptionsHasName(NULL, NULL, opt, &given));
+    if (!given && open && close > open) memmove(open + 1, close, strlen(close) + 1);
+  }
   PetscCall(RewriteValue(clean, out, len));
   /* the man-page reference at the end of an option line, " (PhlexFlexibleSetFromOptions)", means nothing to a user */
   n   = strlen(out);

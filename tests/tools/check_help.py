@@ -22,7 +22,8 @@ def main() -> int:
     print("printable: " + ("PASS" if not bad else "FAIL (bytes " + " ".join(f"0x{b:02x}" for b in bad) + ")"))
     text = data.decode("ascii", errors="replace")
     lines = text.splitlines()
-    print("phlex form: " + ("FAIL" if " : formerly " in text or "<now " in text else "PASS"))
+    raw = [ln for ln in lines if " : formerly " in ln or "<now " in ln]
+    print("phlex form: " + ("FAIL: " + raw[0].strip() if raw else "PASS"))
     options = [ln for ln in lines if re.match(r"^ +-[A-Za-z]", ln)]
     repeated = sorted({ln for ln in options if options.count(ln) > 1})
     print("each option once: " + ("PASS" if not repeated else "FAIL: " + repeated[0]))
