@@ -86,8 +86,13 @@ def phlex_transient(a, steps):
     return stepping_time(log), wall, rss, dofs
 
 
-def peer_env():
+def peer_env(python):
+    """one thread per process; the MPI library of the peer's wheels (MPICH, in the virtual environment's lib/) found
+    without activating the environment"""
     env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1")
+    lib = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(python))), "lib")
+    if os.path.exists(os.path.join(lib, "libmpi.so.12")):
+        env["LD_LIBRARY_PATH"] = lib + (":" + env["LD_LIBRARY_PATH"] if env.get("LD_LIBRARY_PATH") else "")
     return env
 
 
@@ -128,7 +133,7 @@ def main():
                 w.writerow([stamp, case, a.mesh, a.np, "phlex", r, dofs, "%.4f" % ph, "%.2f" % wall, "%.3f" % rss, load, a.extra])
                 cmd = mpi(a.np, [a.peer_python, os.path.join(peer, "transient_bar.py"), mesh, "--degree", "2",
                                  "--solver", "mumps", "--steps", "20"], peer_launcher(a.peer_python))
-                log, wall, rss = timed(cmd, peer_env())
+                log, wall, rss = timed(cmd, peer_env(a.peer_python))
                 j = json.loads([l for l in log.splitlines() if l.startswith("{")][-1])
                 pe = j["per_step_ms"] / 1e3
                 w.writerow([stamp, case, a.mesh, a.np, "peer", r, j["ndofs"], "%.4f" % pe, "%.2f" % wall, "%.3f" % rss, load, ""])
@@ -146,7 +151,7 @@ def main():
                             (a.extra + " -modes_eps_tol " + a.phlex_tol).strip() if a.phlex_tol else a.extra])
                 cmd = mpi(a.np, [a.peer_python, os.path.join(peer, "modal_bar.py"), mesh, "--degree", "2", "--bc",
                                  "free", "--nev", "26", "--tol", a.tol], peer_launcher(a.peer_python))
-                log, wpe, rpe = timed(cmd, peer_env())
+                log, wpe, rpe = timed(cmd, peer_env(a.peer_python))
                 j = json.loads([l for l in log.splitlines() if l.startswith("{")][-1])
                 ndofs = j.get("ndofs", 0)
                 w.writerow([stamp, case, a.mesh, a.np, "peer", r, ndofs, "", "%.2f" % wpe, "%.3f" % rpe, load, ""])
