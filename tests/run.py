@@ -750,7 +750,12 @@ def apply_filter(spec: Spec, stdout: str, outdir: str, chk: Checker) -> Optional
     """
     if not spec.filter:
         return stdout
-    res = run_process(["sh", "-c", substitute(spec.filter, outdir)], os.environ.copy(),
+    # a filter may start phlex itself with mpiexec, which refuses root without OMPI_ALLOW_RUN_AS_ROOT; not the other
+    # settings of test_env(): singletons isolated from an orted share one session directory, and two filters' runs
+    # writing checkpoint.h5 at once then collide in Open MPI's shared-file-pointer files
+    env = os.environ.copy()
+    env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
+    res = run_process(["sh", "-c", substitute(spec.filter, outdir)], env,
                       spec.timeout, stdin_data=stdout.encode("utf-8"))
     if res.timed_out or res.returncode not in (0, 1):
         chk.fail(f"filter failed ({'timeout' if res.timed_out else describe_exit(res.returncode)})",

@@ -229,6 +229,8 @@ struct _p_PhlexFlexible {
   PetscReal stiffness[PHLEX_MAX_MATERIALS][36]; /* each material's A^{-1} */
   PetscReal smass_inv[16];                      /* the stress basis's reference mass, inverted */
   Vec       smap_vloc, smap_floc;               /* local (ghosted) velocity field: the product's input, G^T's sums */
+  PetscScalar *smap_varray;                     /* smap_vloc's storage, one entry longer: a node's 3 velocities read as 4 */
+  PetscBool    smap_vnodes;                     /* each node's 3 velocities consecutive in smap_vloc (read node by node) */
   Vec fvol[3]; /* int phi e_c dOmega (uniform body forces) */
 
   /* Jacobian pieces (transient), updated by the part */

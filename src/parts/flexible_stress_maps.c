@@ -16,7 +16,10 @@
    local offsets. The condensed stiffness K = G^T Ms^{-1} G (SNES phlexreduced's residual and Jacobian) is the two in
    one pass per cell, the stress kept in the cell; a linear stage's predicted stress with its resultant, and its final
    stress, are one pass each (PhlexStressMapsPredict, PhlexStressMapsCorrect), and the monitor's strain energy 1/2
-   Sigma^T Ms Sigma comes from the same structure (PhlexFlexibleStrainEnergyLocal). The sums are not those of the assembled
+   Sigma^T Ms Sigma comes from the same structure (PhlexFlexibleStrainEnergyLocal). The kernels run four cells at once
+   and move whole vectors where they can (a node's three velocities, four consecutive cells' stresses, by 4 x 4
+   transposes; one material's stiffness as scalars), the P2/P1 shape compiled with its sizes as constants: the same
+   operations in the same order as cell by cell (BENCHMARKS.md sections 22 and 30). The sums are not those of the assembled
    products: results differ from them in the last bits (BENCHMARKS.md section 18). For the body's undeformed geometry only: geometric stiffening's G(u) is assembled
    (flexible_stiffening.c). */
 #include <phlex_impl.h>
@@ -54,8 +57,23 @@ static PetscErrorCode StressMapsSetUp(PhlexFlexible b)
   PetscCall(PetscArraycpy(b->smass_inv, b->ref.smass, nn * nn));
   PetscCall(InvertSmall(nn, b->smass_inv, "the stress basis's mass", b->name));
   PetscCall(PhlexFlexibleSetUpLocalDofs(b));
-  PetscCall(DMCreateLocalVector(b->dm, &b->smap_vloc)); /* zero: its constrained entries stay so */
-  PetscCall(VecDuplicate(b->smap_vloc, &b->smap_floc));
+  {
+    /* the local velocities in storage one entry longer than the field (zero: the constrained entries stay so), so that
+       the kernels may read a node's three velocities as four consecutive entries (the fourth unused); and whether every
+       node's three are consecutive */
+    Vec      tmpl;
+    PetscInt nloc, ncv = (b->cEnd - b->cStart) * b->nb_v;
+    PetscCall(DMGetLocalVector(b->dm, &tmpl));
+    PetscCall(VecGetLocalSize(tmpl, &nloc));
+    PetscCall(DMRestoreLocalVector(b->dm, &tmpl));
+    PetscCall(PetscCalloc1(nloc + 1, &b->smap_varray));
+    PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, nloc, b->smap_varray, &b->smap_vloc));
+    PetscCall(VecDuplicate(b->smap_vloc, &b->smap_floc));
+    b->smap_vnodes = b->nb_v % 3 == 0 ? PETSC_TRUE : PETSC_FALSE;
+    for (PetscInt k = 0; k < ncv && b->smap_vnodes; k += 3)
+      if (b->cell_vloc[k + 1] != b->cell_vloc[k] + 1 || b->cell_vloc[k + 2] != b->cell_vloc[k] + 2) b->smap_vnodes = PETSC_FALSE;
+    PetscCall(PetscInfo(NULL, "body %s: the stress maps read the velocities %s\n", b->name, b->smap_vnodes ? "node by node" : "entry by entry"));
+  }
   b->smap_ready = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
@@ -76,70 +94,151 @@ typedef PetscReal PhlexLane;
   #define CELL_INLINE  static inline
 #endif
 #define LANE_ZERO ((PhlexLane){0}) /* +0 in every lane */
+/* a loop unrolled n times (wholly where its count is a constant up to n: the P2/P1 kernels below) */
+#if defined(__GNUC__) && !defined(__clang__)
+  #define PHLEX_PRAGMA(x) _Pragma(#x)
+  #define UNROLL(n)       PHLEX_PRAGMA(GCC unroll n)
+#else
+  #define UNROLL(n)
+#endif
 
 /* the cells' geometry, materials and stress offsets, gathered lane by lane for the cells c0, c0 + 1, ... (the last
-   cell repeated past ncell) */
+   cell repeated past ncell). Where all lanes' cells have one material (most batches), its stiffness is read as scalars
+   (Ds) instead of gathered into lanes: a product with a scalar is the same in every lane as with its copies. Where the
+   four cells' stresses lie one after another (contiguous), they move between the field and the lanes by 4 x 4
+   transposes of whole vectors instead of entry by entry: the same values. */
 typedef struct {
-  PhlexLane detJ, invJ[9], D[36];
-  PetscInt  cell[PHLEX_LANES], used;
+  PhlexLane        detJ, invJ[9], D[36];
+  const PetscReal *Ds;
+  PetscInt         cell[PHLEX_LANES], used;
+  PetscBool        contiguous;
 } CellBatch;
 
-CELL_INLINE void GatherBatch(PhlexFlexible b, PetscInt c0, PetscInt ncell, PetscBool material, CellBatch *cb)
+CELL_INLINE void GatherBatch(PhlexFlexible b, PetscInt nn, PetscInt c0, PetscInt ncell, PetscBool material, CellBatch *cb)
 {
-  cb->used = PetscMin(PHLEX_LANES, ncell - c0);
+  const PetscInt ns6 = 6 * nn;
+  PetscBool      uniform = PETSC_TRUE;
+
+  cb->used       = PetscMin(PHLEX_LANES, ncell - c0);
+  cb->contiguous = cb->used == PHLEX_LANES ? PETSC_TRUE : PETSC_FALSE;
   for (PetscInt l = 0; l < PHLEX_LANES; l++) {
     const PetscInt   c = PetscMin(c0 + l, ncell - 1);
     const PetscReal *g = &b->cell_geom[10 * c];
     cb->cell[l]        = c;
     LANE(cb->detJ, l)  = g[0];
     for (PetscInt q = 0; q < 9; q++) LANE(cb->invJ[q], l) = g[1 + q];
-    if (material) {
-      const PetscReal *D = b->stiffness[b->cell_material[c]];
-      for (PetscInt q = 0; q < 36; q++) LANE(cb->D[q], l) = D[q];
-    }
+    if (b->cell_soff[c] != b->cell_soff[cb->cell[0]] + ns6 * l) cb->contiguous = PETSC_FALSE;
+    if (b->cell_material[c] != b->cell_material[cb->cell[0]]) uniform = PETSC_FALSE;
+  }
+  cb->Ds = NULL;
+  if (!material) return;
+  if (uniform) {
+    cb->Ds = b->stiffness[b->cell_material[cb->cell[0]]];
+    return;
+  }
+  for (PetscInt l = 0; l < PHLEX_LANES; l++) {
+    const PetscReal *D = b->stiffness[b->cell_material[cb->cell[l]]];
+    for (PetscInt q = 0; q < 36; q++) LANE(cb->D[q], l) = D[q];
   }
 }
 
-/* y = B v for the cells' stress blocks: ve the cells' velocities (3 per node), y their stresses (6 per stress node) */
-CELL_INLINE void CellStressRate(PetscInt nv, PetscInt nn, const PetscReal *coup, const PhlexLane *invJ, const PhlexLane *D, const PetscReal *smass_inv, const PhlexLane *ve, PhlexLane *y)
+/* entry q of a material matrix (scalars Ds if the batch's cells share it, else lanes D) times x (a macro: a function
+   returning a vector would change the baseline clone's ABI) */
+#define MaterialTimes(Ds, D, q, x) ((Ds) ? (Ds)[q] * (x) : (D)[q] * (x))
+
+#if PHLEX_LANES == 4
+typedef long long PhlexLaneIndex __attribute__((vector_size(PHLEX_LANES * sizeof(long long))));
+/* out[j] = (r0[j], r1[j], r2[j], r3[j]): a 4 x 4 transpose, its own inverse */
+CELL_INLINE void Transpose4(PhlexLane r0, PhlexLane r1, PhlexLane r2, PhlexLane r3, PhlexLane *out)
+{
+  const PhlexLane t0 = __builtin_shuffle(r0, r1, (PhlexLaneIndex){0, 4, 2, 6});
+  const PhlexLane t1 = __builtin_shuffle(r0, r1, (PhlexLaneIndex){1, 5, 3, 7});
+  const PhlexLane t2 = __builtin_shuffle(r2, r3, (PhlexLaneIndex){0, 4, 2, 6});
+  const PhlexLane t3 = __builtin_shuffle(r2, r3, (PhlexLaneIndex){1, 5, 3, 7});
+  out[0]             = __builtin_shuffle(t0, t2, (PhlexLaneIndex){0, 1, 4, 5});
+  out[1]             = __builtin_shuffle(t1, t3, (PhlexLaneIndex){0, 1, 4, 5});
+  out[2]             = __builtin_shuffle(t0, t2, (PhlexLaneIndex){2, 3, 6, 7});
+  out[3]             = __builtin_shuffle(t1, t3, (PhlexLaneIndex){2, 3, 6, 7});
+}
+/* lanes x[k] = (p[k], p[n + k], p[2 n + k], p[3 n + k]) for k < 4 (n / 4) */
+CELL_INLINE PetscInt LoadTransposed(const PetscReal *p, PetscInt n, PhlexLane *x)
+{
+  PetscInt k = 0;
+  for (; k + 4 <= n; k += 4) {
+    PhlexLane r[4];
+    for (PetscInt l = 0; l < 4; l++) memcpy(&r[l], p + l * n + k, sizeof(r[l]));
+    Transpose4(r[0], r[1], r[2], r[3], x + k);
+  }
+  return k;
+}
+/* p[l n + k] = lane l of x[k] for k < 4 (n / 4) */
+CELL_INLINE PetscInt StoreTransposed(const PhlexLane *x, PetscInt n, PetscReal *p)
+{
+  PetscInt k = 0;
+  for (; k + 4 <= n; k += 4) {
+    PhlexLane r[4];
+    Transpose4(x[k], x[k + 1], x[k + 2], x[k + 3], r);
+    for (PetscInt l = 0; l < 4; l++) memcpy(p + l * n + k, &r[l], sizeof(r[l]));
+  }
+  return k;
+}
+#endif
+
+/* y = B v for the cells' stress blocks: ve the cells' velocities (3 per node), y their stresses (6 per stress node);
+   the gradient's nine sums in variables of their own (registers), each summed over the nodes in order */
+CELL_INLINE void CellStressRate(PetscInt nv, PetscInt nn, const PetscReal *coup, const PhlexLane *invJ, const PetscReal *Ds, const PhlexLane *D, const PetscReal *smass_inv, const PhlexLane *ve, PhlexLane *y)
 {
   PhlexLane e[4][6], De[4][6];
 
+  UNROLL(4)
   for (PetscInt i = 0; i < nn; i++) {
-    PhlexLane Hh[3][3], H[3][3];
-    for (PetscInt a = 0; a < 3; a++)
-      for (PetscInt x = 0; x < 3; x++) Hh[a][x] = LANE_ZERO;
+    const PetscReal *ci  = &coup[i * nv * 3];
+    PhlexLane        h00 = LANE_ZERO, h01 = LANE_ZERO, h02 = LANE_ZERO, h10 = LANE_ZERO, h11 = LANE_ZERO, h12 = LANE_ZERO, h20 = LANE_ZERO, h21 = LANE_ZERO, h22 = LANE_ZERO;
+    PhlexLane        H[3][3];
+    UNROLL(10)
     for (PetscInt bnode = 0; bnode < nv; bnode++) {
-      const PetscReal *cb = &coup[(i * nv + bnode) * 3];
-      for (PetscInt a = 0; a < 3; a++) {
-        const PhlexLane va = ve[3 * bnode + a];
-        Hh[a][0] += va * cb[0];
-        Hh[a][1] += va * cb[1];
-        Hh[a][2] += va * cb[2];
-      }
+      const PetscReal c0 = ci[3 * bnode], c1 = ci[3 * bnode + 1], c2 = ci[3 * bnode + 2];
+      const PhlexLane v0 = ve[3 * bnode], v1 = ve[3 * bnode + 1], v2 = ve[3 * bnode + 2];
+      h00 += v0 * c0;
+      h01 += v0 * c1;
+      h02 += v0 * c2;
+      h10 += v1 * c0;
+      h11 += v1 * c1;
+      h12 += v1 * c2;
+      h20 += v2 * c0;
+      h21 += v2 * c1;
+      h22 += v2 * c2;
     }
-    for (PetscInt a = 0; a < 3; a++)
-      for (PetscInt x = 0; x < 3; x++) H[a][x] = Hh[a][0] * invJ[0 * 3 + x] + Hh[a][1] * invJ[1 * 3 + x] + Hh[a][2] * invJ[2 * 3 + x];
+    for (PetscInt x = 0; x < 3; x++) {
+      H[0][x] = h00 * invJ[0 * 3 + x] + h01 * invJ[1 * 3 + x] + h02 * invJ[2 * 3 + x];
+      H[1][x] = h10 * invJ[0 * 3 + x] + h11 * invJ[1 * 3 + x] + h12 * invJ[2 * 3 + x];
+      H[2][x] = h20 * invJ[0 * 3 + x] + h21 * invJ[1 * 3 + x] + h22 * invJ[2 * 3 + x];
+    }
     e[i][0] = H[0][0];
     e[i][1] = H[1][1];
     e[i][2] = H[2][2];
     e[i][3] = H[1][2] + H[2][1];
     e[i][4] = H[0][2] + H[2][0];
     e[i][5] = H[0][1] + H[1][0];
-    for (PetscInt s = 0; s < 6; s++) De[i][s] = D[s * 6 + 0] * e[i][0] + D[s * 6 + 1] * e[i][1] + D[s * 6 + 2] * e[i][2] + D[s * 6 + 3] * e[i][3] + D[s * 6 + 4] * e[i][4] + D[s * 6 + 5] * e[i][5];
+    for (PetscInt s = 0; s < 6; s++) De[i][s] = MaterialTimes(Ds, D, s * 6 + 0, e[i][0]) + MaterialTimes(Ds, D, s * 6 + 1, e[i][1]) + MaterialTimes(Ds, D, s * 6 + 2, e[i][2]) + MaterialTimes(Ds, D, s * 6 + 3, e[i][3]) + MaterialTimes(Ds, D, s * 6 + 4, e[i][4]) + MaterialTimes(Ds, D, s * 6 + 5, e[i][5]);
   }
+  UNROLL(4)
   for (PetscInt i = 0; i < nn; i++)
     for (PetscInt s = 0; s < 6; s++) {
       PhlexLane sum = LANE_ZERO;
+      UNROLL(4)
       for (PetscInt j = 0; j < nn; j++) sum += smass_inv[i * nn + j] * De[j][s];
       y[6 * i + s] = sum;
     }
 }
 
-/* fe = G_c^T Sigma_c for the cells: sigma their stresses (6 per stress node), fe their velocity rows (3 per node) */
+/* fe = G_c^T Sigma_c for the cells: sigma their stresses (6 per stress node), fe their velocity rows (3 per node); each
+   row summed over the stress nodes in order, in a variable of its own */
 CELL_INLINE void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup, const PhlexLane *detJ, const PhlexLane *invJ, const PhlexLane *sigma, PhlexLane *fe)
 {
-  for (PetscInt k = 0; k < 3 * nv; k++) fe[k] = LANE_ZERO;
+  PhlexLane T[4][3][3]; /* detJ S_i invJ^T per stress node i */
+
+  UNROLL(4)
   for (PetscInt i = 0; i < nn; i++) {
     const PhlexLane *si      = sigma + 6 * i;
     const PhlexLane  S[3][3] = {
@@ -147,20 +246,41 @@ CELL_INLINE void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup, 
       {si[5], si[1], si[3]},
       {si[4], si[3], si[2]}
     };
-    PhlexLane T[3][3]; /* detJ S invJ^T */
     for (PetscInt a = 0; a < 3; a++)
-      for (PetscInt y = 0; y < 3; y++) T[a][y] = *detJ * (S[a][0] * invJ[y * 3 + 0] + S[a][1] * invJ[y * 3 + 1] + S[a][2] * invJ[y * 3 + 2]);
-    for (PetscInt bnode = 0; bnode < nv; bnode++) {
-      const PetscReal *cb = &coup[(i * nv + bnode) * 3];
-      for (PetscInt a = 0; a < 3; a++) fe[3 * bnode + a] += T[a][0] * cb[0] + T[a][1] * cb[1] + T[a][2] * cb[2];
-    }
+      for (PetscInt y = 0; y < 3; y++) T[i][a][y] = *detJ * (S[a][0] * invJ[y * 3 + 0] + S[a][1] * invJ[y * 3 + 1] + S[a][2] * invJ[y * 3 + 2]);
   }
+  UNROLL(10)
+  for (PetscInt bnode = 0; bnode < nv; bnode++)
+    for (PetscInt a = 0; a < 3; a++) {
+      PhlexLane sum = LANE_ZERO;
+      UNROLL(4)
+      for (PetscInt i = 0; i < nn; i++) {
+        const PetscReal *cb = &coup[(i * nv + bnode) * 3];
+        sum += T[i][a][0] * cb[0] + T[i][a][1] * cb[1] + T[i][a][2] * cb[2];
+      }
+      fe[3 * bnode + a] = sum;
+    }
 }
 
-/* the batch's velocities from the local vector va */
-CELL_INLINE void GatherVelocities(PhlexFlexible b, const CellBatch *cb, const PetscScalar *va, PhlexLane *ve)
+/* the batch's velocities from the local vector va: node by node, by a 4 x 4 transpose of the four cells' (x, y, z, next)
+   where each node's three are consecutive (b->smap_vnodes; va has one entry more than the field), else entry by entry */
+CELL_INLINE void GatherVelocities(PhlexFlexible b, PetscInt nv, const CellBatch *cb, const PetscScalar *va, PhlexLane *ve)
 {
-  const PetscInt nv = b->ref.nv;
+#if PHLEX_LANES == 4 && !defined(PETSC_USE_COMPLEX)
+  if (b->smap_vnodes) {
+    const PetscInt *loc[4];
+    for (PetscInt l = 0; l < 4; l++) loc[l] = &b->cell_vloc[cb->cell[l] * 3 * nv];
+    for (PetscInt bnode = 0; bnode < nv; bnode++) {
+      PhlexLane r[4], t[4];
+      for (PetscInt l = 0; l < 4; l++) memcpy(&r[l], va + loc[l][3 * bnode], sizeof(r[l]));
+      Transpose4(r[0], r[1], r[2], r[3], t);
+      ve[3 * bnode]     = t[0];
+      ve[3 * bnode + 1] = t[1];
+      ve[3 * bnode + 2] = t[2];
+    }
+    return;
+  }
+#endif
   for (PetscInt l = 0; l < PHLEX_LANES; l++) {
     const PetscInt *loc = &b->cell_vloc[cb->cell[l] * 3 * nv];
     for (PetscInt k = 0; k < 3 * nv; k++) LANE(ve[k], l) = PetscRealPart(va[loc[k]]);
@@ -168,9 +288,8 @@ CELL_INLINE void GatherVelocities(PhlexFlexible b, const CellBatch *cb, const Pe
 }
 
 /* the used lanes' velocity rows added into the local vector fa, cell after cell */
-CELL_INLINE void ScatterResultants(PhlexFlexible b, const CellBatch *cb, const PhlexLane *fe, PetscScalar *fa)
+CELL_INLINE void ScatterResultants(PhlexFlexible b, PetscInt nv, const CellBatch *cb, const PhlexLane *fe, PetscScalar *fa)
 {
-  const PetscInt nv = b->ref.nv;
   for (PetscInt l = 0; l < cb->used; l++) {
     const PetscInt *loc = &b->cell_vloc[cb->cell[l] * 3 * nv];
     for (PetscInt k = 0; k < 3 * nv; k++) fa[loc[k]] += LANE(fe[k], l);
@@ -178,155 +297,215 @@ CELL_INLINE void ScatterResultants(PhlexFlexible b, const CellBatch *cb, const P
 }
 
 /* the batch of cells from c0: its geometry, materials and velocities (va local), and its stress rates y = B v */
-CELL_INLINE void BatchStressRate(PhlexFlexible b, PetscInt c0, PetscInt ncell, const PetscScalar *va, CellBatch *cb, PhlexLane *y)
+CELL_INLINE void BatchStressRate(PhlexFlexible b, PetscInt nv, PetscInt nn, PetscInt c0, PetscInt ncell, const PetscScalar *va, CellBatch *cb, PhlexLane *y)
 {
   PhlexLane ve[3 * PHLEX_MAX_NODES];
-  GatherBatch(b, c0, ncell, PETSC_TRUE, cb);
-  GatherVelocities(b, cb, va, ve);
-  CellStressRate(b->ref.nv, b->ref.ns, b->ref.coup, cb->invJ, cb->D, b->smass_inv, ve, y);
+  GatherBatch(b, nn, c0, ncell, PETSC_TRUE, cb);
+  GatherVelocities(b, nv, cb, va, ve);
+  CellStressRate(nv, nn, b->ref.coup, cb->invJ, cb->Ds, cb->D, b->smass_inv, ve, y);
 }
 
 /* the batch's stresses from the rank's stress field sa (first entry rstart) */
-CELL_INLINE void GatherStresses(PhlexFlexible b, const CellBatch *cb, PetscInt rstart, const PetscScalar *sa, PhlexLane *sigma)
+CELL_INLINE void GatherStresses(PhlexFlexible b, PetscInt nn, const CellBatch *cb, PetscInt rstart, const PetscScalar *sa, PhlexLane *sigma)
 {
+  const PetscInt n = 6 * nn;
+  PetscInt       k0 = 0;
+
+#if PHLEX_LANES == 4 && !defined(PETSC_USE_COMPLEX)
+  if (cb->contiguous) k0 = LoadTransposed(sa + (b->cell_soff[cb->cell[0]] - rstart), n, sigma);
+#endif
   for (PetscInt l = 0; l < PHLEX_LANES; l++) {
     const PetscScalar *sc = sa + (b->cell_soff[cb->cell[l]] - rstart);
-    for (PetscInt k = 0; k < 6 * b->ref.ns; k++) LANE(sigma[k], l) = PetscRealPart(sc[k]);
+    for (PetscInt k = k0; k < n; k++) LANE(sigma[k], l) = PetscRealPart(sc[k]);
   }
 }
 
 /* the used lanes' stresses into the rank's stress field sa (first entry rstart) */
-CELL_INLINE void StoreStresses(PhlexFlexible b, const CellBatch *cb, PetscInt rstart, const PhlexLane *sigma, PetscScalar *sa)
+CELL_INLINE void StoreStresses(PhlexFlexible b, PetscInt nn, const CellBatch *cb, PetscInt rstart, const PhlexLane *sigma, PetscScalar *sa)
 {
+  const PetscInt n = 6 * nn;
+  PetscInt       k0 = 0;
+
+#if PHLEX_LANES == 4 && !defined(PETSC_USE_COMPLEX)
+  if (cb->contiguous) k0 = StoreTransposed(sigma, n, sa + (b->cell_soff[cb->cell[0]] - rstart));
+#endif
   for (PetscInt l = 0; l < cb->used; l++) {
     PetscScalar *sc = sa + (b->cell_soff[cb->cell[l]] - rstart);
-    for (PetscInt k = 0; k < 6 * b->ref.ns; k++) sc[k] = LANE(sigma[k], l);
+    for (PetscInt k = k0; k < n; k++) sc[k] = LANE(sigma[k], l);
   }
 }
 
 /* the batch's stresses s0 + a B v (s0 from the rank's stress field s0a, first entry rstart; va the local velocities),
    each entry as VecWAXPY forms it from B v */
-CELL_INLINE void BatchStressUpdate(PhlexFlexible b, PetscInt c0, PetscInt ncell, PetscInt rstart, const PetscScalar *va, const PetscScalar *s0a, PetscReal a, CellBatch *cb, PhlexLane *sigma)
+CELL_INLINE void BatchStressUpdate(PhlexFlexible b, PetscInt nv, PetscInt nn, PetscInt c0, PetscInt ncell, PetscInt rstart, const PetscScalar *va, const PetscScalar *s0a, PetscReal a, CellBatch *cb, PhlexLane *sigma)
 {
   PhlexLane y[24];
-  BatchStressRate(b, c0, ncell, va, cb, y);
-  GatherStresses(b, cb, rstart, s0a, sigma);
-  for (PetscInt k = 0; k < 6 * b->ref.ns; k++) sigma[k] = sigma[k] + a * y[k];
+  BatchStressRate(b, nv, nn, c0, ncell, va, cb, y);
+  GatherStresses(b, nn, cb, rstart, s0a, sigma);
+  for (PetscInt k = 0; k < 6 * nn; k++) sigma[k] = sigma[k] + a * y[k];
 }
 
+/* The passes over a rank's cells below are written once for the element's shape (nv velocity nodes, nn stress nodes)
+   and compiled twice (SHAPE_DISPATCH): for P2 velocity with P1 stress as constants, so that the loops over the nodes
+   unroll and the sums stay in registers, and for any shape. The same operations in the same order either way. */
+#define SHAPE_DISPATCH(b, call, ...) \
+  do { \
+    if ((b)->ref.nv == 10 && (b)->ref.ns == 4) call(b, 10, 4, __VA_ARGS__); \
+    else call(b, (b)->ref.nv, (b)->ref.ns, __VA_ARGS__); \
+  } while (0)
+
 /* ya (the rank's stress field, first entry rstart) = B v over the rank's cells, va the local velocities */
-PHLEX_KERNEL_CLONES static void StressRateCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, PetscScalar *ya)
+CELL_INLINE void StressRateShape(PhlexFlexible b, PetscInt nv, PetscInt nn, PetscInt rstart, const PetscScalar *va, PetscScalar *ya)
 {
   const PetscInt ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
     PhlexLane y[24];
-    BatchStressRate(b, c0, ncell, va, &cb, y);
-    StoreStresses(b, &cb, rstart, y, ya);
+    BatchStressRate(b, nv, nn, c0, ncell, va, &cb, y);
+    StoreStresses(b, nn, &cb, rstart, y, ya);
   }
+}
+PHLEX_KERNEL_CLONES static void StressRateCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, PetscScalar *ya)
+{
+  SHAPE_DISPATCH(b, StressRateShape, rstart, va, ya);
 }
 
 /* fa (local velocity rows) += G^T Sigma over the rank's cells, sa the rank's stress field (first entry rstart) */
-PHLEX_KERNEL_CLONES static void ResultantCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *sa, PetscScalar *fa)
+CELL_INLINE void ResultantShape(PhlexFlexible b, PetscInt nv, PetscInt nn, PetscInt rstart, const PetscScalar *sa, PetscScalar *fa)
 {
-  const PetscInt nv = b->ref.nv, nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
     PhlexLane sigma[24], fe[3 * PHLEX_MAX_NODES];
-    GatherBatch(b, c0, ncell, PETSC_FALSE, &cb);
-    GatherStresses(b, &cb, rstart, sa, sigma);
+    GatherBatch(b, nn, c0, ncell, PETSC_FALSE, &cb);
+    GatherStresses(b, nn, &cb, rstart, sa, sigma);
     CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
-    ScatterResultants(b, &cb, fe, fa);
+    ScatterResultants(b, nv, &cb, fe, fa);
   }
+}
+PHLEX_KERNEL_CLONES static void ResultantCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *sa, PetscScalar *fa)
+{
+  SHAPE_DISPATCH(b, ResultantShape, rstart, sa, fa);
 }
 
 /* fa (local velocity rows) += G^T Ms^{-1} G v over the rank's cells, va the local velocities */
-PHLEX_KERNEL_CLONES static void CondensedStiffnessCells(PhlexFlexible b, const PetscScalar *va, PetscScalar *fa)
+CELL_INLINE void CondensedStiffnessShape(PhlexFlexible b, PetscInt nv, PetscInt nn, const PetscScalar *va, PetscScalar *fa)
 {
-  const PetscInt nv = b->ref.nv, nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
     PhlexLane sigma[24], fe[3 * PHLEX_MAX_NODES];
-    BatchStressRate(b, c0, ncell, va, &cb, sigma);
+    BatchStressRate(b, nv, nn, c0, ncell, va, &cb, sigma);
     CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
-    ScatterResultants(b, &cb, fe, fa);
+    ScatterResultants(b, nv, &cb, fe, fa);
   }
+}
+PHLEX_KERNEL_CLONES static void CondensedStiffnessCells(PhlexFlexible b, const PetscScalar *va, PetscScalar *fa)
+{
+  SHAPE_DISPATCH(b, CondensedStiffnessShape, va, fa);
 }
 
 /* spa = s0a + a B v and fa (local velocity rows) += G^T spa over the rank's cells (the stress fields' first entry
    rstart): the stage's predicted stress and its resultant in one pass. Each entry is s0 + a (B v) as VecWAXPY forms it,
    and the resultant reads that entry: the bytes of the three passes B v, VecWAXPY, G^T */
-PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *s0a, PetscReal a, PetscScalar *spa, PetscScalar *fa)
+CELL_INLINE void PredictShape(PhlexFlexible b, PetscInt nv, PetscInt nn, PetscInt rstart, const PetscScalar *va, const PetscScalar *s0a, PetscReal a, PetscScalar *spa, PetscScalar *fa)
 {
-  const PetscInt nv = b->ref.nv, nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
     PhlexLane sigma[24], fe[3 * PHLEX_MAX_NODES];
-    BatchStressUpdate(b, c0, ncell, rstart, va, s0a, a, &cb, sigma);
-    StoreStresses(b, &cb, rstart, sigma, spa);
+    BatchStressUpdate(b, nv, nn, c0, ncell, rstart, va, s0a, a, &cb, sigma);
+    StoreStresses(b, nn, &cb, rstart, sigma, spa);
     CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
-    ScatterResultants(b, &cb, fe, fa);
+    ScatterResultants(b, nv, &cb, fe, fa);
   }
+}
+PHLEX_KERNEL_CLONES static void PredictCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *s0a, PetscReal a, PetscScalar *spa, PetscScalar *fa)
+{
+  SHAPE_DISPATCH(b, PredictShape, rstart, va, s0a, a, spa, fa);
 }
 
 /* sa = spa + a B v over the rank's cells (the stress fields' first entry rstart), as VecWAXPY forms it from B v: the
    bytes of the two passes */
-PHLEX_KERNEL_CLONES static void CorrectCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *spa, PetscReal a, PetscScalar *sa)
+CELL_INLINE void CorrectShape(PhlexFlexible b, PetscInt nv, PetscInt nn, PetscInt rstart, const PetscScalar *va, const PetscScalar *spa, PetscReal a, PetscScalar *sa)
 {
   const PetscInt ncell = b->cEnd - b->cStart;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
     PhlexLane sigma[24];
-    BatchStressUpdate(b, c0, ncell, rstart, va, spa, a, &cb, sigma);
-    StoreStresses(b, &cb, rstart, sigma, sa);
+    BatchStressUpdate(b, nv, nn, c0, ncell, rstart, va, spa, a, &cb, sigma);
+    StoreStresses(b, nn, &cb, rstart, sigma, sa);
   }
 }
+PHLEX_KERNEL_CLONES static void CorrectCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *va, const PetscScalar *spa, PetscReal a, PetscScalar *sa)
+{
+  SHAPE_DISPATCH(b, CorrectShape, rstart, va, spa, a, sa);
+}
 
-/* the energies 1/2 detJ_c sum_ij smass_ij s_i . A_m s_j of the batch's cells (PhlexFlexibleStrainEnergyLocal) */
-CELL_INLINE void CellStrainEnergy(PetscInt nn, const PetscReal *smass, const PhlexLane *A, const PhlexLane *sc, PhlexLane *e)
+/* the energies 1/2 detJ_c sum_ij smass_ij s_i . A_m s_j of the batch's cells (PhlexFlexibleStrainEnergyLocal); the
+   compliance A_m as scalars As where the cells share it, else lanes A */
+CELL_INLINE void CellStrainEnergy(PetscInt nn, const PetscReal *smass, const PetscReal *As, const PhlexLane *A, const PhlexLane *sc, PhlexLane *e)
 {
   *e = LANE_ZERO;
+  UNROLL(4)
   for (PetscInt i = 0; i < nn; i++) {
     const PhlexLane *si = sc + 6 * i;
     PhlexLane        t[6]; /* sum_j smass_ij s_j */
     for (PetscInt k = 0; k < 6; k++) t[k] = LANE_ZERO;
+    UNROLL(4)
     for (PetscInt j = 0; j < nn; j++)
       for (PetscInt k = 0; k < 6; k++) t[k] += smass[i * nn + j] * sc[6 * j + k];
     for (PetscInt k = 0; k < 6; k++) {
       PhlexLane Asi = LANE_ZERO;
-      for (PetscInt l = 0; l < 6; l++) Asi += A[k * 6 + l] * si[l];
+      if (As)
+        for (PetscInt l = 0; l < 6; l++) Asi += As[k * 6 + l] * si[l];
+      else
+        for (PetscInt l = 0; l < 6; l++) Asi += A[k * 6 + l] * si[l];
       *e += t[k] * Asi;
     }
   }
 }
 
 /* sum over the rank's cells of detJ_c e_c, added cell after cell (sa the rank's stress field, first entry rstart) */
-PHLEX_KERNEL_CLONES static PetscReal StrainEnergyCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *sa)
+CELL_INLINE PetscReal StrainEnergyShape(PhlexFlexible b, PetscInt nn, PetscInt rstart, const PetscScalar *sa)
 {
-  const PetscInt nn = b->ref.ns, ncell = b->cEnd - b->cStart;
+  const PetscInt ncell = b->cEnd - b->cStart;
   PetscReal      local = 0;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
-    PhlexLane detJ = LANE_ZERO, A[36], sc[24], e, de;
-    PetscInt  used = PetscMin(PHLEX_LANES, ncell - c0);
+    const PetscInt   m0 = b->cell_material[c0];
+    PhlexLane        detJ = LANE_ZERO, A[36], sc[24], e, de;
+    const PetscReal *As   = b->compliance[m0];
+    CellBatch        cb;
+    cb.used       = PetscMin(PHLEX_LANES, ncell - c0);
+    cb.contiguous = cb.used == PHLEX_LANES ? PETSC_TRUE : PETSC_FALSE;
     for (PetscInt l = 0; l < PHLEX_LANES; l++) {
-      const PetscInt     c  = PetscMin(c0 + l, ncell - 1);
-      const PetscReal   *Am = b->compliance[b->cell_material[c]];
-      const PetscScalar *s  = sa + (b->cell_soff[c] - rstart);
-      LANE(detJ, l)         = b->cell_geom[10 * c];
-      for (PetscInt q = 0; q < 36; q++) LANE(A[q], l) = Am[q];
-      for (PetscInt k = 0; k < 6 * nn; k++) LANE(sc[k], l) = PetscRealPart(s[k]);
+      const PetscInt c = PetscMin(c0 + l, ncell - 1);
+      cb.cell[l]       = c;
+      LANE(detJ, l)    = b->cell_geom[10 * c];
+      if (b->cell_soff[c] != b->cell_soff[c0] + 6 * nn * l) cb.contiguous = PETSC_FALSE;
+      if (b->cell_material[c] != m0) As = NULL;
     }
-    CellStrainEnergy(nn, b->ref.smass, A, sc, &e);
+    if (!As)
+      for (PetscInt l = 0; l < PHLEX_LANES; l++) {
+        const PetscReal *Am = b->compliance[b->cell_material[cb.cell[l]]];
+        for (PetscInt q = 0; q < 36; q++) LANE(A[q], l) = Am[q];
+      }
+    GatherStresses(b, nn, &cb, rstart, sa, sc);
+    CellStrainEnergy(nn, b->ref.smass, As, A, sc, &e);
     de = detJ * e;
-    for (PetscInt l = 0; l < used; l++) local += LANE(de, l);
+    for (PetscInt l = 0; l < cb.used; l++) local += LANE(de, l);
   }
   return local;
+}
+PHLEX_KERNEL_CLONES static PetscReal StrainEnergyCells(PhlexFlexible b, PetscInt rstart, const PetscScalar *sa)
+{
+  return b->ref.ns == 4 ? StrainEnergyShape(b, 4, rstart, sa) : StrainEnergyShape(b, b->ref.ns, rstart, sa);
 }
 
 /* the flops of one cell's stress rate and of one cell's resultant (PetscLogFlops) */
@@ -629,6 +808,7 @@ PetscErrorCode PhlexFlexibleStressMapsDestroy(PhlexFlexible b)
   PetscCall(MatDestroy(&b->smap_K));
   PetscCall(VecDestroy(&b->smap_vloc));
   PetscCall(VecDestroy(&b->smap_floc));
+  PetscCall(PetscFree(b->smap_varray));
   b->smap_ready   = PETSC_FALSE;
   b->smap_created = PETSC_FALSE;
   PetscFunctionReturn(0);
