@@ -25,6 +25,14 @@
 #include <phlex_impl.h>
 #include <petscblaslapack.h>
 
+/* the kernels' whole-vector moves below (4 x 4 transposes with GCC's __builtin_shuffle, lanes of doubles): GCC, real
+   double precision; elsewhere entry by entry */
+#if defined(__GNUC__) && !defined(__clang__) && !defined(PETSC_USE_COMPLEX) && defined(PETSC_USE_REAL_DOUBLE)
+  #define PHLEX_WHOLE_MOVES 1
+#else
+  #define PHLEX_WHOLE_MOVES 0
+#endif
+
 /* A^{-1} of a small dense matrix (row-major n x n), in place, by LAPACK */
 static PetscErrorCode InvertSmall(PetscInt n, PetscReal *A, const char *what, const char *body)
 {
@@ -69,7 +77,7 @@ static PetscErrorCode StressMapsSetUp(PhlexFlexible b)
     PetscCall(PetscCalloc1(nloc + 1, &b->smap_varray));
     PetscCall(VecCreateSeqWithArray(PETSC_COMM_SELF, 1, nloc, b->smap_varray, &b->smap_vloc));
     PetscCall(VecDuplicate(b->smap_vloc, &b->smap_floc));
-    b->smap_vnodes = b->nb_v % 3 == 0 ? PETSC_TRUE : PETSC_FALSE;
+    b->smap_vnodes = PHLEX_WHOLE_MOVES && b->nb_v % 3 == 0 ? PETSC_TRUE : PETSC_FALSE;
     for (PetscInt k = 0; k < ncv && b->smap_vnodes; k += 3)
       if (b->cell_vloc[k + 1] != b->cell_vloc[k] + 1 || b->cell_vloc[k + 2] != b->cell_vloc[k] + 2) b->smap_vnodes = PETSC_FALSE;
     PetscCall(PetscInfo(NULL, "body %s: the stress maps read the velocities %s\n", b->name, b->smap_vnodes ? "node by node" : "entry by entry"));
@@ -146,38 +154,39 @@ CELL_INLINE void GatherBatch(PhlexFlexible b, PetscInt nn, PetscInt c0, PetscInt
    returning a vector would change the baseline clone's ABI) */
 #define MaterialTimes(Ds, D, q, x) ((Ds) ? (Ds)[q] * (x) : (D)[q] * (x))
 
-#if PHLEX_LANES == 4
+#if PHLEX_WHOLE_MOVES
 typedef long long PhlexLaneIndex __attribute__((vector_size(PHLEX_LANES * sizeof(long long))));
-/* out[j] = (r0[j], r1[j], r2[j], r3[j]): a 4 x 4 transpose, its own inverse */
-CELL_INLINE void Transpose4(PhlexLane r0, PhlexLane r1, PhlexLane r2, PhlexLane r3, PhlexLane *out)
+/* out[j] = (r[0][j], r[1][j], r[2][j], r[3][j]): a 4 x 4 transpose, its own inverse (vectors passed by address: by
+   value they would change the baseline clone's ABI) */
+CELL_INLINE void Transpose4(const PhlexLane *r, PhlexLane *out)
 {
-  const PhlexLane t0 = __builtin_shuffle(r0, r1, (PhlexLaneIndex){0, 4, 2, 6});
-  const PhlexLane t1 = __builtin_shuffle(r0, r1, (PhlexLaneIndex){1, 5, 3, 7});
-  const PhlexLane t2 = __builtin_shuffle(r2, r3, (PhlexLaneIndex){0, 4, 2, 6});
-  const PhlexLane t3 = __builtin_shuffle(r2, r3, (PhlexLaneIndex){1, 5, 3, 7});
+  const PhlexLane t0 = __builtin_shuffle(r[0], r[1], (PhlexLaneIndex){0, 4, 2, 6});
+  const PhlexLane t1 = __builtin_shuffle(r[0], r[1], (PhlexLaneIndex){1, 5, 3, 7});
+  const PhlexLane t2 = __builtin_shuffle(r[2], r[3], (PhlexLaneIndex){0, 4, 2, 6});
+  const PhlexLane t3 = __builtin_shuffle(r[2], r[3], (PhlexLaneIndex){1, 5, 3, 7});
   out[0]             = __builtin_shuffle(t0, t2, (PhlexLaneIndex){0, 1, 4, 5});
   out[1]             = __builtin_shuffle(t1, t3, (PhlexLaneIndex){0, 1, 4, 5});
   out[2]             = __builtin_shuffle(t0, t2, (PhlexLaneIndex){2, 3, 6, 7});
   out[3]             = __builtin_shuffle(t1, t3, (PhlexLaneIndex){2, 3, 6, 7});
 }
-/* lanes x[k] = (p[k], p[n + k], p[2 n + k], p[3 n + k]) for k < 4 (n / 4) */
+/* lanes x[k] = (p[k], p[n + k], p[2 n + k], p[3 n + k]) for k below 4 floor(n / 4), which it returns */
 CELL_INLINE PetscInt LoadTransposed(const PetscReal *p, PetscInt n, PhlexLane *x)
 {
   PetscInt k = 0;
   for (; k + 4 <= n; k += 4) {
     PhlexLane r[4];
     for (PetscInt l = 0; l < 4; l++) memcpy(&r[l], p + l * n + k, sizeof(r[l]));
-    Transpose4(r[0], r[1], r[2], r[3], x + k);
+    Transpose4(r, x + k);
   }
   return k;
 }
-/* p[l n + k] = lane l of x[k] for k < 4 (n / 4) */
+/* p[l n + k] = lane l of x[k] for k below 4 floor(n / 4), which it returns */
 CELL_INLINE PetscInt StoreTransposed(const PhlexLane *x, PetscInt n, PetscReal *p)
 {
   PetscInt k = 0;
   for (; k + 4 <= n; k += 4) {
     PhlexLane r[4];
-    Transpose4(x[k], x[k + 1], x[k + 2], x[k + 3], r);
+    Transpose4(x + k, r);
     for (PetscInt l = 0; l < 4; l++) memcpy(p + l * n + k, &r[l], sizeof(r[l]));
   }
   return k;
@@ -263,17 +272,18 @@ CELL_INLINE void CellResultant(PetscInt nv, PetscInt nn, const PetscReal *coup, 
 }
 
 /* the batch's velocities from the local vector va: node by node, by a 4 x 4 transpose of the four cells' (x, y, z, next)
-   where each node's three are consecutive (b->smap_vnodes; va has one entry more than the field), else entry by entry */
+   where each node's three are consecutive (b->smap_vnodes), else entry by entry. va must be b->smap_vloc's array,
+   whose storage has one entry more than the field (the last node's fourth read) */
 CELL_INLINE void GatherVelocities(PhlexFlexible b, PetscInt nv, const CellBatch *cb, const PetscScalar *va, PhlexLane *ve)
 {
-#if PHLEX_LANES == 4 && !defined(PETSC_USE_COMPLEX)
+#if PHLEX_WHOLE_MOVES
   if (b->smap_vnodes) {
     const PetscInt *loc[4];
     for (PetscInt l = 0; l < 4; l++) loc[l] = &b->cell_vloc[cb->cell[l] * 3 * nv];
     for (PetscInt bnode = 0; bnode < nv; bnode++) {
       PhlexLane r[4], t[4];
       for (PetscInt l = 0; l < 4; l++) memcpy(&r[l], va + loc[l][3 * bnode], sizeof(r[l]));
-      Transpose4(r[0], r[1], r[2], r[3], t);
+      Transpose4(r, t);
       ve[3 * bnode]     = t[0];
       ve[3 * bnode + 1] = t[1];
       ve[3 * bnode + 2] = t[2];
@@ -311,7 +321,7 @@ CELL_INLINE void GatherStresses(PhlexFlexible b, PetscInt nn, const CellBatch *c
   const PetscInt n = 6 * nn;
   PetscInt       k0 = 0;
 
-#if PHLEX_LANES == 4 && !defined(PETSC_USE_COMPLEX)
+#if PHLEX_WHOLE_MOVES
   if (cb->contiguous) k0 = LoadTransposed(sa + (b->cell_soff[cb->cell[0]] - rstart), n, sigma);
 #endif
   for (PetscInt l = 0; l < PHLEX_LANES; l++) {
@@ -326,7 +336,7 @@ CELL_INLINE void StoreStresses(PhlexFlexible b, PetscInt nn, const CellBatch *cb
   const PetscInt n = 6 * nn;
   PetscInt       k0 = 0;
 
-#if PHLEX_LANES == 4 && !defined(PETSC_USE_COMPLEX)
+#if PHLEX_WHOLE_MOVES
   if (cb->contiguous) k0 = StoreTransposed(sigma, n, sa + (b->cell_soff[cb->cell[0]] - rstart));
 #endif
   for (PetscInt l = 0; l < cb->used; l++) {
