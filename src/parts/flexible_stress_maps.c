@@ -111,8 +111,9 @@ typedef PetscReal PhlexLane;
 #endif
 
 /* the cells' geometry, materials and stress offsets, gathered lane by lane for the cells c0, c0 + 1, ... (the last
-   cell repeated past ncell). Where all lanes' cells have one material (most batches), its stiffness is read as scalars
-   (Ds) instead of gathered into lanes: a product with a scalar is the same in every lane as with its copies. Where the
+   cell repeated past ncell), and their material matrices (the stiffness; the compliance for the strain energy) where
+   asked for. Where all lanes' cells have one material (most batches), its matrix is read as scalars (Ds) instead of
+   gathered into lanes: a product with a scalar is the same in every lane as with its copies. Where the
    four cells' stresses lie one after another (contiguous), they move between the field and the lanes by 4 x 4
    transposes of whole vectors instead of entry by entry: the same values. */
 typedef struct {
@@ -122,7 +123,7 @@ typedef struct {
   PetscBool        contiguous;
 } CellBatch;
 
-CELL_INLINE void GatherBatch(PhlexFlexible b, PetscInt nn, PetscInt c0, PetscInt ncell, PetscBool material, CellBatch *cb)
+CELL_INLINE void GatherBatch(PhlexFlexible b, PetscInt nn, PetscInt c0, PetscInt ncell, PetscReal (*mats)[36], PetscBool inverse, CellBatch *cb)
 {
   const PetscInt ns6 = 6 * nn;
   PetscBool      uniform = PETSC_TRUE;
@@ -134,18 +135,19 @@ CELL_INLINE void GatherBatch(PhlexFlexible b, PetscInt nn, PetscInt c0, PetscInt
     const PetscReal *g = &b->cell_geom[10 * c];
     cb->cell[l]        = c;
     LANE(cb->detJ, l)  = g[0];
-    for (PetscInt q = 0; q < 9; q++) LANE(cb->invJ[q], l) = g[1 + q];
+    if (inverse)
+      for (PetscInt q = 0; q < 9; q++) LANE(cb->invJ[q], l) = g[1 + q];
     if (b->cell_soff[c] != b->cell_soff[cb->cell[0]] + ns6 * l) cb->contiguous = PETSC_FALSE;
     if (b->cell_material[c] != b->cell_material[cb->cell[0]]) uniform = PETSC_FALSE;
   }
   cb->Ds = NULL;
-  if (!material) return;
+  if (!mats) return;
   if (uniform) {
-    cb->Ds = b->stiffness[b->cell_material[cb->cell[0]]];
+    cb->Ds = mats[b->cell_material[cb->cell[0]]];
     return;
   }
   for (PetscInt l = 0; l < PHLEX_LANES; l++) {
-    const PetscReal *D = b->stiffness[b->cell_material[cb->cell[l]]];
+    const PetscReal *D = mats[b->cell_material[cb->cell[l]]];
     for (PetscInt q = 0; q < 36; q++) LANE(cb->D[q], l) = D[q];
   }
 }
@@ -310,7 +312,7 @@ CELL_INLINE void ScatterResultants(PhlexFlexible b, PetscInt nv, const CellBatch
 CELL_INLINE void BatchStressRate(PhlexFlexible b, PetscInt nv, PetscInt nn, PetscInt c0, PetscInt ncell, const PetscScalar *va, CellBatch *cb, PhlexLane *y)
 {
   PhlexLane ve[3 * PHLEX_MAX_NODES];
-  GatherBatch(b, nn, c0, ncell, PETSC_TRUE, cb);
+  GatherBatch(b, nn, c0, ncell, b->stiffness, PETSC_TRUE, cb);
   GatherVelocities(b, nv, cb, va, ve);
   CellStressRate(nv, nn, b->ref.coup, cb->invJ, cb->Ds, cb->D, b->smass_inv, ve, y);
 }
@@ -389,7 +391,7 @@ CELL_INLINE void ResultantShape(PhlexFlexible b, PetscInt nv, PetscInt nn, Petsc
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
     CellBatch cb;
     PhlexLane sigma[24], fe[3 * PHLEX_MAX_NODES];
-    GatherBatch(b, nn, c0, ncell, PETSC_FALSE, &cb);
+    GatherBatch(b, nn, c0, ncell, NULL, PETSC_TRUE, &cb);
     GatherStresses(b, nn, &cb, rstart, sa, sigma);
     CellResultant(nv, nn, b->ref.coup, &cb.detJ, cb.invJ, sigma, fe);
     ScatterResultants(b, nv, &cb, fe, fa);
@@ -488,27 +490,12 @@ CELL_INLINE PetscReal StrainEnergyShape(PhlexFlexible b, PetscInt nn, PetscInt r
   PetscReal      local = 0;
 
   for (PetscInt c0 = 0; c0 < ncell; c0 += PHLEX_LANES) {
-    const PetscInt   m0 = b->cell_material[c0];
-    PhlexLane        detJ = LANE_ZERO, A[36], sc[24], e, de;
-    const PetscReal *As   = b->compliance[m0];
-    CellBatch        cb;
-    cb.used       = PetscMin(PHLEX_LANES, ncell - c0);
-    cb.contiguous = cb.used == PHLEX_LANES ? PETSC_TRUE : PETSC_FALSE;
-    for (PetscInt l = 0; l < PHLEX_LANES; l++) {
-      const PetscInt c = PetscMin(c0 + l, ncell - 1);
-      cb.cell[l]       = c;
-      LANE(detJ, l)    = b->cell_geom[10 * c];
-      if (b->cell_soff[c] != b->cell_soff[c0] + 6 * nn * l) cb.contiguous = PETSC_FALSE;
-      if (b->cell_material[c] != m0) As = NULL;
-    }
-    if (!As)
-      for (PetscInt l = 0; l < PHLEX_LANES; l++) {
-        const PetscReal *Am = b->compliance[b->cell_material[cb.cell[l]]];
-        for (PetscInt q = 0; q < 36; q++) LANE(A[q], l) = Am[q];
-      }
+    PhlexLane sc[24], e, de;
+    CellBatch cb;
+    GatherBatch(b, nn, c0, ncell, b->compliance, PETSC_FALSE, &cb);
     GatherStresses(b, nn, &cb, rstart, sa, sc);
-    CellStrainEnergy(nn, b->ref.smass, As, A, sc, &e);
-    de = detJ * e;
+    CellStrainEnergy(nn, b->ref.smass, cb.Ds, cb.D, sc, &e);
+    de = cb.detJ * e;
     for (PetscInt l = 0; l < cb.used; l++) local += LANE(de, l);
   }
   return local;
