@@ -310,7 +310,7 @@ PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec
   PetscScalar       *fa;
   const PetscScalar *ta, *wa, *ua, *va, *uda, *Mua, *Mvva, *Muda;
   PetscInt           n;
-  PetscReal          C[9], vxw[3], a[3], c[3], wdxw[9];
+  PetscReal          C[9], vxw[3], a[3], c[3];
 
   PetscFunctionBeginUser;
   /* kinematics: r' = R v_P, R' = R [w]x  (Fq rows 0-11) */
@@ -348,7 +348,6 @@ PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec
     C[4] += w2;
     C[8] += w2;
   }
-  PhlexSkew(f->wd, wdxw);
   if (!fr->tnode) PetscFunctionReturn(0);
   PetscCall(VecGetLocalSize(u, &n));
   PetscCall(VecGetArray(Fv, &fa));
