@@ -87,6 +87,7 @@ enum {
 };
 PETSC_INTERN PetscErrorCode PhlexFrameJacobian(PhlexFrame *, PhlexFrameState *, PetscReal, PetscScalar *, PetscScalar *, PetscScalar *, PetscInt, PetscReal[9], PetscReal[9], PetscReal[324]);
 PETSC_INTERN PetscErrorCode PhlexFrameNodeInputs(PhlexFrame *, PhlexFrameState *, PetscScalar *, PetscInt);
+PETSC_INTERN PetscErrorCode PhlexFrameLoadCoefficients(PhlexFrame *, PhlexFrameState *, PetscReal[3 * PHLEX_FRAME_NIN]);
 PETSC_INTERN PetscErrorCode PhlexFrameEnergy(PhlexFrame *, PhlexFrameState *, PetscReal, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFrameMomenta(PhlexFrameState *, PetscReal[3], PetscReal[3]);
 PETSC_INTERN PetscErrorCode PhlexFrameStateDestroy(PhlexFrameState *);

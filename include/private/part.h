@@ -29,11 +29,16 @@ typedef enum {
 PETSC_EXTERN const char *const PhlexFieldNames[];
 
 /* What a discrete unknown is: checkpoints name it, adaptive steps leave impulses out of the error norm, the
-   consistent start replaces velocities only. */
+   consistent start replaces velocities (a frame's and elastic ones) only, the redundancy check and the loop closure
+   move frames only (configuration and velocity of a frame), the linearised analysis keeps velocities and elastic
+   coordinates. Elastic coordinates (a reduced body's eta, u = Phi eta) and their velocities (zeta) are a body's
+   deformation, not its frame's motion. */
 typedef enum {
-  PHLEX_DOF_CONFIGURATION,
-  PHLEX_DOF_VELOCITY,
-  PHLEX_DOF_IMPULSE
+  PHLEX_DOF_CONFIGURATION,   /* a frame's position and rotation, a point mass's position */
+  PHLEX_DOF_VELOCITY,        /* a frame's or point mass's velocity */
+  PHLEX_DOF_IMPULSE,         /* a multiplier's impulse */
+  PHLEX_DOF_ELASTIC,         /* an elastic coordinate (non-dimensional displacement) */
+  PHLEX_DOF_ELASTIC_VELOCITY /* its rate */
 } PhlexDofKind;
 
 /* Offsets of a moving frame's unknowns among a part's discrete unknowns (-1: absent): position r of the frame
@@ -235,6 +240,7 @@ PETSC_INTERN PetscErrorCode PhlexPoseSetFromOptions(PetscOptionItems *, PhlexPar
 PETSC_INTERN PetscErrorCode PhlexPartCreate_Flexible(PhlexPart);
 PETSC_INTERN PetscErrorCode PhlexPartCreate_Rigid(PhlexPart);
 PETSC_INTERN PetscErrorCode PhlexPartCreate_Lumped(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexPartCreate_Reduced(PhlexPart);
 PETSC_INTERN PetscErrorCode PhlexPartCreate_Ground(PhlexPart);
 
 #endif

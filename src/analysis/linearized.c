@@ -1054,6 +1054,11 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(scene->gravity[k], g[k], sizeof(g[k]));
     SETERRQ(scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has gravity (-gravity %s,%s,%s): the analysis linearises about an unloaded configuration at rest", g[0], g[1], g[2]);
   }
+  for (PetscInt k = 0; k < scene->nparts; k++) {
+    PetscBool reduced;
+    PetscCall(PetscStrcmp(scene->parts[k]->type, "reduced", &reduced));
+    PetscCheck(!reduced, scene->comm, PETSC_ERR_SUP, "linearized analysis: body %s is a reduced body (-%stype reduced), whose stiffness lies on its discrete unknowns: this analysis linearises the field blocks of full bodies only; use -%stype flexible", scene->parts[k]->name, scene->parts[k]->prefix, scene->parts[k]->prefix);
+  }
   {
     PetscBool flexible = PETSC_FALSE;
     for (PetscInt k = 0; k < scene->nparts; k++)

@@ -645,7 +645,11 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       }
       if (vchar == 0) vchar = 1e-3; /* a scene at rest moved by loads only */
       PetscCall(PetscMalloc1(sys->nq, &a));
-      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 1e300 : (sys->qkind[k] == PHLEX_DOF_VELOCITY ? rtol * vchar : rtol);
+      for (PetscInt k = 0; k < sys->nq; k++) {
+        const PhlexDofKind kind = sys->qkind[k];
+        /* elastic coordinates and their rates: the fields' absolute tolerance (a reduced body's share of the field) */
+        a[k] = kind == PHLEX_DOF_IMPULSE ? 1e300 : (kind == PHLEX_DOF_VELOCITY ? rtol * vchar : ((kind == PHLEX_DOF_ELASTIC || kind == PHLEX_DOF_ELASTIC_VELOCITY) ? atol : rtol));
+      }
       PetscCall(PhlexSystemScatter(sys, a, vatol));
       for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 0.0 : rtol;
       PetscCall(PhlexSystemScatter(sys, a, vrtol));

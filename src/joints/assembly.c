@@ -405,7 +405,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     if (sys->qkind[k] == PHLEX_DOF_IMPULSE) cmax = PetscMax(cmax, PetscAbsReal(sys->fq[k]));
   PetscCall(PhlexSystemGather(sys, X, sys->q));
   for (PetscInt k = 0; k < sys->nq; k++)
-    if (sys->qkind[k] == PHLEX_DOF_VELOCITY) zmax = PetscMax(zmax, PetscAbsReal(sys->q[k]));
+    if (sys->qkind[k] == PHLEX_DOF_VELOCITY || sys->qkind[k] == PHLEX_DOF_ELASTIC_VELOCITY) zmax = PetscMax(zmax, PetscAbsReal(sys->q[k]));
   if (sys->nfparts) {
     Vec       v;
     PetscReal vmax;
@@ -484,7 +484,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
       PetscCall(PhlexSystemGather(sys, Y, qy));
       PetscCall(PhlexSystemGather(sys, X, sys->q));
       for (PetscInt k = 0; k < sys->nq; k++)
-        if (sys->qkind[k] == PHLEX_DOF_VELOCITY) sys->q[k] = qy[k];
+        if (sys->qkind[k] == PHLEX_DOF_VELOCITY || sys->qkind[k] == PHLEX_DOF_ELASTIC_VELOCITY) sys->q[k] = qy[k]; /* frames' and elastic velocities */
       PetscCall(PhlexSystemScatter(sys, sys->q, X));
       PetscCall(PetscFree(qy));
     }

@@ -297,6 +297,74 @@ PetscErrorCode PhlexFrameAddLoadArms(PhlexFrame *fr, Vec u, PhlexFrameState *f)
   PetscFunctionReturn(0);
 }
 
+/* the moving-frame terms of the elastic momentum rows at one node, from its inputs (t_l, z_l = int rho y phi_l, (Mv u')_l,
+   (Mv v)_l): linear in them, with coefficients of the frame's state (C = |w|^2 I - w w^T, vxw = v_P x w) */
+static inline void NodeLoad(const PhlexFrame *fr, const PhlexFrameState *f, const PetscReal C[9], const PetscReal vxw[3], PetscReal tl, const PetscReal z[3], const PetscReal Mud_l[3], const PetscReal Mv_l[3], PetscReal acc[3])
+{
+  const PetscBool full = fr->frozen ? PETSC_FALSE : PETSC_TRUE;
+  PetscReal       tmp[3], tmp2[3];
+
+  /* t vP' + int rho phi (w' x y) = t vP' + w' x z */
+  PhlexCross(f->wd, z, acc);
+  for (PetscInt k = 0; k < 3; k++) acc[k] += tl * f->vPd[k] - tl * f->gbody[k];
+  if (full) {
+    /* + Mv (w x ud): node-wise cross commutes with Mv */
+    PhlexCross(f->w, Mud_l, tmp);
+    /* - dT/du = - [t (vP x w) + C z + Mv v x w]  (C = |w|^2 I - w w^T, (w x y) x w = C y) */
+    PhlexMatVec3(C, z, tmp2);
+    for (PetscInt k = 0; k < 3; k++) acc[k] += tmp[k] - tl * vxw[k] - tmp2[k];
+    PhlexCross(Mv_l, f->w, tmp);
+    for (PetscInt k = 0; k < 3; k++) acc[k] -= tmp[k];
+  } else if (fr->gyroscopic) {
+    /* constant model: - (t v_P + w x w_l + 2 Mv v) x w  (z = w_l: u = 0) */
+    PhlexMatVec3(C, z, tmp2);
+    PhlexCross(Mv_l, f->w, tmp);
+    for (PetscInt k = 0; k < 3; k++) acc[k] -= tl * vxw[k] + tmp2[k] + 2.0 * tmp[k];
+  }
+}
+
+/* C = |w|^2 I - w w^T and v_P x w of an evaluated state */
+static void NodeLoadFactors(const PhlexFrameState *f, PetscReal C[9], PetscReal vxw[3])
+{
+  PhlexCross(f->vP, f->w, vxw);
+  for (PetscInt i = 0; i < 9; i++) C[i] = -f->w[i / 3] * f->w[i % 3];
+  {
+    const PetscReal w2 = PhlexDot3(f->w, f->w);
+    C[0] += w2;
+    C[4] += w2;
+    C[8] += w2;
+  }
+}
+
+/*@C
+  PhlexFrameLoadCoefficients - the moving-frame terms of the elastic momentum rows as a linear map of a node's inputs
+  (PHLEX_FRAME_IN_*): the load at a node with inputs P_l is sum_i A[c + 3 i] P_l[i] (component c), at the evaluated
+  state; the terms PhlexFrameResidual adds node by node
+
+  Not collective
+
+  Notes:
+  A body whose elastic field is spanned by a basis Phi (a reduced body) gets its generalized frame loads by contracting
+  A with the moments sum_l P_l[i] Phi_k(l, c) of the node inputs with each basis vector (its inertia invariants): the
+  Galerkin projection of the full body's rows, term by term. PHLEX_FRAME_IN_B (load arms) and PHLEX_FRAME_IN_W have no
+  term here.
+@*/
+PetscErrorCode PhlexFrameLoadCoefficients(PhlexFrame *fr, PhlexFrameState *f, PetscReal A[3 * PHLEX_FRAME_NIN])
+{
+  PetscReal C[9], vxw[3];
+
+  PetscFunctionBeginUser;
+  NodeLoadFactors(f, C, vxw);
+  for (PetscInt i = 0; i < 3 * PHLEX_FRAME_NIN; i++) A[i] = 0.0;
+  for (PetscInt i = 0; i < PHLEX_FRAME_IN_B; i++) {
+    PetscReal in[PHLEX_FRAME_NIN] = {0}, acc[3];
+    in[i] = 1.0;
+    NodeLoad(fr, f, C, vxw, in[PHLEX_FRAME_IN_T], in + PHLEX_FRAME_IN_Z, in + PHLEX_FRAME_IN_ZD, in + PHLEX_FRAME_IN_MV, acc);
+    for (PetscInt c = 0; c < 3; c++) A[c + 3 * i] = acc[c];
+  }
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexFrameResidual - adds the moving-frame terms to the elastic momentum residual Fv (which already holds
   Mv v' + G^T Sigma - b_ext; NULL without a field) and computes the 18 rigid residuals Fq (all in non-dimensional
@@ -340,14 +408,7 @@ PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec
   }
 
   /* elastic rows: p_f' - Mv v' = t vP' + int rho phi (w' x y) + Mv (w x ud), minus dT/du, minus t R^T g */
-  PhlexCross(f->vP, f->w, vxw);
-  for (PetscInt i = 0; i < 9; i++) C[i] = -f->w[i / 3] * f->w[i % 3];
-  {
-    const PetscReal w2 = PhlexDot3(f->w, f->w);
-    C[0] += w2;
-    C[4] += w2;
-    C[8] += w2;
-  }
+  NodeLoadFactors(f, C, vxw);
   if (!fr->tnode) PetscFunctionReturn(0);
   PetscCall(VecGetLocalSize(u, &n));
   PetscCall(VecGetArray(Fv, &fa));
@@ -361,33 +422,13 @@ PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec
   uda = NULL;
   if (ud) PetscCall(VecGetArrayRead(ud, &uda));
   for (PetscInt l = 0; l < n / 3; l++) {
-    const PetscReal tl = PetscRealPart(ta[3 * l]);
-    PetscReal       z[3], acc[3], tmp[3], tmp2[3];
-    for (PetscInt k = 0; k < 3; k++) z[k] = PetscRealPart(wa[3 * l + k] + Mua[3 * l + k]); /* int rho y phi_l */
-    /* t vP' + int rho phi (w' x y) = t vP' + w' x z */
-    PhlexCross(f->wd, z, acc);
-    for (PetscInt k = 0; k < 3; k++) acc[k] += tl * f->vPd[k] - tl * f->gbody[k];
-    if (full) {
-      PetscReal Mud_l[3], Mv_l[3];
-      for (PetscInt k = 0; k < 3; k++) {
-        Mud_l[k] = PetscRealPart(Muda[3 * l + k]);
-        Mv_l[k]  = PetscRealPart(Mvva[3 * l + k]);
-      }
-      /* + Mv (w x ud): node-wise cross commutes with Mv */
-      PhlexCross(f->w, Mud_l, tmp);
-      /* - dT/du = - [t (vP x w) + C z + Mv v x w]  (C = |w|^2 I - w w^T, (w x y) x w = C y) */
-      PhlexMatVec3(C, z, tmp2);
-      for (PetscInt k = 0; k < 3; k++) acc[k] += tmp[k] - tl * vxw[k] - tmp2[k];
-      PhlexCross(Mv_l, f->w, tmp);
-      for (PetscInt k = 0; k < 3; k++) acc[k] -= tmp[k];
-    } else if (fr->gyroscopic) {
-      /* constant model: - (t v_P + w x w_l + 2 Mv v) x w  (z = w_l: u = 0) */
-      PetscReal Mv_l[3];
-      for (PetscInt k = 0; k < 3; k++) Mv_l[k] = PetscRealPart(Mvva[3 * l + k]);
-      PhlexMatVec3(C, z, tmp2);
-      PhlexCross(Mv_l, f->w, tmp);
-      for (PetscInt k = 0; k < 3; k++) acc[k] -= tl * vxw[k] + tmp2[k] + 2.0 * tmp[k];
+    PetscReal z[3], Mud_l[3] = {0, 0, 0}, Mv_l[3], acc[3];
+    for (PetscInt k = 0; k < 3; k++) {
+      z[k]    = PetscRealPart(wa[3 * l + k] + Mua[3 * l + k]); /* int rho y phi_l */
+      Mv_l[k] = PetscRealPart(Mvva[3 * l + k]);
+      if (full) Mud_l[k] = PetscRealPart(Muda[3 * l + k]);
     }
+    NodeLoad(fr, f, C, vxw, PetscRealPart(ta[3 * l]), z, Mud_l, Mv_l, acc);
     for (PetscInt k = 0; k < 3; k++) fa[3 * l + k] += acc[k];
   }
   PetscCall(VecRestoreArray(Fv, &fa));
@@ -642,7 +683,7 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
 
   /* the field borders: every column is linear in the node inputs, with coefficients the same at every node; they are
      the borders' values at unit inputs */
-  if (!fr->tnode || !Lb) PetscFunctionReturn(0);
+  if (!Lb) PetscFunctionReturn(0);
   for (PetscInt i = 0; i < PHLEX_FRAME_NIN; i++) {
     PetscReal in[PHLEX_FRAME_NIN] = {0}, bc[54], cu[54], cv[54];
     in[i] = 1.0;

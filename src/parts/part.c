@@ -41,6 +41,7 @@ PetscErrorCode PhlexPartRegisterAll(void)
   PetscCall(PhlexPartRegister("flexible", PhlexPartCreate_Flexible));
   PetscCall(PhlexPartRegister("rigid", PhlexPartCreate_Rigid));
   PetscCall(PhlexPartRegister("lumped", PhlexPartCreate_Lumped));
+  PetscCall(PhlexPartRegister("reduced", PhlexPartCreate_Reduced));
   PetscCall(PetscRegisterFinalize(PhlexPartFinalizePackage_Private));
   PetscFunctionReturn(0);
 }
@@ -73,7 +74,7 @@ PetscErrorCode PhlexPartCreate(MPI_Comm comm, PetscInt index, PhlexPart *part)
 
   Options Database Keys (prefix body<k>_):
 + -name <s>                         - name in messages, output files and joint specifications
-- -type <flexible,rigid,lumped>     - kind of part (default flexible)
+- -type <flexible,rigid,lumped,reduced> - kind of part (default flexible)
 @*/
 PetscErrorCode PhlexPartSetFromOptions(PhlexPart p)
 {
@@ -85,14 +86,14 @@ PetscErrorCode PhlexPartSetFromOptions(PhlexPart p)
   PetscCall(PhlexPartRegisterAll());
   PetscOptionsBegin(p->comm, p->prefix, "Part options", NULL);
   PetscCall(PetscOptionsString("-name", "Name of the body (messages, output files, joints)", "PhlexPartSetFromOptions", p->name, p->name, sizeof(p->name), NULL));
-  PetscCall(PetscOptionsFList("-type", "Kind of body: flexible (3D FE solid), rigid (mass, inertia, ports at points), lumped (a point mass)", "PhlexPartSetFromOptions", PhlexPartList, type, type, sizeof(type), &flg));
+  PetscCall(PetscOptionsFList("-type", "Kind of body: flexible (3D FE solid), rigid (mass, inertia, ports at points), lumped (a point mass), reduced (a flexible body reduced to a modal basis: the flexible options plus -reduction_*)", "PhlexPartSetFromOptions", PhlexPartList, type, type, sizeof(type), &flg));
   PetscOptionsEnd();
   PetscCall(PetscStrcmp(p->name, "ground", &flg));
   PetscCheck(!flg, p->comm, PETSC_ERR_USER_INPUT, "body %" PetscInt_FMT ": the name 'ground' is reserved for the fixed inertial frame (option -%sname)", p->index, p->prefix);
   valid = (p->name[0] && !strchr(p->name, ':') && !strchr(p->name, ',') && !strchr(p->name, ' ')) ? PETSC_TRUE : PETSC_FALSE;
   PetscCheck(valid, p->comm, PETSC_ERR_USER_INPUT, "body %" PetscInt_FMT ": option -%sname '%s' must be non-empty without ':', ',' or spaces", p->index, p->prefix, p->name);
   PetscCall(PetscFunctionListFind(PhlexPartList, type, &create));
-  PetscCheck(create, p->comm, PETSC_ERR_USER_INPUT, "body %s: unknown option -%stype '%s' (flexible, rigid, lumped)", p->name, p->prefix, type);
+  PetscCheck(create, p->comm, PETSC_ERR_USER_INPUT, "body %s: unknown option -%stype '%s' (flexible, rigid, lumped, reduced)", p->name, p->prefix, type);
   PetscCall(PetscStrncpy(p->type, type, sizeof(p->type)));
   PetscCall((*create)(p));
   if (p->ops.setfromoptions) PetscCall((*p->ops.setfromoptions)(p));

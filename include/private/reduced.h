@@ -1,0 +1,36 @@
+/* A reduced flexible body (paper Section 5.3): its elastic field in the span of a basis Phi of the full body's
+   velocity space, u = Phi eta, v = Phi zeta; what the online model (src/parts/reduced.c) needs of the full body is
+   the Galerkin projection of its operators and its inertia invariants (src/parts/reduced_build.c builds them, and
+   reads and writes the reduced body file). All non-dimensional (the scene's units) in memory, SI in the file. */
+#ifndef PHLEX_PRIVATE_REDUCED_H
+#define PHLEX_PRIVATE_REDUCED_H
+
+typedef enum {
+  PHLEX_REDUCTION_FREE_INTERFACE /* the body's own normal modes (clamped at its frame patch, or free on mean axes)
+                                    plus the static attachment modes of its ports */
+} PhlexReductionType;
+PETSC_EXTERN const char *const PhlexReductionTypes[];
+
+typedef struct {
+  PetscInt   m;        /* basis size */
+  PetscInt   nnormal;  /* normal modes among the basis vectors' span */
+  PetscInt   nports;   /* the full body's listed ports (its port maps follow their order) */
+  PetscReal *Mr, *Kr;  /* Phi^T Mv Phi, Phi^T K Phi (m x m, row-major; the basis makes them I and diagonal) */
+  PetscReal *S;        /* 3 m: int rho phi_k (component c at 3 k + c) */
+  PetscReal *W;        /* 9 m: int rho x_b phi_k,c at 9 k + 3 b + c (x relative to the frame origin P) */
+  PetscReal *N;        /* 9 m^2: int rho phi_i,b phi_j,c at 9 (i m + j) + 3 b + c */
+  PetscReal *Svol;     /* 3 m: int phi_k (uniform body forces) */
+  PetscReal *P;        /* 6 m per port: its output map B_q^T Phi, row d (translation 0-2, rotation 3-5) at 6 m q + m d + k */
+  PetscReal *lambda;   /* the reduced eigenvalues (diagonal of Kr) */
+  PetscReal *lambda_full; /* nnormal: the full body's eigenvalues of the normal modes in the basis */
+  PhlexInertia inertia; /* the whole body about P: m, s0, E0, vol, svol */
+} PhlexReducedModel;
+
+PETSC_INTERN PetscErrorCode PhlexReducedBuild(PhlexPart, PhlexReductionType, PetscInt, PhlexReducedModel *);
+PETSC_INTERN PetscErrorCode PhlexReducedModelDestroy(PhlexReducedModel *);
+PETSC_INTERN PetscErrorCode PhlexReducedWrite(MPI_Comm, const char[], const char[], const PhlexReducedModel *, const PhlexUnits *, const char[]);
+PETSC_INTERN PetscErrorCode PhlexReducedRead(MPI_Comm, const char[], const char[], const char[], const PhlexUnits *, PhlexReducedModel *);
+PETSC_INTERN PetscErrorCode PhlexReducedModelRoundTrip(PhlexReducedModel *, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexReducedProvenance(PhlexPart, PhlexReductionType, PetscInt, char[], size_t);
+
+#endif

@@ -1,0 +1,862 @@
+/* A reduced flexible body as a part (part kind "reduced", paper Section 5.3): a flexible body whose elastic field is
+   spanned by a basis Phi of the full body's field (reduced_build.c), u = Phi eta, v = Phi zeta, with the same
+   options, ports and frame as the full body (-body<k>_type reduced instead of flexible). Its unknowns are discrete:
+   q = [r | R | v_P | w] (floating) | eta (elastic coordinates) | zeta (their velocities).
+
+   Equations: the Galerkin projection of the full body's (flexible_dynamics.c, frame.c):
+     F_q    = the frame's kinematics and Hamel equations (frame.c), with the field's integrals from the invariants
+     F_eta  = eta' - zeta
+     F_zeta = Mr zeta' + Kr eta + Phi^T (the frame's loads on the field) - sum_q P_q^T w_q - (body force, weight)
+   Mr = Phi^T Mv Phi, Kr = Phi^T K Phi (the stress eliminated exactly: Sigma = Ms^{-1} G u), P_q = B_q^T Phi the port
+   maps. The frame's loads on the field are linear in the node inputs of frame.c (t, int rho y phi, Mv u', Mv v,
+   Mv v'): their generalized forces are the coefficients of PhlexFrameLoadCoefficients contracted with the inputs'
+   moments with each basis vector, formed from the invariants int rho phi_k, int rho x phi_k^T, int rho phi_i phi_j^T;
+   the Jacobian's borders likewise from PhlexFrameJacobian's node coefficients. Every inertia model of the full body
+   is the same projection; with the constant ones the Hamiltonian 1/2 e^T M e + 1/2 eta^T Kr eta is quadratic and
+   the implicit midpoint rule keeps it to solver tolerance. */
+#include <phlex_impl.h>
+#include <private/reduced.h>
+
+typedef struct {
+  PhlexPart          full; /* the FE body it reduces: its options, mesh and operators (the offline build) */
+  PhlexFlexible      fb;
+  PhlexReductionType type;
+  PetscInt           nmodes;
+  char               file[PETSC_MAX_PATH_LEN];
+  PetscBool          built; /* the model was built in this run (else read from the file) */
+  PhlexReducedModel  md;
+  PetscBool          floating, full_inertia;
+  PetscInt           m, ie, iz, nports; /* basis size, offsets of eta and zeta in q, the listed ports */
+  PhlexFrame         frame;
+  PhlexFrameState    fs;
+  PetscReal         *Mom;   /* per basis vector 3 PHLEX_FRAME_NIN: the node inputs' moments at the evaluated state */
+  PetscReal         *gext;  /* m: generalized force of the external inputs (ports, body force, a fixed body's weight) */
+  PetscReal         *work;  /* m */
+  PetscReal        (*port_ext)[6], (*port_y)[6], (*port_ub)[6]; /* per port: input, output, mean displacement and rotation */
+  PetscReal          beta[3]; /* body force density at the evaluated time */
+  PetscReal          power_ext, t_eval;
+  PetscViewer        rigid_csv, ports_csv, modal_csv;
+} Reduced;
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Options, set-up                                                                                                */
+
+static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
+{
+  Reduced      *r = (Reduced *)part->data;
+  PhlexFlexible b;
+  PetscInt      type = 0;
+
+  PetscFunctionBeginUser;
+  /* the full body reads its options under the same prefix: the scene of a reduced body is that of the full one */
+  PetscCall(PhlexPartCreate(part->comm, part->index, &r->full));
+  PetscCall(PetscStrcpy(r->full->name, part->name));
+  PetscCall(PetscStrcpy(r->full->type, "flexible"));
+  PetscCall(PhlexPartCreate_Flexible(r->full));
+  PetscCall((*r->full->ops.setfromoptions)(r->full));
+  r->fb = b  = (PhlexFlexible)r->full->data;
+  r->nmodes  = 10;
+  PetscOptionsBegin(part->comm, part->prefix, "Reduced body options", NULL);
+  PetscCall(PetscOptionsString("-reduced_file", "Reduced body file (HDF5): read if it exists and was built for this body, else built and written; empty: built in memory at every run", "ReducedSetFromOptions", r->file, r->file, sizeof(r->file), NULL));
+  PetscCall(PetscOptionsEList("-reduction", "Basis of the reduction: free_interface (the body's normal modes with its frame held, plus the static attachment modes of its ports)", "ReducedSetFromOptions", PhlexReductionTypes, 1, PhlexReductionTypes[type], &type, NULL));
+  PetscCall(PetscOptionsInt("-reduction_modes", "Normal modes in the basis (the attachment modes of the ports, six each, come in addition)", "ReducedSetFromOptions", r->nmodes, &r->nmodes, NULL));
+  PetscOptionsEnd();
+  r->type = (PhlexReductionType)type;
+  PetscCheck(r->nmodes >= 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_modes must be >= 0, got %" PetscInt_FMT, part->name, part->prefix, r->nmodes);
+  PetscCheck(!b->stiffening && !b->spinning, part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced body has no %s (its basis is that of the linear body at rest, and the stiffening would need the stress of every basis pair): use the full body (-%stype flexible)", part->name, b->stiffening ? "geometric stiffening (-geometric_stiffening)" : "prescribed spin (-spin)", part->prefix);
+  {
+    /* the elastic initial state is the basis's: a reduced body starts undeformed, its frame placed and moving as given */
+    const PhlexIC *iv = &b->ic_velocity, *iu = &b->ic_displacement, *is = &b->ic_stress;
+    const char    *what = NULL;
+    if (iu->type != PHLEX_IC_ZERO) what = "ic_displacement_type";
+    else if (is->type != PHLEX_IC_ZERO) what = "ic_stress_type";
+    else if (iv->type != PHLEX_IC_ZERO && !(b->floating && (iv->type == PHLEX_IC_UNIFORM || iv->type == PHLEX_IC_RIGID))) what = "ic_velocity_type";
+    PetscCheck(!what, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%s%s: a reduced body starts with its elastic field at rest and undeformed (its frame placed and moving by -position, -orientation_*, -velocity, -angular_velocity or a rigid -ic_velocity_type); use the full body (-%stype flexible) for an initial elastic field", part->name, part->prefix, what, part->prefix);
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedGeometry(PhlexPart part, PhlexScaleHints *h)
+{
+  Reduced *r = (Reduced *)part->data;
+
+  PetscFunctionBeginUser;
+  /* the same scales as the full body: swapping one for the other changes nothing else in the scene */
+  r->full->process_cells = part->process_cells;
+  PetscCall((*r->full->ops.geometry)(r->full, h));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedSetUp(PhlexPart part)
+{
+  Reduced      *r = (Reduced *)part->data;
+  PhlexFlexible b;
+  char          prov[4096], who[PHLEX_NAME_LEN + 8];
+  PetscBool     exists = PETSC_FALSE;
+  PetscInt      m, nq;
+
+  PetscFunctionBeginUser;
+  r->full->units = part->units;
+  for (PetscInt k = 0; k < 3; k++) r->full->gravity[k] = part->gravity[k];
+  PetscCall((*r->full->ops.setup)(r->full));
+  b = r->fb;
+  PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", part->name));
+  PetscCall(PhlexReducedProvenance(r->full, r->type, r->nmodes, prov, sizeof(prov)));
+  if (r->file[0]) PetscCall(PetscTestFile(r->file, 'r', &exists));
+  if (exists) PetscCall(PhlexReducedRead(part->comm, r->file, who, prov, part->units, &r->md));
+  else {
+    PetscCall(PhlexReducedBuild(r->full, r->type, r->nmodes, &r->md));
+    PetscCall(PhlexReducedModelRoundTrip(&r->md, part->units));
+    r->built = PETSC_TRUE;
+    if (r->file[0]) PetscCall(PhlexReducedWrite(part->comm, r->file, part->name, &r->md, part->units, prov));
+  }
+  PetscCheck(r->md.nports == b->nports, part->comm, PETSC_ERR_PLIB, "body %s: the reduced model has %" PetscInt_FMT " ports, the body %" PetscInt_FMT, part->name, r->md.nports, b->nports);
+  m = r->m      = r->md.m;
+  r->nports     = b->nports;
+  r->floating   = b->floating;
+  r->full_inertia = (PetscBool)(b->floating && !b->frozen_inertia);
+  r->ie         = r->floating ? 18 : 0;
+  r->iz         = r->ie + m;
+  nq            = r->iz + m;
+  PetscCall(PhlexPartSetUpLayout(part, 0, 0, 0, 0, nq));
+  if (r->floating) {
+    const char *const rn[18] = {"rx", "ry", "rz", "R11", "R12", "R13", "R21", "R22", "R23", "R31", "R32", "R33", "vPx", "vPy", "vPz", "wx", "wy", "wz"};
+    for (PetscInt k = 0; k < 18; k++) PetscCall(PhlexPartSetDof(part, k, k < 12 ? PHLEX_DOF_CONFIGURATION : PHLEX_DOF_VELOCITY, rn[k]));
+    part->frame               = (PhlexFrameIndex){0, 3, 12, 15};
+    part->nonlinear           = PETSC_TRUE;
+    part->nonquadratic_energy = r->full_inertia;
+  }
+  for (PetscInt k = 0; k < m; k++) {
+    char name[16];
+    PetscCall(PetscSNPrintf(name, sizeof(name), "eta%" PetscInt_FMT, k + 1));
+    PetscCall(PhlexPartSetDof(part, r->ie + k, PHLEX_DOF_ELASTIC, name));
+    PetscCall(PetscSNPrintf(name, sizeof(name), "zeta%" PetscInt_FMT, k + 1));
+    PetscCall(PhlexPartSetDof(part, r->iz + k, PHLEX_DOF_ELASTIC_VELOCITY, name));
+  }
+  /* the full body's ports: its listed surfaces, and a floating body's frame patch */
+  {
+    const PhlexUnits *u = part->units;
+    const PetscBool   frame_port = (b->floating && b->frame_condition == PHLEX_FRAME_PATCH) ? PETSC_TRUE : PETSC_FALSE;
+    const PetscInt    n = b->nports + (frame_port ? 1 : 0);
+    PetscCall(PhlexPartSetPorts(part, n));
+    for (PetscInt q = 0; q < n; q++) {
+      PetscCall(PetscStrcpy(part->ports[q].name, q < b->nports ? b->ports[q].name : b->frame_patch));
+      part->ports[q].dim = 6;
+      for (PetscInt d = 0; d < 3; d++) part->ports[q].point[d] = q < b->nports ? (b->ports[q].centroid[d] - b->origin[d]) / u->length : 0.0;
+    }
+    PetscCall(PetscCalloc3(PetscMax(n, 1), &r->port_ext, PetscMax(n, 1), &r->port_y, PetscMax(n, 1), &r->port_ub));
+  }
+  if (!r->floating) {
+    part->ops.momenta   = NULL; /* held: no momentum of its own, no frame to move */
+    part->ops.rigidmass = NULL;
+  }
+  r->frame.comm       = part->comm;
+  r->frame.frozen     = b->frozen_inertia;
+  r->frame.gyroscopic = b->gyroscopic;
+  r->frame.inertia    = r->md.inertia;
+  r->frame.gravity    = part->gravity;
+  PetscCall(PetscCalloc3(3 * PHLEX_FRAME_NIN * m, &r->Mom, m, &r->gext, m, &r->work));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
+{
+  Reduced  *r = (Reduced *)part->data;
+  const PhlexUnits *u = part->units;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " normal modes, %" PetscInt_FMT " attachment modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, 6 * r->nports, r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
+  PetscCall(PetscViewerASCIIPushTab(viewer));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "the full body it reduces:\n"));
+  PetscCall(PetscViewerASCIIPushTab(viewer));
+  PetscCall(PhlexPartView(r->full, viewer));
+  PetscCall(PetscViewerASCIIPopTab(viewer));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "reduced frequencies [Hz]:"));
+  for (PetscInt k = 0; k < r->m; k++) PetscCall(PetscViewerASCIIPrintf(viewer, " %.6g", (double)(PetscSqrtReal(PetscMax(r->md.lambda[k], 0.0)) / (2 * PETSC_PI * u->time))));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "full body's frequencies of the normal modes in the basis [Hz]:"));
+  for (PetscInt k = 0; k < r->md.nnormal; k++) PetscCall(PetscViewerASCIIPrintf(viewer, " %.6g", (double)(PetscSqrtReal(PetscMax(r->md.lambda_full[k], 0.0)) / (2 * PETSC_PI * u->time))));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
+  PetscCall(PetscViewerASCIIPopTab(viewer));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedDestroy(PhlexPart part)
+{
+  Reduced *r = (Reduced *)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexPartDestroy(&r->full));
+  if (r->m) PetscCall(PhlexReducedModelDestroy(&r->md));
+  PetscCall(PetscFree3(r->Mom, r->gext, r->work));
+  PetscCall(PetscFree3(r->port_ext, r->port_y, r->port_ub));
+  PetscCall(PetscFree(part->data));
+  PetscFunctionReturn(0);
+}
+
+/* the frame placed and moving as the full body's would be (-position, -orientation_*, -velocity, -angular_velocity, a
+   rigid initial velocity field); the elastic field at rest and undeformed */
+static PetscErrorCode ReducedInitialState(PhlexPart part, PhlexPartVec *X)
+{
+  Reduced          *r = (Reduced *)part->data;
+  PhlexFlexible     b = r->fb;
+  const PhlexUnits *u = part->units;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < part->nq; k++) X->q[k] = 0.0;
+  if (r->floating) {
+    PetscReal v0[3], w0[3];
+    (void)PhlexFlexibleFrameVelocity(b, v0, w0);
+    for (PetscInt k = 0; k < 3; k++) {
+      X->q[k]      = b->pose.position[k] / u->length;
+      X->q[12 + k] = v0[k] / u->velocity;
+      X->q[15 + k] = w0[k] * u->time;
+    }
+    for (PetscInt k = 0; k < 9; k++) X->q[3 + k] = b->pose.rotation[k];
+  }
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Evaluation, residual, Jacobian                                                                                 */
+
+/* sum_j x_j N_jk[b][c] (9 values): the moment of a field x = Phi x with basis vector k through the mass */
+static inline void NMoment(const Reduced *r, const PetscReal *x, PetscInt k, PetscReal out[9])
+{
+  const PetscInt m = r->m;
+  for (PetscInt i = 0; i < 9; i++) out[i] = 0.0;
+  for (PetscInt j = 0; j < m; j++) {
+    const PetscReal *N = r->md.N + 9 * (j * m + k);
+    if (x[j] == 0.0) continue;
+    for (PetscInt i = 0; i < 9; i++) out[i] += x[j] * N[i];
+  }
+}
+
+/* the frame's integrals of the field (frame.c's sums) from the invariants */
+static void FieldSums(const Reduced *r, const PetscReal *eta, const PetscReal *etad, const PetscReal *zeta, const PetscReal *zetad, PetscReal sums[84])
+{
+  const PetscInt m = r->m;
+  PetscReal     *U = sums, *Ud = sums + 3, *Vf = sums + 6, *Vfd = sums + 9, *Wu = sums + 12, *Wud = sums + 21, *Wv = sums + 30, *Wvd = sums + 39, *Nuu = sums + 48, *Nudu = sums + 57, *Nuv = sums + 66, *Nuvd = sums + 75;
+
+  for (PetscInt i = 0; i < 84; i++) sums[i] = 0.0;
+  for (PetscInt k = 0; k < m; k++) {
+    const PetscReal *S = r->md.S + 3 * k, *W = r->md.W + 9 * k;
+    for (PetscInt c = 0; c < 3; c++) {
+      U[c] += S[c] * eta[k];
+      Ud[c] += S[c] * etad[k];
+      Vf[c] += S[c] * zeta[k];
+      Vfd[c] += S[c] * zetad[k];
+    }
+    for (PetscInt i = 0; i < 9; i++) {
+      Wu[i] += W[i] * eta[k];
+      Wud[i] += W[i] * etad[k];
+      Wv[i] += W[i] * zeta[k];
+      Wvd[i] += W[i] * zetad[k];
+    }
+  }
+  if (!r->full_inertia) return;
+  for (PetscInt a = 0; a < m; a++)
+    for (PetscInt j = 0; j < m; j++) {
+      const PetscReal *N = r->md.N + 9 * (a * m + j);
+      const PetscReal  uu = eta[a] * eta[j], du = etad[a] * eta[j], uv = eta[a] * zeta[j], ud = eta[a] * zetad[j] + etad[a] * zeta[j];
+      for (PetscInt i = 0; i < 9; i++) {
+        Nuu[i] += uu * N[i];
+        Nudu[i] += du * N[i];
+        Nuv[i] += uv * N[i];
+        Nuvd[i] += ud * N[i];
+      }
+    }
+}
+
+/* the node inputs' moments with each basis vector (PhlexFrameLoadCoefficients, PhlexFrameJacobian): inputs t, z = int
+   rho y phi, Mv u', Mv v, Mv v', the load arm (none here: the reduced body adds its arms itself), int rho x phi */
+static void InputMoments(Reduced *r, const PetscReal *eta, const PetscReal *etad, const PetscReal *zeta, const PetscReal *zetad)
+{
+  const PetscInt m = r->m;
+  for (PetscInt k = 0; k < m; k++) {
+    PetscReal       *Mom = r->Mom + 3 * PHLEX_FRAME_NIN * k, nu[9], nud[9], nv[9], nvd[9];
+    const PetscReal *S = r->md.S + 3 * k, *W = r->md.W + 9 * k;
+    for (PetscInt i = 0; i < 3 * PHLEX_FRAME_NIN; i++) Mom[i] = 0.0;
+    if (r->full_inertia) {
+      NMoment(r, eta, k, nu);
+      NMoment(r, etad, k, nud);
+    } else
+      for (PetscInt i = 0; i < 9; i++) nu[i] = nud[i] = 0.0;
+    NMoment(r, zeta, k, nv);
+    NMoment(r, zetad, k, nvd);
+    for (PetscInt c = 0; c < 3; c++) {
+      Mom[c + 3 * PHLEX_FRAME_IN_T] = S[c];
+      for (PetscInt bb = 0; bb < 3; bb++) {
+        Mom[c + 3 * (PHLEX_FRAME_IN_Z + bb)]   = W[3 * bb + c] + nu[3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_ZD + bb)]  = nud[3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_MV + bb)]  = nv[3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_MVD + bb)] = nvd[3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_W + bb)]   = W[3 * bb + c];
+      }
+    }
+  }
+}
+
+/* sum_{c,i} L[(3 j + c) nin + i] Mom_k[c + 3 i] */
+static inline PetscReal Contract(const PetscReal *L, PetscInt j, const PetscReal *Mom)
+{
+  PetscReal s = 0.0;
+  for (PetscInt c = 0; c < 3; c++)
+    for (PetscInt i = 0; i < PHLEX_FRAME_NIN; i++) s += L[(3 * j + c) * PHLEX_FRAME_NIN + i] * Mom[c + 3 * i];
+  return s;
+}
+
+/* the arm of a force on port q from the frame origin P: its point, and with full inertia its mean displacement */
+static inline void PortArm(const Reduced *r, PhlexPart part, PetscInt q, PetscReal arm[3])
+{
+  for (PetscInt k = 0; k < 3; k++) arm[k] = part->ports[q].point[k] + (r->full_inertia && q < r->nports ? r->port_ub[q][k] : 0.0);
+}
+
+static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPartVec *X, const PhlexPartVec *Xdot)
+{
+  Reduced          *r = (Reduced *)part->data;
+  PhlexFlexible     b = r->fb;
+  const PhlexUnits *u = part->units;
+  const PetscInt    m = r->m;
+  const PetscReal   T = u->time, *eta = X->q + r->ie, *zeta = X->q + r->iz;
+  PhlexFrameState  *f = &r->fs;
+  PetscReal        *etad, *zetad, qd[18];
+
+  PetscFunctionBeginUser;
+  r->t_eval = t;
+  PetscCall(PetscCalloc2(m, &etad, m, &zetad));
+  if (Xdot)
+    for (PetscInt k = 0; k < m; k++) {
+      etad[k]  = T * Xdot->q[r->ie + k];
+      zetad[k] = T * Xdot->q[r->iz + k];
+    }
+  /* the ports' mean displacements and rotations */
+  for (PetscInt q = 0; q < r->nports; q++)
+    for (PetscInt d = 0; d < 6; d++) {
+      const PetscReal *P = r->md.P + 6 * m * q + m * d;
+      PetscReal        s = 0.0;
+      for (PetscInt k = 0; k < m; k++) s += P[k] * eta[k];
+      r->port_ub[q][d] = s;
+    }
+  if (r->floating) {
+    for (PetscInt k = 0; k < 18; k++) qd[k] = Xdot ? T * Xdot->q[k] : 0.0;
+    FieldSums(r, eta, etad, zeta, zetad, f->sums);
+    f->sums_req = MPI_REQUEST_NULL;
+    PetscCall(PhlexFrameEvaluateEnd(&r->frame, X->q, qd, f));
+    InputMoments(r, eta, etad, zeta, zetad);
+  }
+  /* the external inputs: generalized forces on the field, resultant about P on the frame, their power */
+  for (PetscInt k = 0; k < m; k++) r->gext[k] = 0.0;
+  for (PetscInt k = 0; k < 3; k++) f->Fext[k] = f->Mext[k] = 0.0;
+  r->power_ext = 0.0;
+  for (PetscInt q = 0; q < r->nports; q++) {
+    PetscReal *w = r->port_ext[q], arm[3], a[3];
+    PetscCall(PhlexPortLoadEvaluate(&b->ports[q].load, t, u, r->floating ? f->R : NULL, w));
+    if (!b->ports[q].load.loaded) continue;
+    for (PetscInt d = 0; d < 6; d++)
+      for (PetscInt k = 0; k < m; k++) r->gext[k] += r->md.P[6 * m * q + m * d + k] * w[d];
+    if (r->floating) {
+      PortArm(r, part, q, arm);
+      PhlexCross(arm, w, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        f->Fext[k] += w[k];
+        f->Mext[k] += a[k] + w[3 + k];
+      }
+    }
+  }
+  if (r->floating && b->frame_loaded) {
+    PetscReal fr;
+    PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+    for (PetscInt k = 0; k < 3; k++) {
+      f->Fext[k] += fr * b->frame_force[k] / u->force;
+      f->Mext[k] += fr * b->frame_moment[k] / (u->force * u->length);
+    }
+  }
+  for (PetscInt c = 0; c < 3; c++) r->beta[c] = 0.0;
+  if (b->has_body_force) {
+    PetscReal fr;
+    PetscCall(PhlexProfileEvaluate(b->body_force_profile, t, &fr));
+    for (PetscInt c = 0; c < 3; c++) r->beta[c] = fr * b->body_force[c] * u->length / u->modulus;
+    for (PetscInt k = 0; k < m; k++) r->gext[k] += PhlexDot3(r->md.Svol + 3 * k, r->beta);
+    if (r->floating) {
+      PetscReal arm[3], a[3];
+      for (PetscInt c = 0; c < 3; c++) {
+        arm[c] = r->md.inertia.svol[c];
+        if (r->full_inertia)
+          for (PetscInt k = 0; k < m; k++) arm[c] += r->md.Svol[3 * k + c] * eta[k];
+      }
+      PhlexCross(arm, r->beta, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        f->Fext[k] += r->md.inertia.vol * r->beta[k];
+        f->Mext[k] += a[k];
+      }
+    }
+  }
+  if (!r->floating)
+    for (PetscInt k = 0; k < m; k++) r->gext[k] += PhlexDot3(r->md.S + 3 * k, part->gravity); /* the weight of a fixed body */
+  /* the ports' outputs */
+  for (PetscInt q = 0; q < part->nports; q++) {
+    PetscReal *y = r->port_y[q];
+    for (PetscInt d = 0; d < 6; d++) {
+      y[d] = 0.0;
+      if (q < r->nports)
+        for (PetscInt k = 0; k < m; k++) y[d] += r->md.P[6 * m * q + m * d + k] * zeta[k];
+    }
+    if (r->floating) {
+      PetscReal arm[3], a[3];
+      PortArm(r, part, q, arm);
+      PhlexCross(f->w, arm, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        y[k] += f->vP[k] + a[k];
+        y[3 + k] += f->w[k];
+      }
+    }
+  }
+  /* the inputs' power: the ports' w . y, the frame wrench, the body force */
+  for (PetscInt q = 0; q < r->nports; q++)
+    if (b->ports[q].load.loaded)
+      for (PetscInt d = 0; d < 6; d++) r->power_ext += r->port_ext[q][d] * r->port_y[q][d];
+  if (b->has_body_force)
+    for (PetscInt k = 0; k < m; k++) r->power_ext += PhlexDot3(r->md.Svol + 3 * k, r->beta) * zeta[k];
+  if (r->floating) {
+    PetscReal Fb[3] = {0, 0, 0}, Mb[3] = {0, 0, 0};
+    /* the frame's share of the port inputs is in their w . y: the frame wrench and the body force's resultant only */
+    if (b->frame_loaded) {
+      PetscReal fr;
+      PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+      for (PetscInt k = 0; k < 3; k++) {
+        Fb[k] += fr * b->frame_force[k] / u->force;
+        Mb[k] += fr * b->frame_moment[k] / (u->force * u->length);
+      }
+    }
+    if (b->has_body_force) {
+      PetscReal arm[3], a[3];
+      for (PetscInt c = 0; c < 3; c++) {
+        arm[c] = r->md.inertia.svol[c];
+        if (r->full_inertia)
+          for (PetscInt k = 0; k < m; k++) arm[c] += r->md.Svol[3 * k + c] * eta[k];
+      }
+      PhlexCross(arm, r->beta, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        Fb[k] += r->md.inertia.vol * r->beta[k];
+        Mb[k] += a[k];
+      }
+    }
+    r->power_ext += PhlexDot3(Fb, f->vP) + PhlexDot3(Mb, f->w);
+  }
+  PetscCall(PetscFree2(etad, zetad));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedResidual(PhlexPart part, PetscReal t, const PhlexPartVec *X, const PhlexPartVec *Xdot, PhlexPartVec *F)
+{
+  Reduced        *r = (Reduced *)part->data;
+  const PetscInt  m = r->m;
+  const PetscReal T = part->units->time, *eta = X->q + r->ie, *zeta = X->q + r->iz;
+  PhlexFrameState f = r->fs; /* the joint wrenches join the inputs in a copy: the evaluation stays as it was */
+  PetscReal      *g = r->work;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < m; k++) g[k] = r->gext[k];
+  for (PetscInt q = 0; q < part->nports; q++) {
+    const PetscReal *w = part->wrench[q];
+    if (q < r->nports)
+      for (PetscInt d = 0; d < 6; d++)
+        if (w[d] != 0.0)
+          for (PetscInt k = 0; k < m; k++) g[k] += r->md.P[6 * m * q + m * d + k] * w[d];
+    if (r->floating) {
+      PetscReal arm[3], a[3];
+      PortArm(r, part, q, arm);
+      PhlexCross(arm, w, a);
+      for (PetscInt k = 0; k < 3; k++) {
+        f.Fext[k] += w[k];
+        f.Mext[k] += a[k] + w[3 + k];
+      }
+    }
+  }
+  if (r->floating) PetscCall(PhlexFrameResidual(&r->frame, &f, NULL, NULL, NULL, NULL, F->q));
+  for (PetscInt k = 0; k < m; k++) F->q[r->ie + k] = T * Xdot->q[r->ie + k] - zeta[k];
+  for (PetscInt k = 0; k < m; k++) {
+    PetscReal s = -g[k];
+    for (PetscInt j = 0; j < m; j++) s += r->md.Mr[m * k + j] * T * Xdot->q[r->iz + j] + r->md.Kr[m * k + j] * eta[j];
+    F->q[r->iz + k] = s;
+  }
+  if (r->floating) {
+    PetscReal A[3 * PHLEX_FRAME_NIN];
+    PetscCall(PhlexFrameLoadCoefficients(&r->frame, &r->fs, A));
+    for (PetscInt k = 0; k < m; k++) {
+      const PetscReal *Mom = r->Mom + 3 * PHLEX_FRAME_NIN * k;
+      PetscReal        s   = 0.0;
+      for (PetscInt i = 0; i < 3 * PHLEX_FRAME_NIN; i++) s += A[i] * Mom[i];
+      F->q[r->iz + k] += s;
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedJacobian(PhlexPart part, PetscReal shift, const PhlexPartVec *X, PetscReal *D, PetscInt ld)
+{
+  Reduced        *r = (Reduced *)part->data;
+  PhlexFlexible   b = r->fb;
+  const PetscInt  m = r->m, ie = r->ie, iz = r->iz, nin = PHLEX_FRAME_NIN;
+  PetscReal       Bvv[9] = {0}, Bvu[9] = {0};
+
+#define Dq(i, j) D[ld * (i) + (j)]
+  PetscFunctionBeginUser;
+  if (r->floating) {
+    PetscReal *Lb, *Lu, *Lv, Arr[324];
+    PetscCall(PetscCalloc3(54 * nin, &Lb, 54 * nin, &Lu, 54 * nin, &Lv));
+    PetscCall(PhlexFrameJacobian(&r->frame, &r->fs, shift, Lb, Lu, Lv, nin, Bvv, Bvu, Arr));
+    for (PetscInt i = 0; i < 18; i++)
+      for (PetscInt j = 0; j < 18; j++) Dq(i, j) = Arr[18 * i + j];
+    for (PetscInt k = 0; k < m; k++) {
+      const PetscReal *Mom = r->Mom + 3 * nin * k;
+      for (PetscInt j = 0; j < 18; j++) {
+        Dq(j, ie + k) = Contract(Lu, j, Mom);
+        Dq(j, iz + k) = Contract(Lv, j, Mom);
+        Dq(iz + k, j) = Contract(Lb, j, Mom);
+      }
+    }
+    PetscCall(PetscFree3(Lb, Lu, Lv));
+    if (r->full_inertia) {
+      /* the arms of the forces move with the ports' mean displacements (and the body force's with int u) */
+      for (PetscInt q = 0; q < r->nports; q++) {
+        PetscReal F[3];
+        for (PetscInt c = 0; c < 3; c++) F[c] = part->wrench[q][c] + (b->ports[q].load.loaded ? r->port_ext[q][c] : 0.0);
+        for (PetscInt k = 0; k < m; k++) {
+          PetscReal dub[3], a[3];
+          for (PetscInt c = 0; c < 3; c++) dub[c] = r->md.P[6 * m * q + m * c + k];
+          PhlexCross(dub, F, a);
+          for (PetscInt c = 0; c < 3; c++) Dq(15 + c, ie + k) -= a[c];
+        }
+      }
+      if (b->has_body_force)
+        for (PetscInt k = 0; k < m; k++) {
+          PetscReal a[3];
+          PhlexCross(r->md.Svol + 3 * k, r->beta, a);
+          for (PetscInt c = 0; c < 3; c++) Dq(15 + c, ie + k) -= a[c];
+        }
+    }
+    /* inputs with directions fixed in the inertial frame turn with R */
+    for (PetscInt q = 0; q < r->nports; q++) {
+      if (!b->ports[q].load.loaded || b->ports[q].load.frame != PHLEX_DIRECTION_INERTIAL) continue;
+      for (PetscInt kk = 0; kk < 9; kk++) {
+        PetscReal dw[6], arm[3], a[3];
+        PetscCall(PhlexPortLoadDerivativeR(&b->ports[q].load, r->t_eval, part->units, kk, dw));
+        PortArm(r, part, q, arm);
+        PhlexCross(arm, dw, a);
+        for (PetscInt c = 0; c < 3; c++) {
+          Dq(12 + c, 3 + kk) -= dw[c];
+          Dq(15 + c, 3 + kk) -= a[c] + dw[3 + c];
+        }
+        for (PetscInt k = 0; k < m; k++)
+          for (PetscInt d = 0; d < 6; d++) Dq(iz + k, 3 + kk) -= r->md.P[6 * m * q + m * d + k] * dw[d];
+      }
+    }
+  }
+  for (PetscInt k = 0; k < m; k++) {
+    Dq(ie + k, ie + k) = shift;
+    Dq(ie + k, iz + k) = -1.0;
+    for (PetscInt i = 0; i < m; i++) {
+      const PetscReal *N  = r->md.N + 9 * (k * m + i);
+      PetscReal        sv = 0.0, su = 0.0;
+      for (PetscInt j = 0; j < 9; j++) {
+        sv += Bvv[j] * N[j];
+        su += Bvu[j] * N[j];
+      }
+      Dq(iz + k, ie + i) = r->md.Kr[m * k + i] + su;
+      Dq(iz + k, iz + i) = shift * r->md.Mr[m * k + i] + sv;
+    }
+  }
+#undef Dq
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedPostStep(PhlexPart part, PetscReal *q, PetscReal *defect)
+{
+  PetscFunctionBeginUser;
+  *defect = 0.0;
+  if (!((Reduced *)part->data)->floating) PetscFunctionReturn(0);
+  *defect = PhlexOrthogonalityError(q + 3);
+  PhlexOrthonormalize(q + 3);
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Ports                                                                                                          */
+
+static PetscErrorCode ReducedPortOutput(PhlexPart part, PetscInt q, PetscReal y[6])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 6; k++) y[k] = ((Reduced *)part->data)->port_y[q][k];
+  PetscFunctionReturn(0);
+}
+
+/* dy for a change dq of its unknowns (it has no field unknowns) */
+static PetscErrorCode ReducedPortLinear(PhlexPart part, PetscInt q, Vec du, PetscReal au, Vec dv, const PetscReal *dq, PetscReal dy[6])
+{
+  Reduced       *r = (Reduced *)part->data;
+  const PetscInt m = r->m;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 6; k++) dy[k] = 0.0;
+  if (!dq) PetscFunctionReturn(0);
+  if (q < r->nports)
+    for (PetscInt d = 0; d < 6; d++)
+      for (PetscInt k = 0; k < m; k++) dy[d] += r->md.P[6 * m * q + m * d + k] * dq[r->iz + k];
+  if (r->floating) {
+    PetscReal arm[3], a[3];
+    if (r->full_inertia && q < r->nports) {
+      /* w x d ubar */
+      PetscReal dub[3] = {0, 0, 0};
+      for (PetscInt c = 0; c < 3; c++)
+        for (PetscInt k = 0; k < m; k++) dub[c] += r->md.P[6 * m * q + m * c + k] * dq[r->ie + k];
+      PhlexCross(r->fs.w, dub, a);
+      for (PetscInt c = 0; c < 3; c++) dy[c] += a[c];
+    }
+    PortArm(r, part, q, arm);
+    PhlexCross(dq + 15, arm, a);
+    for (PetscInt c = 0; c < 3; c++) {
+      dy[c] += dq[12 + c] + a[c];
+      dy[3 + c] += dq[15 + c];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedPortForce(PhlexPart part, PetscInt q, const PetscReal w[6], Vec fv, PetscReal *fq)
+{
+  Reduced       *r = (Reduced *)part->data;
+  const PetscInt m = r->m;
+
+  PetscFunctionBeginUser;
+  if (!fq) PetscFunctionReturn(0);
+  if (q < r->nports)
+    for (PetscInt d = 0; d < 6; d++)
+      for (PetscInt k = 0; k < m; k++) fq[r->iz + k] += r->md.P[6 * m * q + m * d + k] * w[d];
+  if (r->floating) {
+    PetscReal arm[3], a[3];
+    PortArm(r, part, q, arm);
+    PhlexCross(arm, w, a);
+    for (PetscInt c = 0; c < 3; c++) {
+      fq[12 + c] += w[c];
+      fq[15 + c] += a[c] + w[3 + c];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/* inertial position and orientation of port q at the state X: r + R (c - P + ubar), R exp([theta]x) */
+static PetscErrorCode ReducedPortPlacement(PhlexPart part, PetscInt q, const PhlexPartVec *X, PetscReal x[3], PetscReal Rp[9])
+{
+  Reduced       *r = (Reduced *)part->data;
+  const PetscInt m = r->m;
+  PetscReal      R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, o[3] = {0, 0, 0}, ub[6] = {0, 0, 0, 0, 0, 0}, c[3], E[9], n;
+
+  PetscFunctionBeginUser;
+  if (q < r->nports)
+    for (PetscInt d = 0; d < 6; d++)
+      for (PetscInt k = 0; k < m; k++) ub[d] += r->md.P[6 * m * q + m * d + k] * X->q[r->ie + k];
+  if (r->floating)
+    for (PetscInt k = 0; k < 3; k++) {
+      o[k] = X->q[k];
+      for (PetscInt j = 0; j < 3; j++) R[3 * k + j] = X->q[3 + 3 * k + j];
+    }
+  for (PetscInt k = 0; k < 3; k++) c[k] = part->ports[q].point[k] + ub[k];
+  PhlexMatVec3(R, c, x);
+  for (PetscInt k = 0; k < 3; k++) x[k] += o[k];
+  n = PhlexNorm3(ub + 3);
+  PhlexAxisAngleToRotation(n > 0 ? ub + 3 : (PetscReal[3]){1, 0, 0}, n, E);
+  PhlexMatMat3(R, E, Rp);
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Energy, outputs                                                                                                */
+
+/* x^T A y for an m x m row-major A */
+static PetscReal Quadratic(PetscInt m, const PetscReal *A, const PetscReal *x, const PetscReal *y)
+{
+  PetscReal s = 0.0;
+  for (PetscInt i = 0; i < m; i++)
+    for (PetscInt j = 0; j < m; j++) s += x[i] * A[m * i + j] * y[j];
+  return s;
+}
+
+static PetscErrorCode ReducedEnergy(PhlexPart part, const PhlexPartVec *X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
+{
+  Reduced         *r = (Reduced *)part->data;
+  const PetscInt   m = r->m;
+  const PetscReal *eta = X->q + r->ie, *zeta = X->q + r->iz, vMv = Quadratic(m, r->md.Mr, zeta, zeta);
+
+  PetscFunctionBeginUser;
+  *strain = 0.5 * Quadratic(m, r->md.Kr, eta, eta);
+  if (r->floating) PetscCall(PhlexFrameEnergy(&r->frame, &r->fs, vMv, kin, pot));
+  else {
+    *kin = 0.5 * vMv;
+    *pot = 0.0;
+    for (PetscInt k = 0; k < m; k++) *pot -= PhlexDot3(r->md.S + 3 * k, part->gravity) * eta[k];
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedInputPower(PhlexPart part, PetscReal *P)
+{
+  PetscFunctionBeginUser;
+  *P = ((Reduced *)part->data)->power_ext;
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedMomenta(PhlexPart part, PetscReal P[3], PetscReal L[3])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFrameMomenta(&((Reduced *)part->data)->fs, P, L));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedRigidMass(PhlexPart part, PetscReal M[36])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFrameRigidMass(&((Reduced *)part->data)->md.inertia, M));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedOutputOpen(PhlexPart part, PhlexOutput out, PetscBool fields)
+{
+  Reduced      *r = (Reduced *)part->data;
+  PhlexFlexible b = r->fb;
+  char          name[PHLEX_NAME_LEN + 16], header[1024];
+  const size_t  len = (size_t)((r->nports + 1) * 15 + 2 * r->m + 1) * (PHLEX_NAME_LEN + 8);
+  char         *h;
+  size_t        n;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(len, &h));
+  if (r->nports || r->floating) {
+    /* the same series as the full body's: the frame first (its patch, or "frame" with mean axes), then the ports */
+    PetscCall(PetscStrcpy(h, "time"));
+    for (PetscInt p = r->floating ? -1 : 0; p < r->nports; p++) {
+      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
+      PetscCall(PetscStrlen(h, &n));
+      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn));
+    }
+    for (PetscInt p = r->floating ? -1 : 0; p < r->nports; p++) {
+      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
+      PetscCall(PetscStrlen(h, &n));
+      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_x,%s_y,%s_z", pn, pn, pn));
+    }
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, h, &r->ports_csv));
+  }
+  if (r->floating) {
+    PetscCall(PhlexFrameWriteHeader(header, sizeof(header)));
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_rigid.csv", part->name));
+    PetscCall(PhlexOutputCSVOpen(out, name, header, &r->rigid_csv));
+  }
+  /* the elastic coordinates and their velocities (non-dimensional shapes: u = sum_k eta_k phi_k, in m) */
+  PetscCall(PetscStrcpy(h, "time"));
+  for (PetscInt k = 0; k < r->m; k++) {
+    PetscCall(PetscStrlen(h, &n));
+    PetscCall(PetscSNPrintf(h + n, len - n, ",eta%" PetscInt_FMT, k + 1));
+  }
+  for (PetscInt k = 0; k < r->m; k++) {
+    PetscCall(PetscStrlen(h, &n));
+    PetscCall(PetscSNPrintf(h + n, len - n, ",zeta%" PetscInt_FMT, k + 1));
+  }
+  PetscCall(PetscSNPrintf(name, sizeof(name), "%s_modal.csv", part->name));
+  PetscCall(PhlexOutputCSVOpen(out, name, h, &r->modal_csv));
+  PetscCall(PetscFree(h));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedOutputStep(PhlexPart part, PetscInt step, PetscReal t, const PhlexPartVec *X, PetscBool fields)
+{
+  Reduced          *r = (Reduced *)part->data;
+  PhlexFlexible     b = r->fb;
+  const PhlexUnits *u = part->units;
+
+  PetscFunctionBeginUser;
+  if (step < 0) PetscFunctionReturn(0);
+  if (r->ports_csv) {
+    PetscViewer csv = r->ports_csv;
+    PetscReal   fr  = 0.0;
+    PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
+    if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+    if (r->floating) {
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_force[c])));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_moment[c])));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->fs.vP[c] * u->velocity)));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->fs.w[c] / u->time)));
+    }
+    for (PetscInt p = 0; p < r->nports; p++) {
+      PetscReal in[6];
+      PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, r->floating ? r->fs.R : NULL, in));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force)));
+      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force * u->length)));
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->port_y[p][c] * u->velocity)));
+      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->port_y[p][c] / u->time)));
+    }
+    for (PetscInt p = r->floating ? -1 : 0; p < r->nports; p++) {
+      PetscReal x[3], R[9];
+      if (p >= 0) PetscCall(ReducedPortPlacement(part, p, X, x, R));
+      else
+        for (PetscInt c = 0; c < 3; c++) x[c] = r->fs.r[c];
+      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
+    }
+    PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
+  }
+  if (r->rigid_csv) {
+    PetscReal P[3], L[3];
+    PetscCall(PhlexFrameWriteRow(r->rigid_csv, t, &r->fs, u, P, L));
+  }
+  PetscCall(PetscViewerASCIIPrintf(r->modal_csv, "%.12e", (double)t));
+  for (PetscInt k = 0; k < r->m; k++) PetscCall(PetscViewerASCIIPrintf(r->modal_csv, ",%.12e", (double)(X->q[r->ie + k] * u->length)));
+  for (PetscInt k = 0; k < r->m; k++) PetscCall(PetscViewerASCIIPrintf(r->modal_csv, ",%.12e", (double)(X->q[r->iz + k] * u->velocity)));
+  PetscCall(PetscViewerASCIIPrintf(r->modal_csv, "\n"));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ReducedOutputClose(PhlexPart part)
+{
+  Reduced *r = (Reduced *)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerDestroy(&r->ports_csv));
+  PetscCall(PetscViewerDestroy(&r->rigid_csv));
+  PetscCall(PetscViewerDestroy(&r->modal_csv));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPartCreate_Reduced - a reduced flexible body (part kind "reduced")
+@*/
+PetscErrorCode PhlexPartCreate_Reduced(PhlexPart part)
+{
+  Reduced *r;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&r));
+  part->data               = r;
+  part->ops.setfromoptions = ReducedSetFromOptions;
+  part->ops.geometry       = ReducedGeometry;
+  part->ops.setup          = ReducedSetUp;
+  part->ops.view           = ReducedView;
+  part->ops.destroy        = ReducedDestroy;
+  part->ops.initialstate   = ReducedInitialState;
+  part->ops.evaluate       = ReducedEvaluate;
+  part->ops.residual       = ReducedResidual;
+  part->ops.jacobian       = ReducedJacobian;
+  part->ops.poststep       = ReducedPostStep;
+  part->ops.portoutput     = ReducedPortOutput;
+  part->ops.portlinear     = ReducedPortLinear;
+  part->ops.portforce      = ReducedPortForce;
+  part->ops.portplacement  = ReducedPortPlacement;
+  part->ops.energy         = ReducedEnergy;
+  part->ops.inputpower     = ReducedInputPower;
+  part->ops.momenta        = ReducedMomenta;
+  part->ops.rigidmass      = ReducedRigidMass;
+  part->ops.outputopen     = ReducedOutputOpen;
+  part->ops.outputstep     = ReducedOutputStep;
+  part->ops.outputclose    = ReducedOutputClose;
+  PetscFunctionReturn(0);
+}
