@@ -57,7 +57,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   r->fb = b  = (PhlexFlexible)r->full->data;
   r->nmodes  = 10;
   PetscOptionsBegin(part->comm, part->prefix, "Reduced body options", NULL);
-  PetscCall(PetscOptionsString("-reduced_file", "Reduced body file (HDF5): read if it exists and was built for this body, else built and written; empty: built in memory at every run", "ReducedSetFromOptions", r->file, r->file, sizeof(r->file), NULL));
+  PetscCall(PetscOptionsString("-reduced_file", "Reduced body file (HDF5): read if it exists (refused if built for another body), else built and written; empty: built in memory at every run", "ReducedSetFromOptions", r->file, r->file, sizeof(r->file), NULL));
   PetscCall(PetscOptionsEList("-reduction", "Basis of the reduction: free_interface (the body's normal modes with its frame held, plus the static attachment modes of its ports)", "ReducedSetFromOptions", PhlexReductionTypes, 1, PhlexReductionTypes[type], &type, NULL));
   PetscCall(PetscOptionsInt("-reduction_modes", "Normal modes in the basis (the attachment modes of the ports, six each, come in addition)", "ReducedSetFromOptions", r->nmodes, &r->nmodes, NULL));
   PetscOptionsEnd();
@@ -102,7 +102,13 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   b = r->fb;
   PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", part->name));
   PetscCall(PhlexReducedProvenance(r->full, r->type, r->nmodes, prov, sizeof(prov)));
-  if (r->file[0]) PetscCall(PetscTestFile(r->file, 'r', &exists));
+  if (r->file[0]) {
+    /* rank 0 decides, so that every process reads or every process builds */
+    PetscMPIInt rank;
+    PetscCallMPI(MPI_Comm_rank(part->comm, &rank));
+    if (!rank) PetscCall(PetscTestFile(r->file, 'r', &exists));
+    PetscCallMPI(MPI_Bcast(&exists, 1, MPIU_BOOL, 0, part->comm));
+  }
   if (exists) PetscCall(PhlexReducedRead(part->comm, r->file, who, prov, part->units, &r->md));
   else {
     PetscCall(PhlexReducedBuild(r->full, r->type, r->nmodes, &r->md));
@@ -165,7 +171,7 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
   const PhlexUnits *u = part->units;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " normal modes, %" PetscInt_FMT " attachment modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, 6 * r->nports, r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " normal modes and the attachment modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PetscViewerASCIIPrintf(viewer, "the full body it reduces:\n"));
   PetscCall(PetscViewerASCIIPushTab(viewer));

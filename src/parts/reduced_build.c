@@ -118,15 +118,23 @@ static PetscErrorCode AttachmentModes(PhlexPart part, PetscReal lambda1, Vec **p
         PetscCall(VecAXPY(f, -1.0, r)); /* f - Mv R R^T f: no resultant */
       }
       PetscCall(KSPSolve(ksp, f, x));
-      if (mean_axes)
-        for (PetscInt it = 0; it < 3; it++) {
-          /* K x = f on the complement of the rigid fields: refine the shifted solve */
+      if (mean_axes) {
+        /* K x = f on the complement of the rigid fields: refine the shifted solve until the residual is at round-off
+           (each refinement divides the error in mode i by 1 + lambda_i / lambda1) */
+        PetscReal fn, rn = 0.0;
+        PetscInt  it;
+        PetscCall(VecNorm(f, NORM_2, &fn));
+        for (it = 0; it < 200; it++) {
           PetscCall(RemoveRigid(b, R, x, work));
           PetscCall(MatMult(b->K, x, r));
           PetscCall(VecAYPX(r, -1.0, f));
+          PetscCall(VecNorm(r, NORM_2, &rn));
+          if (rn <= 1e-12 * fn) break;
           PetscCall(KSPSolve(ksp, r, dx));
           PetscCall(VecAXPY(x, 1.0, dx));
         }
+        PetscCheck(rn <= 1e-12 * fn, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the attachment mode of port %s, component %" PetscInt_FMT ", did not converge on mean axes (relative residual %g after %" PetscInt_FMT " refinements)", b->name, b->ports[q].name, d, (double)(rn / fn), it);
+      }
       if (mean_axes) PetscCall(RemoveRigid(b, R, x, work));
       (*psi)[6 * q + d] = x;
     }
@@ -418,7 +426,13 @@ PetscErrorCode PhlexReducedProvenance(PhlexPart part, PhlexReductionType type, P
     PetscCall(PetscSNPrintf(buf + n, len - n, "%s%s", q ? "," : "", b->ports[q].name));
   }
   PetscCall(PetscStrlen(buf, &n));
-  PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " normal modes", PhlexReductionTypes[type], nmodes));
+  {
+    /* the normal modes are the modal analysis's (-modes_target_frequency chooses which) */
+    PetscReal ft  = 0.0;
+    PetscBool set = PETSC_FALSE;
+    PetscCall(PetscOptionsGetReal(NULL, NULL, "-modes_target_frequency", &ft, &set));
+    PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " normal modes %s %.15g Hz", PhlexReductionTypes[type], nmodes, set ? "nearest" : "from", set ? (double)ft : 0.0));
+  }
   PetscFunctionReturn(0);
 }
 
