@@ -129,6 +129,7 @@ PETSC_INTERN PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *);
 PETSC_INTERN PetscErrorCode PhlexCheckpointOpenWrite(MPI_Comm, const char[], char[], PetscViewer *);
 PETSC_INTERN PetscErrorCode PhlexCheckpointCommit(MPI_Comm, const char[], const char[], PetscViewer *);
 PETSC_INTERN PetscErrorCode PhlexCheckpointOpenRead(MPI_Comm, const char[], PetscViewer *);
+PETSC_INTERN PetscErrorCode PhlexHDF5Readable(MPI_Comm, const char[], PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexFileSync(MPI_Comm, const char[]);
 PETSC_INTERN PetscErrorCode PhlexCheckpointWriteReals(PetscViewer, const char[], const char[], PetscInt, const PetscReal[]);
 PETSC_INTERN PetscErrorCode PhlexCheckpointReadReals(PetscViewer, const char[], const char[], PetscInt, PetscReal[]);

@@ -206,6 +206,9 @@ PETSC_INTERN PetscErrorCode PhlexPartGetVec(PhlexPart, Vec, PetscReal *, PhlexPa
 PETSC_INTERN PetscErrorCode PhlexPartRestoreVec(PhlexPart, Vec, PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexPartCreateGround(MPI_Comm, PhlexPart *);
 PETSC_INTERN PetscBool      PhlexPartIsGround(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexPortSeriesOpen(PhlexOutput, const char[], PetscInt, const char *const[], PetscViewer *);
+PETSC_INTERN PetscErrorCode PhlexPortSeriesEntry(PetscViewer, const PhlexUnits *, const PetscReal[6], PetscBool, const PetscReal[6]);
+PETSC_INTERN PetscErrorCode PhlexPortSeriesPosition(PetscViewer, const PhlexUnits *, const PetscReal[3]);
 
 /* Wrench inputs of a port given in the scene (flexible and rigid bodies): amplitudes with a time profile, directions
    fixed in the body frame or in the inertial frame. */

@@ -1055,9 +1055,11 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     SETERRQ(scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has gravity (-gravity %s,%s,%s): the analysis linearises about an unloaded configuration at rest", g[0], g[1], g[2]);
   }
   for (PetscInt k = 0; k < scene->nparts; k++) {
-    PetscBool reduced;
-    PetscCall(PetscStrcmp(scene->parts[k]->type, "reduced", &reduced));
-    PetscCheck(!reduced, scene->comm, PETSC_ERR_SUP, "linearized analysis: body %s is a reduced body (-%stype reduced), whose stiffness lies on its discrete unknowns: this analysis linearises the field blocks of full bodies only; use -%stype flexible", scene->parts[k]->name, scene->parts[k]->prefix, scene->parts[k]->prefix);
+    /* the pencil keeps the discrete velocities and impulses and drops the configuration: elastic coordinates (a
+       reduced body's stiffness) have no place in it yet */
+    const PhlexPart p = scene->parts[k];
+    for (PetscInt i = 0; i < p->nq; i++)
+      PetscCheck(p->qkind[i] != PHLEX_DOF_ELASTIC, scene->comm, PETSC_ERR_SUP, "linearized analysis: body %s has elastic coordinates (-%stype %s), whose stiffness lies on discrete unknowns: this analysis linearises the field blocks of full bodies only; use -%stype flexible", p->name, p->prefix, p->type, p->prefix);
   }
   {
     PetscBool flexible = PETSC_FALSE;

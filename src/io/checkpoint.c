@@ -93,6 +93,35 @@ PetscErrorCode PhlexCheckpointCommit(MPI_Comm comm, const char tmp[], const char
 }
 
 /*@C
+  PhlexHDF5Readable - whether a file opens as HDF5: rank 0 tries it quietly, so that a file that is not HDF5, or a
+  truncated one, gets the caller's message instead of HDF5's trace
+
+  Collective
+@*/
+PetscErrorCode PhlexHDF5Readable(MPI_Comm comm, const char path[], PetscBool *readable)
+{
+  PetscMPIInt rank;
+  int         ok = 1;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) {
+    H5E_auto2_t func;
+    void       *data;
+    hid_t       f;
+    H5Eget_auto2(H5E_DEFAULT, &func, &data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+    f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
+    if (f < 0) ok = 0;
+    else H5Fclose(f);
+    H5Eset_auto2(H5E_DEFAULT, func, data);
+  }
+  PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
+  *readable = ok ? PETSC_TRUE : PETSC_FALSE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexCheckpointOpenRead - opens a checkpoint to restart from, with a clear error if it is not one
 
   Collective
@@ -106,22 +135,8 @@ PetscErrorCode PhlexCheckpointOpenRead(MPI_Comm comm, const char path[], PetscVi
   PetscCall(PetscTestFile(path, 'r', &exists));
   PetscCheck(exists, comm, PETSC_ERR_FILE_OPEN, "cannot read the checkpoint '%s' (option -restart): no such file", path);
   {
-    /* rank 0 tries it first, quietly: a file that is not HDF5, or a truncated one, gets a message, not HDF5's trace */
-    PetscMPIInt rank;
-    int         ok = 1;
-    PetscCallMPI(MPI_Comm_rank(comm, &rank));
-    if (rank == 0) {
-      H5E_auto2_t func;
-      void       *data;
-      hid_t       f;
-      H5Eget_auto2(H5E_DEFAULT, &func, &data);
-      H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-      f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-      if (f < 0) ok = 0;
-      else H5Fclose(f);
-      H5Eset_auto2(H5E_DEFAULT, func, data);
-    }
-    PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
+    PetscBool ok;
+    PetscCall(PhlexHDF5Readable(comm, path, &ok));
     PetscCheck(ok, comm, PETSC_ERR_FILE_UNEXPECTED, "cannot read the checkpoint '%s' (option -restart): not an HDF5 file, or a damaged one (truncated?)", path);
   }
   PetscCall(PetscViewerHDF5Open(comm, path, FILE_MODE_READ, viewer));

@@ -617,10 +617,14 @@ static PetscErrorCode RowsFromPortChange(PhlexJoint j, PetscInt s, const PetscRe
 @*/
 PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, PetscInt ld)
 {
-  PetscReal wJ[6], Dl[6];
+  PetscReal wJ[6], Dl[6], *work;
+  PetscInt  nw = 1;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_JointJacobian, 0, 0, 0, 0));
+  /* one work array for the unit changes and generalized forces of both sides (allocated once, not per column) */
+  for (PetscInt s = 0; s < 2; s++) nw = PetscMax(nw, j->side[s].part->nq);
+  PetscCall(PetscCalloc1(nw, &work));
   JointWrench(j, j->lambda, NULL, wJ);
   Relative(j, Dl);
   for (PetscInt s = 0; s < 2; s++) {
@@ -628,24 +632,23 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
     if (PhlexPartIsGround(p)) continue;
     /* rows x the part's discrete unknowns, through its port */
     for (PetscInt m = 0; m < p->nq; m++) {
-      PetscReal *dq, dy[6], rows[7];
-      PetscCall(PetscCalloc1(p->nq, &dq));
-      dq[m] = 1.0;
-      PetscCall((*p->ops.portlinear)(p, j->side[s].port, NULL, 0.0, NULL, dq, dy));
-      PetscCall(PetscFree(dq));
+      PetscReal dy[6], rows[7];
+      work[m] = 1.0;
+      PetscCall((*p->ops.portlinear)(p, j->side[s].port, NULL, 0.0, NULL, work, dy));
+      work[m] = 0.0;
       PetscCall(RowsFromPortChange(j, s, dy, rows));
       for (PetscInt k = 0; k < j->nc; k++) D[ld * (j->qoff + k) + p->qoff + m] += rows[k];
     }
     /* the part's rows x the impulses: -shift (generalized force of d w / d lambda_k) */
     for (PetscInt k = 0; k < j->nc; k++) {
-      PetscReal e[7] = {0, 0, 0, 0, 0, 0, 0}, wk[6], w[2][6], *fq;
+      PetscReal e[7] = {0, 0, 0, 0, 0, 0, 0}, wk[6], w[2][6];
       e[k] = 1.0;
       JointWrench(j, e, NULL, wk);
       PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
-      PetscCall(PetscCalloc1(p->nq, &fq));
-      PetscCall((*p->ops.portforce)(p, j->side[s].port, w[s], NULL, fq));
-      for (PetscInt m = 0; m < p->nq; m++) D[ld * (p->qoff + m) + j->qoff + k] -= shift * fq[m];
-      PetscCall(PetscFree(fq));
+      PetscCall(PetscArrayzero(work, p->nq));
+      PetscCall((*p->ops.portforce)(p, j->side[s].port, w[s], NULL, work));
+      for (PetscInt m = 0; m < p->nq; m++) D[ld * (p->qoff + m) + j->qoff + k] -= shift * work[m];
+      PetscCall(PetscArrayzero(work, p->nq));
     }
   }
   /* R_ab = R_a^T R_b: the rows (R_ab y_b, and the universal's cross direction) and the wrenches turn with it */
@@ -666,16 +669,15 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
         D[ld * (j->qoff + k) + col] += Dot6(sk, r) + (j->row[k] == PHLEX_ROW_CROSS ? Dot6(dsk, Dl) : 0.0);
       }
       for (PetscInt t = 0; t < 2; t++) {
-        PhlexPart  pt = j->side[t].part;
-        PetscReal *fq;
+        PhlexPart pt = j->side[t].part;
         if (PhlexPartIsGround(pt)) continue;
-        PetscCall(PetscCalloc1(pt->nq, &fq));
-        PetscCall((*pt->ops.portforce)(pt, j->side[t].port, w[t], NULL, fq));
-        for (PetscInt i = 0; i < pt->nq; i++) D[ld * (pt->qoff + i) + col] -= fq[i];
-        PetscCall(PetscFree(fq));
+        PetscCall((*pt->ops.portforce)(pt, j->side[t].port, w[t], NULL, work));
+        for (PetscInt i = 0; i < pt->nq; i++) D[ld * (pt->qoff + i) + col] -= work[i];
+        PetscCall(PetscArrayzero(work, pt->nq));
       }
     }
   }
+  PetscCall(PetscFree(work));
   PetscCall(PetscLogEventEnd(PHLEX_JointJacobian, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }

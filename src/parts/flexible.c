@@ -516,29 +516,14 @@ static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool 
     if (b->floating) PetscCall(PhlexFieldWriterSetGeometryField((PhlexFieldWriter)b->writer, "inertial_position"));
   }
   if (b->nports || b->floating) {
-    /* the header in one piece: a restarted run continues the series without it */
-    const size_t len = (size_t)((b->nports + 1) * 15 + 1) * (PHLEX_NAME_LEN + 8);
-    char        *h;
-    size_t       n;
-    PetscViewer  csv;
-    PetscCall(PetscMalloc1(len, &h));
-    PetscCall(PetscStrcpy(h, "time"));
     /* the frame of a floating body first (its patch, or "frame" with mean axes), then the ports */
-    for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
-      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      PetscCall(PetscStrlen(h, &n));
-      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn));
-    }
-    /* then the inertial positions of the port points (the mean of the patch's displaced points) */
-    for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
-      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      PetscCall(PetscStrlen(h, &n));
-      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_x,%s_y,%s_z", pn, pn, pn));
-    }
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", b->name));
-    PetscCall(PhlexOutputCSVOpen(out, name, h, &csv));
-    PetscCall(PetscFree(h));
-    b->ports_csv = csv;
+    const char **names;
+    PetscInt     n = 0;
+    PetscCall(PetscMalloc1(b->nports + 1, &names));
+    if (b->floating) names[n++] = b->frame_patch[0] ? b->frame_patch : "frame";
+    for (PetscInt p = 0; p < b->nports; p++) names[n++] = b->ports[p].name;
+    PetscCall(PhlexPortSeriesOpen(out, b->name, n, names, (PetscViewer *)&b->ports_csv));
+    PetscCall(PetscFree(names));
   }
   if (b->floating) {
     PetscCall(PhlexFrameWriteHeader(header, sizeof(header)));
@@ -564,25 +549,22 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
     PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
     if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
     if (b->floating) {
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_force[c])));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_moment[c])));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->fs.vP[c] * u->velocity)));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->fs.w[c] / u->time)));
+      /* the frame: its wrench (SI), its motion (v_P, w) */
+      const PetscReal wf[6] = {fr * b->frame_force[0], fr * b->frame_force[1], fr * b->frame_force[2], fr * b->frame_moment[0], fr * b->frame_moment[1], fr * b->frame_moment[2]};
+      const PetscReal yf[6] = {b->fs.vP[0], b->fs.vP[1], b->fs.vP[2], b->fs.w[0], b->fs.w[1], b->fs.w[2]};
+      PetscCall(PhlexPortSeriesEntry(csv, u, wf, PETSC_TRUE, yf));
     }
     for (PetscInt p = 0; p < b->nports; p++) {
       PetscReal in[6];
       PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, b->floating ? b->fs.R : NULL, in)); /* body frame */
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force)));
-      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force * u->length)));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->port_y[p][c] * u->velocity)));
-      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(b->port_y[p][c] / u->time)));
+      PetscCall(PhlexPortSeriesEntry(csv, u, in, PETSC_FALSE, b->port_y[p]));
     }
     for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
       PetscReal x[3], R[9];
       if (p >= 0) PetscCall((*part->ops.portplacement)(part, p, X, x, R));
       else
         for (PetscInt c = 0; c < 3; c++) x[c] = b->fs.r[c]; /* the frame: its origin P */
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
+      PetscCall(PhlexPortSeriesPosition(csv, u, x));
     }
     PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
   }

@@ -413,3 +413,61 @@ PetscErrorCode PhlexPartCreateGround(MPI_Comm comm, PhlexPart *ground)
   PetscCall(PhlexPartCreate_Ground(*ground));
   PetscFunctionReturn(0);
 }
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* The ports series (<part>_ports.csv) of the parts with ports: per step and port its wrench input and output,     */
+/* then the inertial position of each port point                                                                 */
+
+/*@C
+  PhlexPortSeriesOpen - opens <part>_ports.csv with its header: for each name (a moving frame's first, then the
+  ports) _Fx.._Tz, _vx.._wz, then for each _x,_y,_z (in one piece: a restarted run continues the series without it)
+
+  Collective
+@*/
+PetscErrorCode PhlexPortSeriesOpen(PhlexOutput out, const char part[], PetscInt n, const char *const names[], PetscViewer *csv)
+{
+  const size_t len = (size_t)(n * 15 + 1) * (PHLEX_NAME_LEN + 8);
+  char        *h, name[PHLEX_NAME_LEN + 16];
+  size_t       k;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(len, &h));
+  PetscCall(PetscStrcpy(h, "time"));
+  for (PetscInt p = 0; p < n; p++) {
+    const char *pn = names[p];
+    PetscCall(PetscStrlen(h, &k));
+    PetscCall(PetscSNPrintf(h + k, len - k, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn));
+  }
+  for (PetscInt p = 0; p < n; p++) {
+    PetscCall(PetscStrlen(h, &k));
+    PetscCall(PetscSNPrintf(h + k, len - k, ",%s_x,%s_y,%s_z", names[p], names[p], names[p]));
+  }
+  PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part));
+  PetscCall(PhlexOutputCSVOpen(out, name, h, csv));
+  PetscCall(PetscFree(h));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPortSeriesEntry - one port's wrench (SI when si, else non-dimensional) and output y (non-dimensional) in a
+  ports series row
+@*/
+PetscErrorCode PhlexPortSeriesEntry(PetscViewer csv, const PhlexUnits *u, const PetscReal w[6], PetscBool si, const PetscReal y[6])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(si ? w[c] : w[c] * u->force)));
+  for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(si ? w[c] : w[c] * u->force * u->length)));
+  for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(y[c] * u->velocity)));
+  for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(y[c] / u->time)));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPortSeriesPosition - a port point's inertial position (non-dimensional) in a ports series row
+@*/
+PetscErrorCode PhlexPortSeriesPosition(PetscViewer csv, const PhlexUnits *u, const PetscReal x[3])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
+  PetscFunctionReturn(0);
+}

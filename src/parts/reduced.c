@@ -32,6 +32,8 @@ typedef struct {
   PetscReal         *Mom;   /* per basis vector 3 PHLEX_FRAME_NIN: the node inputs' moments at the evaluated state */
   PetscReal         *gext;  /* m: generalized force of the external inputs (ports, body force, a fixed body's weight) */
   PetscReal         *work;  /* m */
+  PetscReal         *etad, *zetad; /* m each: the rates of the evaluated state (non-dimensional time) */
+  PetscReal         *Lb, *Lu, *Lv; /* the frame's node-border coefficients (PhlexFrameJacobian), 54 PHLEX_FRAME_NIN each */
   PetscReal        (*port_ext)[6], (*port_y)[6], (*port_ub)[6]; /* per port: input, output, mean displacement and rotation */
   PetscReal          beta[3]; /* body force density at the evaluated time */
   PetscReal          power_ext, t_eval;
@@ -63,6 +65,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscOptionsEnd();
   r->type = (PhlexReductionType)type;
   PetscCheck(r->nmodes >= 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_modes must be >= 0, got %" PetscInt_FMT, part->name, part->prefix, r->nmodes);
+  PetscCheck(b->floating || b->frame_patch[0], part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced fixed body needs the clamp of its frame (-%sframe_patch <surface>): a free fixed body has no reduced model", part->name, part->prefix);
   PetscCheck(!b->stiffening && !b->spinning, part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced body has no %s (its basis is that of the linear body at rest, and the stiffening would need the stress of every basis pair): use the full body (-%stype flexible)", part->name, b->stiffening ? "geometric stiffening (-geometric_stiffening)" : "prescribed spin (-spin)", part->prefix);
   {
     /* the elastic initial state is the basis's: a reduced body starts undeformed, its frame placed and moving as given */
@@ -162,6 +165,26 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   r->frame.inertia    = r->md.inertia;
   r->frame.gravity    = part->gravity;
   PetscCall(PetscCalloc3(3 * PHLEX_FRAME_NIN * m, &r->Mom, m, &r->gext, m, &r->work));
+  PetscCall(PetscCalloc2(m, &r->etad, m, &r->zetad));
+  if (r->floating) PetscCall(PetscCalloc3(54 * PHLEX_FRAME_NIN, &r->Lb, 54 * PHLEX_FRAME_NIN, &r->Lu, 54 * PHLEX_FRAME_NIN, &r->Lv));
+  PetscFunctionReturn(0);
+}
+
+/* one line of frequencies [Hz] from non-dimensional eigenvalues (written at once: the viewer indents each call) */
+static PetscErrorCode ViewFrequencies(PetscViewer viewer, const char what[], PetscInt n, const PetscReal *lambda, const PhlexUnits *u)
+{
+  char  *line;
+  size_t len = 128 + 16 * (size_t)n, k;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(len, &line));
+  PetscCall(PetscStrcpy(line, what));
+  for (PetscInt i = 0; i < n; i++) {
+    PetscCall(PetscStrlen(line, &k));
+    PetscCall(PetscSNPrintf(line + k, len - k, " %.6g", (double)(PetscSqrtReal(PetscMax(lambda[i], 0.0)) / (2 * PETSC_PI * u->time))));
+  }
+  PetscCall(PetscViewerASCIIPrintf(viewer, "%s\n", line));
+  PetscCall(PetscFree(line));
   PetscFunctionReturn(0);
 }
 
@@ -177,12 +200,8 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PhlexPartView(r->full, viewer));
   PetscCall(PetscViewerASCIIPopTab(viewer));
-  PetscCall(PetscViewerASCIIPrintf(viewer, "reduced frequencies [Hz]:"));
-  for (PetscInt k = 0; k < r->m; k++) PetscCall(PetscViewerASCIIPrintf(viewer, " %.6g", (double)(PetscSqrtReal(PetscMax(r->md.lambda[k], 0.0)) / (2 * PETSC_PI * u->time))));
-  PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
-  PetscCall(PetscViewerASCIIPrintf(viewer, "full body's frequencies of the normal modes in the basis [Hz]:"));
-  for (PetscInt k = 0; k < r->md.nnormal; k++) PetscCall(PetscViewerASCIIPrintf(viewer, " %.6g", (double)(PetscSqrtReal(PetscMax(r->md.lambda_full[k], 0.0)) / (2 * PETSC_PI * u->time))));
-  PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
+  PetscCall(ViewFrequencies(viewer, "reduced frequencies [Hz]:", r->m, r->md.lambda, u));
+  PetscCall(ViewFrequencies(viewer, "full body's frequencies of the normal modes in the basis [Hz]:", r->md.nnormal, r->md.lambda_full, u));
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscFunctionReturn(0);
 }
@@ -195,6 +214,8 @@ static PetscErrorCode ReducedDestroy(PhlexPart part)
   PetscCall(PhlexPartDestroy(&r->full));
   if (r->m) PetscCall(PhlexReducedModelDestroy(&r->md));
   PetscCall(PetscFree3(r->Mom, r->gext, r->work));
+  PetscCall(PetscFree2(r->etad, r->zetad));
+  PetscCall(PetscFree3(r->Lb, r->Lu, r->Lv));
   PetscCall(PetscFree3(r->port_ext, r->port_y, r->port_ub));
   PetscCall(PetscFree(part->data));
   PetscFunctionReturn(0);
@@ -326,11 +347,11 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
   const PetscInt    m = r->m;
   const PetscReal   T = u->time, *eta = X->q + r->ie, *zeta = X->q + r->iz;
   PhlexFrameState  *f = &r->fs;
-  PetscReal        *etad, *zetad, qd[18];
+  PetscReal        *etad = r->etad, *zetad = r->zetad, qd[18];
 
   PetscFunctionBeginUser;
   r->t_eval = t;
-  PetscCall(PetscCalloc2(m, &etad, m, &zetad));
+  for (PetscInt k = 0; k < m; k++) etad[k] = zetad[k] = 0.0;
   if (Xdot)
     for (PetscInt k = 0; k < m; k++) {
       etad[k]  = T * Xdot->q[r->ie + k];
@@ -354,7 +375,6 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
   /* the external inputs: generalized forces on the field, resultant about P on the frame, their power */
   for (PetscInt k = 0; k < m; k++) r->gext[k] = 0.0;
   for (PetscInt k = 0; k < 3; k++) f->Fext[k] = f->Mext[k] = 0.0;
-  r->power_ext = 0.0;
   for (PetscInt q = 0; q < r->nports; q++) {
     PetscReal *w = r->port_ext[q], arm[3], a[3];
     PetscCall(PhlexPortLoadEvaluate(&b->ports[q].load, t, u, r->floating ? f->R : NULL, w));
@@ -370,33 +390,12 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
       }
     }
   }
-  if (r->floating && b->frame_loaded) {
-    PetscReal fr;
-    PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
-    for (PetscInt k = 0; k < 3; k++) {
-      f->Fext[k] += fr * b->frame_force[k] / u->force;
-      f->Mext[k] += fr * b->frame_moment[k] / (u->force * u->length);
-    }
-  }
   for (PetscInt c = 0; c < 3; c++) r->beta[c] = 0.0;
   if (b->has_body_force) {
     PetscReal fr;
     PetscCall(PhlexProfileEvaluate(b->body_force_profile, t, &fr));
     for (PetscInt c = 0; c < 3; c++) r->beta[c] = fr * b->body_force[c] * u->length / u->modulus;
     for (PetscInt k = 0; k < m; k++) r->gext[k] += PhlexDot3(r->md.Svol + 3 * k, r->beta);
-    if (r->floating) {
-      PetscReal arm[3], a[3];
-      for (PetscInt c = 0; c < 3; c++) {
-        arm[c] = r->md.inertia.svol[c];
-        if (r->full_inertia)
-          for (PetscInt k = 0; k < m; k++) arm[c] += r->md.Svol[3 * k + c] * eta[k];
-      }
-      PhlexCross(arm, r->beta, a);
-      for (PetscInt k = 0; k < 3; k++) {
-        f->Fext[k] += r->md.inertia.vol * r->beta[k];
-        f->Mext[k] += a[k];
-      }
-    }
   }
   if (!r->floating)
     for (PetscInt k = 0; k < m; k++) r->gext[k] += PhlexDot3(r->md.S + 3 * k, part->gravity); /* the weight of a fixed body */
@@ -418,7 +417,9 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
       }
     }
   }
-  /* the inputs' power: the ports' w . y, the frame wrench, the body force */
+  /* the inputs' power: the ports' w . y (their share of the frame's motion included), the body force on the field,
+     and on a floating frame the frame wrench and the body force's resultant (both in Fext, Mext from here on) */
+  r->power_ext = 0.0;
   for (PetscInt q = 0; q < r->nports; q++)
     if (b->ports[q].load.loaded)
       for (PetscInt d = 0; d < 6; d++) r->power_ext += r->port_ext[q][d] * r->port_y[q][d];
@@ -426,16 +427,16 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
     for (PetscInt k = 0; k < m; k++) r->power_ext += PhlexDot3(r->md.Svol + 3 * k, r->beta) * zeta[k];
   if (r->floating) {
     PetscReal Fb[3] = {0, 0, 0}, Mb[3] = {0, 0, 0};
-    /* the frame's share of the port inputs is in their w . y: the frame wrench and the body force's resultant only */
     if (b->frame_loaded) {
       PetscReal fr;
       PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
       for (PetscInt k = 0; k < 3; k++) {
-        Fb[k] += fr * b->frame_force[k] / u->force;
-        Mb[k] += fr * b->frame_moment[k] / (u->force * u->length);
+        Fb[k] = fr * b->frame_force[k] / u->force;
+        Mb[k] = fr * b->frame_moment[k] / (u->force * u->length);
       }
     }
     if (b->has_body_force) {
+      /* its resultant vol beta at P and its moment (int x + [full] int u) x beta */
       PetscReal arm[3], a[3];
       for (PetscInt c = 0; c < 3; c++) {
         arm[c] = r->md.inertia.svol[c];
@@ -449,8 +450,11 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
       }
     }
     r->power_ext += PhlexDot3(Fb, f->vP) + PhlexDot3(Mb, f->w);
+    for (PetscInt k = 0; k < 3; k++) {
+      f->Fext[k] += Fb[k];
+      f->Mext[k] += Mb[k];
+    }
   }
-  PetscCall(PetscFree2(etad, zetad));
   PetscFunctionReturn(0);
 }
 
@@ -510,8 +514,7 @@ static PetscErrorCode ReducedJacobian(PhlexPart part, PetscReal shift, const Phl
 #define Dq(i, j) D[ld * (i) + (j)]
   PetscFunctionBeginUser;
   if (r->floating) {
-    PetscReal *Lb, *Lu, *Lv, Arr[324];
-    PetscCall(PetscCalloc3(54 * nin, &Lb, 54 * nin, &Lu, 54 * nin, &Lv));
+    PetscReal *Lb = r->Lb, *Lu = r->Lu, *Lv = r->Lv, Arr[324];
     PetscCall(PhlexFrameJacobian(&r->frame, &r->fs, shift, Lb, Lu, Lv, nin, Bvv, Bvu, Arr));
     for (PetscInt i = 0; i < 18; i++)
       for (PetscInt j = 0; j < 18; j++) Dq(i, j) = Arr[18 * i + j];
@@ -523,7 +526,6 @@ static PetscErrorCode ReducedJacobian(PhlexPart part, PetscReal shift, const Phl
         Dq(iz + k, j) = Contract(Lb, j, Mom);
       }
     }
-    PetscCall(PetscFree3(Lb, Lu, Lv));
     if (r->full_inertia) {
       /* the arms of the forces move with the ports' mean displacements (and the body force's with int u) */
       for (PetscInt q = 0; q < r->nports; q++) {
@@ -700,7 +702,8 @@ static PetscErrorCode ReducedEnergy(PhlexPart part, const PhlexPartVec *X, Petsc
   if (r->floating) PetscCall(PhlexFrameEnergy(&r->frame, &r->fs, vMv, kin, pot));
   else {
     *kin = 0.5 * vMv;
-    *pot = 0.0;
+    /* V = -g . int rho (x + u), as the full body's */
+    *pot = -PhlexDot3(part->gravity, r->md.inertia.s0);
     for (PetscInt k = 0; k < m; k++) *pot -= PhlexDot3(r->md.S + 3 * k, part->gravity) * eta[k];
   }
   PetscFunctionReturn(0);
@@ -732,34 +735,28 @@ static PetscErrorCode ReducedOutputOpen(PhlexPart part, PhlexOutput out, PetscBo
   Reduced      *r = (Reduced *)part->data;
   PhlexFlexible b = r->fb;
   char          name[PHLEX_NAME_LEN + 16], header[1024];
-  const size_t  len = (size_t)((r->nports + 1) * 15 + 2 * r->m + 1) * (PHLEX_NAME_LEN + 8);
+  const size_t  len = (size_t)(2 * r->m + 1) * 16;
   char         *h;
   size_t        n;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(len, &h));
   if (r->nports || r->floating) {
-    /* the same series as the full body's: the frame first (its patch, or "frame" with mean axes), then the ports */
-    PetscCall(PetscStrcpy(h, "time"));
-    for (PetscInt p = r->floating ? -1 : 0; p < r->nports; p++) {
-      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      PetscCall(PetscStrlen(h, &n));
-      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn));
-    }
-    for (PetscInt p = r->floating ? -1 : 0; p < r->nports; p++) {
-      const char *pn = p >= 0 ? b->ports[p].name : (b->frame_patch[0] ? b->frame_patch : "frame");
-      PetscCall(PetscStrlen(h, &n));
-      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_x,%s_y,%s_z", pn, pn, pn));
-    }
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part->name));
-    PetscCall(PhlexOutputCSVOpen(out, name, h, &r->ports_csv));
+    /* the full body's series: the frame first (its patch, or "frame" with mean axes), then the ports */
+    const char **names;
+    PetscInt     k = 0;
+    PetscCall(PetscMalloc1(r->nports + 1, &names));
+    if (r->floating) names[k++] = b->frame_patch[0] ? b->frame_patch : "frame";
+    for (PetscInt p = 0; p < r->nports; p++) names[k++] = b->ports[p].name;
+    PetscCall(PhlexPortSeriesOpen(out, part->name, k, names, &r->ports_csv));
+    PetscCall(PetscFree(names));
   }
   if (r->floating) {
     PetscCall(PhlexFrameWriteHeader(header, sizeof(header)));
     PetscCall(PetscSNPrintf(name, sizeof(name), "%s_rigid.csv", part->name));
     PetscCall(PhlexOutputCSVOpen(out, name, header, &r->rigid_csv));
   }
-  /* the elastic coordinates and their velocities (non-dimensional shapes: u = sum_k eta_k phi_k, in m) */
+  /* the elastic coordinates and their velocities (u = sum_k eta_k phi_k: eta in m, zeta in m/s) */
+  PetscCall(PetscMalloc1(len, &h));
   PetscCall(PetscStrcpy(h, "time"));
   for (PetscInt k = 0; k < r->m; k++) {
     PetscCall(PetscStrlen(h, &n));
@@ -789,25 +786,21 @@ static PetscErrorCode ReducedOutputStep(PhlexPart part, PetscInt step, PetscReal
     PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
     if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
     if (r->floating) {
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_force[c])));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(fr * b->frame_moment[c])));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->fs.vP[c] * u->velocity)));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->fs.w[c] / u->time)));
+      const PetscReal wf[6] = {fr * b->frame_force[0], fr * b->frame_force[1], fr * b->frame_force[2], fr * b->frame_moment[0], fr * b->frame_moment[1], fr * b->frame_moment[2]};
+      const PetscReal yf[6] = {r->fs.vP[0], r->fs.vP[1], r->fs.vP[2], r->fs.w[0], r->fs.w[1], r->fs.w[2]};
+      PetscCall(PhlexPortSeriesEntry(csv, u, wf, PETSC_TRUE, yf));
     }
     for (PetscInt p = 0; p < r->nports; p++) {
       PetscReal in[6];
       PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, r->floating ? r->fs.R : NULL, in));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force)));
-      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(in[c] * u->force * u->length)));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->port_y[p][c] * u->velocity)));
-      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(r->port_y[p][c] / u->time)));
+      PetscCall(PhlexPortSeriesEntry(csv, u, in, PETSC_FALSE, r->port_y[p]));
     }
     for (PetscInt p = r->floating ? -1 : 0; p < r->nports; p++) {
       PetscReal x[3], R[9];
       if (p >= 0) PetscCall(ReducedPortPlacement(part, p, X, x, R));
       else
         for (PetscInt c = 0; c < 3; c++) x[c] = r->fs.r[c];
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
+      PetscCall(PhlexPortSeriesPosition(csv, u, x));
     }
     PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
   }

@@ -169,8 +169,6 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscI
   PetscBool       floating = b->floating;
 
   PetscFunctionBeginUser;
-  PetscCheck(b->frame_patch[0] || mean_axes, b->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced fixed body needs the clamp of its frame (-%sframe_patch <surface>): a free fixed body has no reduced model", b->name, b->prefix);
-  PetscCheck(!b->stiffening && !b->spinning, b->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced body has no %s (its basis is that of the linear body at rest): use the full body (-%stype flexible)", b->name, b->stiffening ? "geometric stiffening (-geometric_stiffening)" : "prescribed spin (-spin)", b->prefix);
   /* the normal modes of the field on its own space: clamped at the frame patch (a floating body's frame patch is its
      field's Dirichlet part: the modes of the field, not those of the body with its frame), free on mean axes */
   if (!mean_axes) b->floating = PETSC_FALSE;
@@ -230,10 +228,10 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscI
 
   /* Rayleigh-Ritz: Kr = Phi^T K Phi, rotated to its eigenvectors (the reduced mass stays I) */
   {
-    PetscReal   *Kr, *w, *work2, *Q;
+    PetscReal   *Kr, *w, *work2;
     PetscBLASInt bm, lwork, info;
     Vec         *rot;
-    PetscCall(PetscMalloc4(m * m, &Kr, m, &w, 4 * m * m + 8 * m, &work2, m * m, &Q));
+    PetscCall(PetscMalloc3(m * m, &Kr, m, &w, 4 * m * m + 8 * m, &work2));
     for (PetscInt j = 0; j < m; j++) {
       PetscScalar *d;
       PetscCall(PetscMalloc1(m, &d));
@@ -265,7 +263,7 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscI
     PetscCall(PetscFree(rot));
     PetscCall(PetscMalloc1(m, &model->lambda));
     for (PetscInt k = 0; k < m; k++) model->lambda[k] = w[k];
-    PetscCall(PetscFree4(Kr, w, work2, Q));
+    PetscCall(PetscFree3(Kr, w, work2));
   }
 
   /* the projected operators and the invariants */
@@ -342,8 +340,7 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscI
     PetscCall(PetscFree(MPhi));
   }
   model->nports  = b->nports;
-  model->inertia = b->floating ? b->inertia : (PhlexInertia){0};
-  if (!b->floating) model->inertia.m = 0.0;
+  model->inertia = b->inertia; /* about P (a fixed body: about the inertial origin, its weight's potential) */
   for (PetscInt j = 0; j < m; j++) PetscCall(VecDestroy(&Phi[j]));
   PetscCall(PetscFree(Phi));
   PetscCall(VecDestroy(&work));
@@ -572,25 +569,8 @@ PetscErrorCode PhlexReducedRead(MPI_Comm comm, const char path[], const char who
   ReducedScales f;
 
   PetscFunctionBeginUser;
-  {
-    /* rank 0 tries it first, quietly: a file that is not HDF5 gets a message, not HDF5's trace */
-    PetscMPIInt rank;
-    int         ok = 1;
-    PetscCallMPI(MPI_Comm_rank(comm, &rank));
-    if (rank == 0) {
-      H5E_auto2_t func;
-      void       *data;
-      hid_t       h;
-      H5Eget_auto2(H5E_DEFAULT, &func, &data);
-      H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
-      h = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
-      if (h < 0) ok = 0;
-      else H5Fclose(h);
-      H5Eset_auto2(H5E_DEFAULT, func, data);
-    }
-    PetscCallMPI(MPI_Bcast(&ok, 1, MPI_INT, 0, comm));
-    PetscCheck(ok, comm, PETSC_ERR_USER_INPUT, "%s: the reduced body file '%s' is not an HDF5 file, or a damaged one: delete it to rebuild", who, path);
-  }
+  PetscCall(PhlexHDF5Readable(comm, path, &has));
+  PetscCheck(has, comm, PETSC_ERR_USER_INPUT, "%s: the reduced body file '%s' is not an HDF5 file, or a damaged one: delete it to rebuild", who, path);
   PetscCall(PetscViewerHDF5Open(comm, path, FILE_MODE_READ, &v));
   PetscCall(PetscViewerHDF5HasAttribute(v, "/", "phlex_reduced_body", &has));
   if (has) PetscCall(PetscViewerHDF5ReadAttribute(v, "/", "phlex_reduced_body", PETSC_INT, NULL, &version));

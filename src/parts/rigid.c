@@ -366,24 +366,11 @@ static PetscErrorCode RigidOutputOpen(PhlexPart part, PhlexOutput out, PetscBool
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_rigid.csv", part->name));
   PetscCall(PhlexOutputCSVOpen(out, name, header, &r->rigid_csv));
   if (r->nports) {
-    /* the header in one piece: a restarted run continues the series without it */
-    const size_t len = (size_t)(r->nports * 15 + 1) * (PHLEX_NAME_LEN + 8);
-    char        *h;
-    size_t       n;
-    PetscCall(PetscMalloc1(len, &h));
-    PetscCall(PetscStrcpy(h, "time"));
-    for (PetscInt p = 0; p < r->nports; p++) {
-      const char *pn = r->port_name[p];
-      PetscCall(PetscStrlen(h, &n));
-      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_Fx,%s_Fy,%s_Fz,%s_Tx,%s_Ty,%s_Tz,%s_vx,%s_vy,%s_vz,%s_wx,%s_wy,%s_wz", pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn, pn));
-    }
-    for (PetscInt p = 0; p < r->nports; p++) {
-      PetscCall(PetscStrlen(h, &n));
-      PetscCall(PetscSNPrintf(h + n, len - n, ",%s_x,%s_y,%s_z", r->port_name[p], r->port_name[p], r->port_name[p]));
-    }
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_ports.csv", part->name));
-    PetscCall(PhlexOutputCSVOpen(out, name, h, &r->ports_csv));
-    PetscCall(PetscFree(h));
+    const char **names;
+    PetscCall(PetscMalloc1(r->nports, &names));
+    for (PetscInt p = 0; p < r->nports; p++) names[p] = r->port_name[p];
+    PetscCall(PhlexPortSeriesOpen(out, part->name, r->nports, names, &r->ports_csv));
+    PetscCall(PetscFree(names));
   }
   PetscFunctionReturn(0);
 }
@@ -403,15 +390,12 @@ static PetscErrorCode RigidOutputStep(PhlexPart part, PetscInt step, PetscReal t
       PetscReal in[6], y[6];
       PetscCall(PhlexPortLoadEvaluate(&r->load[p], t, u, r->fs.R, in)); /* body frame */
       PetscCall(RigidPortOutput(part, p, y));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(in[c] * u->force)));
-      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(in[c] * u->force * u->length)));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(y[c] * u->velocity)));
-      for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(y[c] / u->time)));
+      PetscCall(PhlexPortSeriesEntry(r->ports_csv, u, in, PETSC_FALSE, y));
     }
     for (PetscInt p = 0; p < r->nports; p++) {
       PetscReal x[3], R[9];
       PetscCall((*part->ops.portplacement)(part, p, X, x, R));
-      for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(r->ports_csv, ",%.12e", (double)(x[c] * u->length)));
+      PetscCall(PhlexPortSeriesPosition(r->ports_csv, u, x));
     }
     PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "\n"));
   }

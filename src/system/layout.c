@@ -53,7 +53,8 @@ static PetscErrorCode LayoutSub(PhlexLayout L, PetscInt n, const PetscInt fields
   s->pmat_ctx = L->pmat_ctx;
   s->refct    = 1;
   for (PetscInt i = 0; i < n; i++) {
-    PetscCheck(fields[i] >= 0 && fields[i] < L->nf, L->comm, PETSC_ERR_ARG_OUTOFRANGE, "field %" PetscInt_FMT " does not exist (the layout has %" PetscInt_FMT " fields)", fields[i], L->nf);
+    /* a field split from the solver options (a preset for scenes with field unknowns, say) */
+    PetscCheck(fields[i] >= 0 && fields[i] < L->nf, L->comm, PETSC_ERR_USER_INPUT, "the solver options split the unknowns by field %" PetscInt_FMT ", but this scene's unknowns have %" PetscInt_FMT " field%s (the first: %s): is -solver_options_file a preset for other kinds of bodies? (a scene of rigid, lumped and reduced parts only takes options/solver/rigid.opts)", fields[i], L->nf, L->nf == 1 ? "" : "s", L->names[0]);
     PetscCheck(i == 0 || fields[i] > fields[i - 1], L->comm, PETSC_ERR_ARG_WRONG, "fields of a split must be listed in increasing order");
     PetscCall(PetscStrcpy(s->names[i], L->names[fields[i]]));
     s->nlocal[i]     = L->nlocal[fields[i]];
