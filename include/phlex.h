@@ -112,7 +112,7 @@ PETSC_EXTERN PetscErrorCode PhlexPartView(PhlexPart, PetscViewer);
 PETSC_EXTERN PetscErrorCode PhlexPartDestroy(PhlexPart *);
 
 /* joint.c */
-PETSC_EXTERN PetscErrorCode PhlexJointCreate(PhlexScene, PetscInt, PhlexJoint *);
+PETSC_EXTERN PetscErrorCode PhlexJointCreate(MPI_Comm, const PhlexUnits *, PetscInt, PhlexJoint *);
 PETSC_EXTERN PetscErrorCode PhlexJointSetFromOptions(PhlexJoint);
 PETSC_EXTERN PetscErrorCode PhlexJointView(PhlexJoint, PetscViewer);
 PETSC_EXTERN PetscErrorCode PhlexJointDestroy(PhlexJoint *);

@@ -40,8 +40,9 @@ struct _p_PhlexOutput {
   PetscBool locked;     /* this run holds <dir>/.phlex.lock */
   /* checkpoints (checkpoint.c, output.c): the series and field writers a checkpoint records */
   PetscViewer *csv;                       /* per file: its CSV viewer, or NULL */
-  PetscInt     nwriters;
-  void       **writers;                   /* the field writers (PhlexFieldWriter) */
+  PetscInt     nwriters;                  /* writers of files with a state of their own (the field writers) */
+  void       **writer_ctx;
+  PetscErrorCode (**writer_save)(void *, PetscViewer); /* records writer k's state in a checkpoint */
   PetscBool    keep_tmp;                  /* a checkpoint refers to the temporary files: an error keeps them */
   PetscViewer  restart;                   /* the checkpoint a restarted run continues (HDF5, read), or NULL */
   char         restart_dir[PETSC_MAX_PATH_LEN]; /* where the interrupted run's series and field segments are */
@@ -112,10 +113,10 @@ PETSC_INTERN PetscErrorCode PhlexOutputCommit(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputAbort(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputDestroy(PhlexOutput *);
 PETSC_INTERN PetscErrorCode PhlexOutputSaveState(PhlexOutput, PetscViewer);
+PETSC_INTERN PetscErrorCode PhlexOutputAddWriter(PhlexOutput, void *, PetscErrorCode (*)(void *, PetscViewer));
 PETSC_INTERN PetscErrorCode PhlexOutputSetRestart(PhlexOutput, PetscViewer, const char[]);
 PETSC_INTERN PetscErrorCode PhlexOutputRestartCheckUsed(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputRestoreFile(PhlexOutput, const char[], const char[], PetscReal);
-PETSC_INTERN PetscErrorCode PhlexFieldWriterSaveState(PhlexFieldWriter, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterCreate(PhlexOutput, PhlexFlexible, const char[], PhlexFieldWriter *);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterBeginStep(PhlexFieldWriter, PetscReal);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterVertexField(PhlexFieldWriter, const char[], Vec, PetscReal, const PetscReal *, const PetscReal *, PetscBool);

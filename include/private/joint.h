@@ -42,7 +42,7 @@ typedef struct {
 
 struct _p_PhlexJoint {
   MPI_Comm       comm;
-  PhlexScene     scene;
+  const PhlexUnits *units; /* the scene's reference scales */
   PetscInt       index;
   char           prefix[32];
   char           name[PHLEX_NAME_LEN];
@@ -91,7 +91,7 @@ struct _p_PhlexJoint {
   PetscBool   rot_dropped; /* rotation components dropped: a side is a point mass */
 };
 
-PETSC_INTERN PetscErrorCode PhlexJointResolve(PhlexJoint);
+PETSC_INTERN PetscErrorCode PhlexJointResolve(PhlexJoint, PetscInt, const PhlexPart[], PhlexPart);
 PETSC_INTERN PetscErrorCode PhlexJointSetUp(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexJointEvaluate(PhlexJoint, PetscReal, const PetscReal *, const PetscReal *);

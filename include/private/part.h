@@ -1,6 +1,8 @@
 /* The part contract (DESIGN section 3): every part of a mechanism -- flexible FE body (fixed or floating), rigid
-   body, lumped mass, ground, later a reduced (modal) body -- implements this table of operations. The system, the
-   joints, the integrator and the outputs call parts only through it; none of them knows what kind a part is.
+   body, lumped mass, ground, reduced (modal) body -- implements a core table of operations (PhlexPartOps); a part
+   with field unknowns adds the field table (PhlexPartFieldOps), a part with analyses of its own the analysis table
+   (PhlexPartAnalysisOps), as PETSc objects compose their ops. The system, the joints, the integrator and the outputs
+   call parts only through these tables; none of them knows what kind a part is.
 
    Unknowns of a part, in the global vector (system.c):
      field blocks   u (displacement), Sigma (stress), v (velocity): distributed over all ranks, flexible bodies only;
@@ -95,7 +97,10 @@ typedef struct {
 /* the field products behind a port's linearized output: the six velocity moments and three displacement moments */
 #define PHLEX_PORT_SUMS 9
 
+/* The core table: what every part implements (NULL where noted). A part with only discrete unknowns (rigid body,
+   point mass, reduced modal body) needs nothing else. */
 typedef struct {
+  /* life cycle */
   PetscErrorCode (*setfromoptions)(PhlexPart);
   PetscErrorCode (*geometry)(PhlexPart, PhlexScaleHints *); /* read meshes, suggest scales */
   PetscErrorCode (*setup)(PhlexPart);                       /* operators, sizes, ports (part->units is set) */
@@ -104,14 +109,35 @@ typedef struct {
   /* state */
   PetscErrorCode (*prepareinitialstate)(PhlexPart); /* the heavy part of initialstate (an eigensolve), before the system's operators exist; NULL: none */
   PetscErrorCode (*initialstate)(PhlexPart, PhlexPartVec *);
-  /* split phases (split_sum.c): the system calls evaluatebegin (energybegin) of every part, with the arguments of its
-     evaluate (energy), before the evaluate (energy) of any, so that parts on different processes do their local work
-     at the same time; NULL: a part without sums over the processes */
-  PetscErrorCode (*evaluatebegin)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *);
+  PetscErrorCode (*place)(PhlexPart, const PetscReal[3], PetscReal *); /* put its port at a point (an attached part given no position); NULL: never attached */
+  /* residual and Jacobian */
   PetscErrorCode (*evaluate)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *); /* t, X, X' (or NULL: rest) */
   PetscErrorCode (*residual)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PhlexPartVec *);
   PetscErrorCode (*jacobian)(PhlexPart, PetscReal, const PhlexPartVec *, PetscReal *, PetscInt); /* shift, X, its block of the dense discrete Jacobian (row-major, leading dim) */
-  PetscErrorCode (*poststep)(PhlexPart, PetscReal *, PetscReal *);         /* its discrete unknowns after a step; largest correction */
+  PetscErrorCode (*poststep)(PhlexPart, PetscReal *, PetscReal *);         /* its discrete unknowns after a step; largest correction; NULL: none */
+  /* ports */
+  PetscErrorCode (*portoutput)(PhlexPart, PetscInt, PetscReal[6]);                           /* y at the evaluated state */
+  PetscErrorCode (*portlinear)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal *, PetscReal[6]); /* dy for (a du, dv, dq); NULL: zero */
+  PetscErrorCode (*portforce)(PhlexPart, PetscInt, const PetscReal[6], Vec, PetscReal *);      /* += generalized force of w (fv may be NULL) */
+  PetscErrorCode (*portplacement)(PhlexPart, PetscInt, const PhlexPartVec *, PetscReal[3], PetscReal[9]); /* inertial position, orientation */
+  /* energy, inputs, outputs */
+  PetscErrorCode (*energy)(PhlexPart, const PhlexPartVec *, PetscReal *, PetscReal *, PetscReal *); /* kinetic, strain, potential at the evaluated state X */
+  PetscErrorCode (*momenta)(PhlexPart, PetscReal[3], PetscReal[3]);         /* inertial linear and angular momentum (about the origin), evaluated state; NULL: held */
+  PetscErrorCode (*inputpower)(PhlexPart, PetscReal *);                       /* power of its external inputs at the evaluated state */
+  PetscErrorCode (*rigidmass)(PhlexPart, PetscReal[36]);                      /* mass matrix of its frame motion (v_P, w), body frame; NULL: held */
+  PetscErrorCode (*outputopen)(PhlexPart, PhlexOutput, PetscBool);
+  PetscErrorCode (*outputstep)(PhlexPart, PetscInt, PetscReal, const PhlexPartVec *, PetscBool); /* series rows (step >= 0), fields if asked */
+  PetscErrorCode (*outputclose)(PhlexPart);
+} PhlexPartOps;
+
+/* The field table: a part with field unknowns (nv > 0, a finite-element body) implements all of it; NULL for every
+   other part (the system collects the parts with fields and calls this table on them only). */
+typedef struct {
+  /* split phases (border.c, system.c): the system calls evaluatebegin (energybegin) of every part with fields, with
+     the arguments of its evaluate (energy), before the evaluate (energy) of any, so that parts on different
+     processes do their local work at the same time */
+  PetscErrorCode (*evaluatebegin)(PhlexPart, PetscReal, const PhlexPartVec *, const PhlexPartVec *);
+  PetscErrorCode (*energybegin)(PhlexPart, const PhlexPartVec *);
   /* Jacobian pieces of the field blocks and of the border between fields and discrete unknowns */
   PetscErrorCode (*fieldoperators)(PhlexPart, PhlexFieldOperators *);
   PetscErrorCode (*mixedoperators)(PhlexPart, PetscBool); /* PETSC_FALSE: free what only Newton on the whole state
@@ -123,38 +149,31 @@ typedef struct {
   /* the discrete rows applied to field vectors in two phases (border.c sums every part's and joint's products over
      the processes in one reduction): this process's parts of a Cu^T x_u + Cv^T x_v, its own rows (nq values, set;
      NULL vectors are zero), and of portlinear's field products (PHLEX_PORT_SUMS values, set), then portlinear from the
-     summed products; NULL: a part without field unknowns */
+     summed products */
   PetscErrorCode (*bordermulttransposelocal)(PhlexPart, Vec, PetscReal, Vec, PetscReal *);
   PetscErrorCode (*portlinearlocal)(PhlexPart, PetscInt, Vec, PetscReal, Vec, PetscReal[PHLEX_PORT_SUMS]);
   PetscErrorCode (*portlinearsummed)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal[PHLEX_PORT_SUMS], const PetscReal *, PetscReal[6]);
   PetscErrorCode (*borderbasis)(PhlexPart, Mat *);                               /* W: state-independent span of its borders */
   PetscErrorCode (*borderrows)(PhlexPart, Mat, PetscReal *, PetscInt);           /* (Cv + Cu/shift)^T Y, nq x k column-major, ld */
   PetscErrorCode (*bordercoefficients)(PhlexPart, PetscReal *, PetscInt);        /* beta: own border columns ~ W beta (k x nq, ld) */
-  /* ports */
-  PetscErrorCode (*portoutput)(PhlexPart, PetscInt, PetscReal[6]);                           /* y at the evaluated state */
-  PetscErrorCode (*portlinear)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal *, PetscReal[6]); /* dy for (a du, dv, dq); NULL: zero */
-  PetscErrorCode (*portlinearblock)(PhlexPart, PetscInt, Mat, PetscReal, PetscReal *);         /* dy for dv = columns of Y, du = Y/shift: 6 x k */
-  PetscErrorCode (*portforce)(PhlexPart, PetscInt, const PetscReal[6], Vec, PetscReal *);      /* += generalized force of w (fv may be NULL) */
-  PetscErrorCode (*portbasiscolumn)(PhlexPart, PetscInt, PetscInt *);                          /* first of the 6 columns of W spanning its field force */
-  PetscErrorCode (*portplacement)(PhlexPart, PetscInt, const PhlexPartVec *, PetscReal[3], PetscReal[9]); /* inertial position, orientation */
-  /* energy, inputs, outputs */
-  PetscErrorCode (*energybegin)(PhlexPart, const PhlexPartVec *); /* see evaluatebegin */
-  PetscErrorCode (*energy)(PhlexPart, const PhlexPartVec *, PetscReal *, PetscReal *, PetscReal *); /* kinetic, strain, potential at the evaluated state X */
-  PetscErrorCode (*momenta)(PhlexPart, PetscReal[3], PetscReal[3]);         /* inertial linear and angular momentum (about the origin), evaluated state */
-  PetscErrorCode (*inputpower)(PhlexPart, PetscReal *);                       /* power of its external inputs at the evaluated state */
-  PetscErrorCode (*rigidmass)(PhlexPart, PetscReal[36]);                      /* mass matrix of its frame motion (v_P, w), body frame */
-  PetscErrorCode (*outputopen)(PhlexPart, PhlexOutput, PetscBool);
-  PetscErrorCode (*outputstep)(PhlexPart, PetscInt, PetscReal, const PhlexPartVec *, PetscBool); /* series rows (step >= 0), fields if asked */
-  PetscErrorCode (*outputclose)(PhlexPart);
+  PetscErrorCode (*portlinearblock)(PhlexPart, PetscInt, Mat, PetscReal, PetscReal *); /* dy for dv = columns of Y, du = Y/shift: 6 x k */
+  PetscErrorCode (*portbasiscolumn)(PhlexPart, PetscInt, PetscInt *);                  /* first of the 6 columns of W spanning its field force */
+} PhlexPartFieldOps;
+
+/* The analysis table: what the modal and linearised analyses ask of a body beyond the core (its own eigenproblem,
+   refinement, a prescribed spin); NULL for parts without, each entry may be NULL too (PhlexPartAnalysisOp). */
+typedef struct {
   PetscErrorCode (*modes)(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
   PetscErrorCode (*modesoutput)(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *, const PetscReal *); /* ..., placement: r_P (non-dimensional) and R of a floating body in an assembly, or NULL (body frame) */
   PetscErrorCode (*refine)(PhlexPart, PetscInt, PhlexPart *); /* the same part on a finer discretisation */
   PetscErrorCode (*modesorder)(PhlexPart, char[], size_t);      /* its discretisation and the order of its eigenvalues under refinement */
+  PetscErrorCode (*modeskind)(PhlexPart, char[], size_t, PetscInt *); /* "free", "clamped", ...; how many rigid-body modes it has (-1: none counted) */
   PetscErrorCode (*steadystate)(PhlexPart, PhlexPartVec *); /* its fields in the steady state of a prescribed uniform spin (NULL: at rest) */
   PetscErrorCode (*spinrate)(PhlexPart, PetscBool, PetscReal *); /* get (PETSC_FALSE) or set (PETSC_TRUE) the rate of its prescribed spin [rad/s]; -1 on get: it has none */
-  PetscErrorCode (*modeskind)(PhlexPart, char[], size_t, PetscInt *); /* "free", "clamped", ...; how many rigid-body modes it has (-1: none counted) */
-  PetscErrorCode (*place)(PhlexPart, const PetscReal[3], PetscReal *); /* put its port at a point (an attached part given no position) */
-} PhlexPartOps;
+} PhlexPartAnalysisOps;
+
+/* an entry of a part's analysis table, NULL when it has no such table or entry */
+#define PhlexPartAnalysisOp(p, op) ((p)->analysisops ? (p)->analysisops->op : NULL)
 
 struct _p_PhlexPart {
   MPI_Comm          comm;
@@ -165,7 +184,9 @@ struct _p_PhlexPart {
   char              numbering[48]; /* how its field unknowns are numbered ("rcm" or "file", and "@" a hash of where
                                       they are, PhlexFlexiblePlacement; "": no field unknowns), part of a checkpoint's
                                       fingerprint */
-  PhlexPartOps      ops;
+  PhlexPartOps          ops;
+  PhlexPartFieldOps    *fieldops;    /* NULL: no field unknowns */
+  PhlexPartAnalysisOps *analysisops; /* NULL: no analysis of its own */
   void             *data;
   PetscInt64       *process_cells; /* with -whole_bodies: the scene's count of cells per process of the bodies placed
                                       so far (a flexible body goes whole to the process with the fewest); else NULL */
@@ -201,6 +222,7 @@ struct _p_PhlexPart {
 PETSC_INTERN PetscErrorCode PhlexPartSetUpLayout(PhlexPart, PetscInt, PetscInt, PetscInt, PetscInt, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexPartSetDof(PhlexPart, PetscInt, PhlexDofKind, const char[]);
 PETSC_INTERN PetscErrorCode PhlexPartSetPorts(PhlexPart, PetscInt);
+PETSC_INTERN PetscErrorCode PhlexPartFind(PetscInt, const PhlexPart[], PhlexPart, const char[], PhlexPart *);
 PETSC_INTERN PetscErrorCode PhlexPartFindPort(PhlexPart, const char[], PetscInt *);
 PETSC_INTERN PetscErrorCode PhlexPartGetVec(PhlexPart, Vec, PetscReal *, PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexPartRestoreVec(PhlexPart, Vec, PhlexPartVec *);

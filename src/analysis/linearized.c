@@ -620,8 +620,8 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
     PhlexPart part = sys->fparts[f];
     char      kind[64];
     PetscInt  nrig = -1;
-    if (part->frame.R >= 0 || !part->ops.modeskind) continue;
-    PetscCall((*part->ops.modeskind)(part, kind, sizeof(kind), &nrig));
+    if (part->frame.R >= 0 || !PhlexPartAnalysisOp(part, modeskind)) continue;
+    PetscCall((*part->analysisops->modeskind)(part, kind, sizeof(kind), &nrig));
     if (nrig > 0) *nmech += nrig;
   }
 
@@ -930,7 +930,7 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
   }
   for (PetscInt f = 0; f < sys->nfparts; f++) {
     PhlexPart part = sys->fparts[f];
-    if (!part->ops.modesoutput) continue;
+    if (!PhlexPartAnalysisOp(part, modesoutput)) continue;
     for (PetscInt i = 0; i < s->n; i++) {
       Vec xV, xQ, xi;
       PetscCall(VecGetSubVector(s->x[i], p->isV, &xV));
@@ -957,7 +957,7 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
         for (PetscInt k = 0; k < 9; k++) place[3 + k] = sys->q[part->qoff + part->frame.R + k];
         pl = place;
       }
-      PetscCall((*part->ops.modesoutput)(part, out, s->n, s->nmech, lambda, vecs, rigid, pl));
+      PetscCall((*part->analysisops->modesoutput)(part, out, s->n, s->nmech, lambda, vecs, rigid, pl));
     }
     for (PetscInt i = 0; i < s->n; i++) PetscCall(VecDestroy(&vecs[i]));
   }
@@ -976,9 +976,9 @@ static PetscErrorCode SteadyStates(Pencil *p)
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart    part = sys->parts[i];
     PhlexPartVec pv;
-    if (!part->ops.steadystate) continue;
+    if (!PhlexPartAnalysisOp(part, steadystate)) continue;
     PetscCall(PhlexSystemPartVec(sys, part, p->X, sys->q, &pv));
-    PetscCall((*part->ops.steadystate)(part, &pv));
+    PetscCall((*part->analysisops->steadystate)(part, &pv));
     PetscCall(PhlexSystemPartVecRestore(sys, part, p->X, &pv));
   }
   PetscFunctionReturn(0);
@@ -992,7 +992,7 @@ static PetscErrorCode SpinningPart(PhlexSystem sys, PhlexPart *spun, PetscInt *n
   *nspun = 0;
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PetscReal rate = -1;
-    if (sys->parts[i]->ops.spinrate) PetscCall((*sys->parts[i]->ops.spinrate)(sys->parts[i], PETSC_FALSE, &rate));
+    if (PhlexPartAnalysisOp(sys->parts[i], spinrate)) PetscCall((*sys->parts[i]->analysisops->spinrate)(sys->parts[i], PETSC_FALSE, &rate));
     if (rate >= 0) *spun = sys->parts[i], (*nspun)++;
   }
   PetscFunctionReturn(0);
@@ -1064,7 +1064,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   {
     PetscBool flexible = PETSC_FALSE;
     for (PetscInt k = 0; k < scene->nparts; k++)
-      if (scene->parts[k]->ops.modes) flexible = PETSC_TRUE;
+      if (PhlexPartAnalysisOp(scene->parts[k], modes)) flexible = PETSC_TRUE;
     PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body; rigid bodies and point masses on joints have no elastic modes about rest");
   }
   PetscCall(PetscMemzero(&p, sizeof(p)));
@@ -1081,7 +1081,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(SpinningPart(p.sys, &spun, &nspun));
   if (o.nspins) {
     PetscCheck(nspun == 1, scene->comm, PETSC_ERR_USER_INPUT, "-linearized_spin_sweep: sweeps the rate of the body with -<body>_spin; the scene has %" PetscInt_FMT " such bodies", nspun);
-    PetscCall((*spun->ops.spinrate)(spun, PETSC_TRUE, &o.spins[0]));
+    PetscCall((*spun->analysisops->spinrate)(spun, PETSC_TRUE, &o.spins[0]));
   }
   PetscCall(SteadyStates(&p));
   PetscCall(CheckEquilibrium(&p));
@@ -1108,7 +1108,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   if (spun) {
     char      w[32];
     PetscReal rate;
-    PetscCall((*spun->ops.spinrate)(spun, PETSC_FALSE, &rate));
+    PetscCall((*spun->analysisops->spinrate)(spun, PETSC_FALSE, &rate));
     PhlexFormatReal(rate, w, sizeof(w));
     PetscCall(PetscPrintf(scene->comm, "Linearised analysis about the steady spin of body %s (%s rad/s%s; Coriolis coupling %s): %" PetscInt_FMT " configuration%s", spun->name, w, o.nspins > 1 ? " first" : "", pep ? "kept, quadratic eigenproblem" : (p.Gyr ? "left out" : "none"), nconfig, nconfig == 1 ? "" : "s"));
     if (o.nspins > 1) {
@@ -1140,7 +1140,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   for (PetscInt c = 0; c < nconfig; c++) {
     PetscReal pos = o.nvalues ? o.values[c] : (o.nspins ? o.spins[c] : here / unit);
     const PetscBool shapes = (PetscBool)(c == o.fields_configuration && scene->output->fields);
-    if (spun && !o.nspins && !joint) PetscCall((*spun->ops.spinrate)(spun, PETSC_FALSE, &pos)); /* the scene's spin rate */
+    if (spun && !o.nspins && !joint) PetscCall((*spun->analysisops->spinrate)(spun, PETSC_FALSE, &pos)); /* the scene's spin rate */
     PetscInt        nmech;
     Spectrum        s;
     PetscCall(PetscTime(&t0));
@@ -1152,7 +1152,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     }
     if (o.nspins && c > 0) {
       /* the next spin rate: its steady state from the previous one, and the field operators about it */
-      PetscCall((*spun->ops.spinrate)(spun, PETSC_TRUE, &o.spins[c]));
+      PetscCall((*spun->analysisops->spinrate)(spun, PETSC_TRUE, &o.spins[c]));
       PetscCall(SteadyStates(&p));
       PetscCall(CheckEquilibrium(&p));
       PetscCall(BuildFieldOperators(&p));

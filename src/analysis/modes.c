@@ -76,8 +76,8 @@ static PetscErrorCode ConvergenceStudy(PhlexScene scene, PhlexPart part, PetscIn
     PhlexPart  r;
     PetscInt   nconv, nrigid;
     PetscReal *lr;
-    PetscCall((*part->ops.refine)(part, l, &r));
-    PetscCall((*r->ops.modes)(r, nmodes, &nconv, &nrigid, &lr, NULL, NULL, NULL));
+    PetscCall((*part->analysisops->refine)(part, l, &r));
+    PetscCall((*r->analysisops->modes)(r, nmodes, &nconv, &nrigid, &lr, NULL, NULL, NULL));
     PetscCheck(nconv - nrigid >= nmodes, scene->comm, PETSC_ERR_NOT_CONVERGED, "convergence study: only %" PetscInt_FMT " modes on refinement level %" PetscInt_FMT, nconv - nrigid, l);
     for (PetscInt m = 0; m < nmodes; m++) lam[l * nmodes + m] = lr[nrigid + m];
     PetscCall(PetscFree(lr));
@@ -85,7 +85,7 @@ static PetscErrorCode ConvergenceStudy(PhlexScene scene, PhlexPart part, PetscIn
   }
   {
     char what[128] = "";
-    if (part->ops.modesorder) PetscCall((*part->ops.modesorder)(part, what, sizeof(what)));
+    if (PhlexPartAnalysisOp(part, modesorder)) PetscCall((*part->analysisops->modesorder)(part, what, sizeof(what)));
     PetscCall(PetscPrintf(scene->comm, "Convergence under uniform refinement (%s):\n  mode", what));
   }
   for (PetscInt l = 0; l <= nlevels; l++) PetscCall(PetscPrintf(scene->comm, "   level %" PetscInt_FMT " [Hz]", l));
@@ -160,12 +160,12 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     PetscCheck(!check, scene->comm, PETSC_ERR_USER_INPUT, "-phlex_check_stress_maps checks the stress maps of a transient or linearised analysis; a modal analysis (stiffness and mass only) does not build them");
   }
   for (PetscInt k = 0; k < scene->nparts; k++)
-    if (scene->parts[k]->ops.modes) nbodies++;
+    if (PhlexPartAnalysisOp(scene->parts[k], modes)) nbodies++;
   PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible body)");
   for (PetscInt k = 0; k < scene->nparts; k++) {
     PhlexPart p    = scene->parts[k];
     PetscReal rate = -1;
-    if (p->ops.spinrate) PetscCall((*p->ops.spinrate)(p, PETSC_FALSE, &rate));
+    if (PhlexPartAnalysisOp(p, spinrate)) PetscCall((*p->analysisops->spinrate)(p, PETSC_FALSE, &rate));
     /* the body's modes about rest would silently ignore its spin */
     PetscCheck(rate < 0, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: body %s spins (-%sspin, %g rad/s); its modes about the steady spin are the linearised analysis's (-analysis linearized)", p->name, p->prefix, (double)rate);
   }
@@ -180,14 +180,14 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     char       kind[64];
     PetscBool  shapes; /* the mode shapes are written: the caller's copies of the eigenvectors are needed (else the
                           eigensolver's are read only for the residuals) */
-    if (!part->ops.modes) continue;
-    shapes = (PetscBool)(scene->output->fields && part->ops.modesoutput);
+    if (!PhlexPartAnalysisOp(part, modes)) continue;
+    shapes = (PetscBool)(scene->output->fields && PhlexPartAnalysisOp(part, modesoutput));
     PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
-    PetscCall((*part->ops.modes)(part, nev, &nconv, &nrigid, &lambda, shapes ? &vecs : NULL, shapes ? &rigid : NULL, &resid));
+    PetscCall((*part->analysisops->modes)(part, nev, &nconv, &nrigid, &lambda, shapes ? &vecs : NULL, shapes ? &rigid : NULL, &resid));
     PetscCall(PetscLogStagePop());
     PetscCall(PetscMalloc1(nconv, &freq));
     for (PetscInt i = 0; i < nconv; i++) freq[i] = Frequency(lambda[i], &scene->units);
-    PetscCall((*part->ops.modeskind)(part, kind, sizeof(kind), &nrigid_expected));
+    PetscCall((*part->analysisops->modeskind)(part, kind, sizeof(kind), &nrigid_expected));
     PetscCall(PetscPrintf(scene->comm, "Modes of body %s (%s): %" PetscInt_FMT " computed", part->name, kind, nconv));
     if (nrigid_expected >= 0) PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " rigid-body modes", nrigid));
     PetscCall(PetscPrintf(scene->comm, "\n  mode  frequency [Hz]       kind     rel. residual\n"));
@@ -200,7 +200,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
       const PetscReal lam = lambda[i] / PetscSqr(scene->units.time);
       PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d,%s\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0, part->name));
     }
-    if (shapes) PetscCall((*part->ops.modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid, NULL));
+    if (shapes) PetscCall((*part->analysisops->modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid, NULL));
     if (o.nrefine > 0) PetscCall(ConvergenceStudy(scene, part, o.nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid, o.order_expect, o.order_tol));
     if (nexp) {
       nfexp = nconv - nrigid;

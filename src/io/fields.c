@@ -93,17 +93,15 @@ static PetscErrorCode RestoreState(PhlexFieldWriter w)
   PetscFunctionReturn(0);
 }
 
-/*@C
-  PhlexFieldWriterSaveState - for a checkpoint: closes the current segment (the snapshots written so far stay valid
-  whatever happens to the run) and records the snapshots and segments
-
-  Collective
-@*/
-PetscErrorCode PhlexFieldWriterSaveState(PhlexFieldWriter w, PetscViewer v)
+/* the writer's state for a checkpoint (registered with PhlexOutputAddWriter, called by PhlexOutputSaveState): closes
+   the current segment (the snapshots written so far stay valid whatever happens to the run) and records the
+   snapshots and segments (collective) */
+static PetscErrorCode SaveState(void *ctx, PetscViewer v)
 {
-  char       group[PETSC_MAX_PATH_LEN], list[8 * (PHLEX_NAME_LEN + 8)] = "";
-  PetscReal *buf;
-  size_t     len;
+  PhlexFieldWriter w = (PhlexFieldWriter)ctx;
+  char             group[PETSC_MAX_PATH_LEN], list[8 * (PHLEX_NAME_LEN + 8)] = "";
+  PetscReal       *buf;
+  size_t           len;
 
   PetscFunctionBeginUser;
   if (w->viewer) {
@@ -166,15 +164,7 @@ PetscErrorCode PhlexFieldWriterCreate(PhlexOutput out, PhlexFlexible body, const
   w->out  = out;
   w->body = body;
   PetscCall(PetscStrncpy(w->name, name, sizeof(w->name)));
-  {
-    void **list;
-    PetscCall(PetscMalloc1(out->nwriters + 1, &list));
-    if (out->nwriters) PetscCall(PetscArraycpy(list, out->writers, out->nwriters));
-    list[out->nwriters] = w;
-    PetscCall(PetscFree(out->writers));
-    out->writers = list;
-    out->nwriters++;
-  }
+  PetscCall(PhlexOutputAddWriter(out, w, SaveState));
   /* the HDF5 file(s) first, then the index (the order of the list of results) */
   if (out->restart) PetscCall(RestoreState(w));
   else PetscCall(OpenSegment(w));

@@ -370,7 +370,7 @@ PetscErrorCode PhlexOutputRestoreFile(PhlexOutput out, const char name[], const 
 
 /*@C
   PhlexOutputSaveState - records in a checkpoint where every series stands (flushed to disk, its length) and each
-  field writer's snapshots (PhlexFieldWriterSaveState closes its current segment); from now on an error keeps the
+  field writer's snapshots (a field writer closes its current segment); from now on an error keeps the
   temporary files, which the checkpoint continues
 
   Collective
@@ -408,7 +408,7 @@ PetscErrorCode PhlexOutputSaveState(PhlexOutput out, PetscViewer viewer)
   if (rank == 0 && !realpath(out->dir, dir)) PetscCall(PetscStrncpy(dir, out->dir, sizeof(dir)));
   PetscCallMPI(MPI_Bcast(dir, sizeof(dir), MPI_CHAR, 0, out->comm));
   PetscCall(PhlexCheckpointWriteString(viewer, "/output", "dir", dir));
-  for (PetscInt w = 0; w < out->nwriters; w++) PetscCall(PhlexFieldWriterSaveState((PhlexFieldWriter)out->writers[w], viewer));
+  for (PetscInt w = 0; w < out->nwriters; w++) PetscCall((*out->writer_save[w])(out->writer_ctx[w], viewer));
   out->keep_tmp = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
@@ -423,6 +423,32 @@ PetscErrorCode PhlexOutputRestartCheckUsed(PhlexOutput out)
 {
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < out->nrestart_csv; k++) PetscCheck(out->restart_csv_used[k], out->comm, PETSC_ERR_USER_INPUT, "the checkpoint (option -restart) has the series '%s', which this run does not write: it was written for another scene or other outputs", out->restart_csv[k]);
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputAddWriter - registers a writer of files with a state of its own (a field writer: its segments and
+  snapshots), which PhlexOutputSaveState() records in each checkpoint by calling save(ctx, viewer)
+
+  Not collective
+@*/
+PetscErrorCode PhlexOutputAddWriter(PhlexOutput out, void *ctx, PetscErrorCode (*save)(void *, PetscViewer))
+{
+  void **ctxs;
+  PetscErrorCode (**saves)(void *, PetscViewer);
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc2(out->nwriters + 1, &ctxs, out->nwriters + 1, &saves));
+  for (PetscInt w = 0; w < out->nwriters; w++) {
+    ctxs[w]  = out->writer_ctx[w];
+    saves[w] = out->writer_save[w];
+  }
+  ctxs[out->nwriters]  = ctx;
+  saves[out->nwriters] = save;
+  PetscCall(PetscFree2(out->writer_ctx, out->writer_save));
+  out->writer_ctx  = ctxs;
+  out->writer_save = saves;
+  out->nwriters++;
   PetscFunctionReturn(0);
 }
 
@@ -473,7 +499,7 @@ PetscErrorCode PhlexOutputDestroy(PhlexOutput *out)
   if (!*out) PetscFunctionReturn(0);
   Unlock(*out);
   PetscCall(PetscFree3((*out)->tmp, (*out)->final, (*out)->csv));
-  PetscCall(PetscFree((*out)->writers));
+  PetscCall(PetscFree2((*out)->writer_ctx, (*out)->writer_save));
   PetscCall(PetscFree3((*out)->restart_csv, (*out)->restart_csv_length, (*out)->restart_csv_used));
   PetscCall(PetscFree(*out));
   PetscFunctionReturn(0);

@@ -31,16 +31,8 @@ PetscErrorCode PhlexSceneCreate(MPI_Comm comm, PhlexScene *scene)
 @*/
 PetscErrorCode PhlexSceneFindPart(PhlexScene s, const char name[], PhlexPart *part)
 {
-  PetscBool same;
-
   PetscFunctionBeginUser;
-  *part = NULL;
-  PetscCall(PetscStrcmp(name, "ground", &same));
-  if (same) *part = s->ground;
-  for (PetscInt k = 0; k < s->nparts; k++) {
-    PetscCall(PetscStrcmp(s->parts[k]->name, name, &same));
-    if (same) *part = s->parts[k];
-  }
+  PetscCall(PhlexPartFind(s->nparts, s->parts, s->ground, name, part));
   PetscFunctionReturn(0);
 }
 
@@ -106,13 +98,13 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
     n = s->njoints;
     PetscCall(PetscCalloc1(PetscMax(n + nauto, 1), &s->joints));
     for (PetscInt k = 0; k < n; k++) {
-      PetscCall(PhlexJointCreate(s, k, &s->joints[k]));
+      PetscCall(PhlexJointCreate(s->comm, &s->units, k, &s->joints[k]));
       PetscCall(PhlexJointSetFromOptions(s->joints[k]));
     }
     for (PetscInt k = 0; k < s->nparts; k++) {
       PhlexJoint j;
       if (!s->parts[k]->attach[0]) continue;
-      PetscCall(PhlexJointCreate(s, s->njoints, &j));
+      PetscCall(PhlexJointCreate(s->comm, &s->units, s->njoints, &j));
       PetscCall(PetscSNPrintf(j->name, sizeof(j->name), "%s_attach", s->parts[k]->name));
       PetscCall(PetscSNPrintf(j->ports_option, sizeof(j->ports_option), "-%sattach", s->parts[k]->prefix));
       j->type = PHLEX_JOINT_SPHERICAL;
@@ -221,7 +213,7 @@ PetscErrorCode PhlexSceneSetUp(PhlexScene s)
     PetscCall((*p->ops.setup)(p));
   }
   s->ground->units = &s->units;
-  for (PetscInt k = 0; k < s->njoints; k++) PetscCall(PhlexJointResolve(s->joints[k]));
+  for (PetscInt k = 0; k < s->njoints; k++) PetscCall(PhlexJointResolve(s->joints[k], s->nparts, s->parts, s->ground));
   s->setup = PETSC_TRUE;
   PetscFunctionReturn(0);
 }

@@ -117,18 +117,19 @@ static PetscInt QIndex(PhlexPart p, PetscInt k)
 /* Creation and options                                                                                          */
 
 /*@C
-  PhlexJointCreate - creates joint number index (options prefix "joint<index>_")
+  PhlexJointCreate - creates joint number index (options prefix "joint<index>_") of a scene whose reference scales
+  are units (read when the joint is set up, filled by the scene before)
 
   Collective
 @*/
-PetscErrorCode PhlexJointCreate(PhlexScene scene, PetscInt index, PhlexJoint *joint)
+PetscErrorCode PhlexJointCreate(MPI_Comm comm, const PhlexUnits *units, PetscInt index, PhlexJoint *joint)
 {
   PhlexJoint j;
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&j));
-  j->comm      = scene->comm;
-  j->scene     = scene;
+  j->comm      = comm;
+  j->units     = units;
   j->index     = index;
   j->drive_row = -1;
   PetscCall(PetscSNPrintf(j->prefix, sizeof(j->prefix), "joint%" PetscInt_FMT "_", index));
@@ -242,16 +243,16 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
 }
 
 /* "body:port" or "ground" to a part and a port */
-static PetscErrorCode ResolveSide(PhlexJoint j, PetscInt s)
+static PetscErrorCode ResolveSide(PhlexJoint j, PetscInt s, PetscInt nparts, const PhlexPart parts[], PhlexPart ground)
 {
   PhlexJointSide *side = &j->side[s];
   char            body[PHLEX_NAME_LEN * 2], *colon;
-  PetscBool       ground;
+  PetscBool       is_ground;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscStrcmp(side->spec, "ground", &ground));
-  if (ground) {
-    side->part     = j->scene->ground;
+  PetscCall(PetscStrcmp(side->spec, "ground", &is_ground));
+  if (is_ground) {
+    side->part     = ground;
     side->port     = -1;
     side->rotation = PETSC_TRUE;
     PetscFunctionReturn(0);
@@ -260,7 +261,7 @@ static PetscErrorCode ResolveSide(PhlexJoint j, PetscInt s)
   colon = strchr(body, ':');
   PetscCheck(colon, j->comm, PETSC_ERR_USER_INPUT, "joint %s: option %s: '%s' is not body:port or ground", j->name, j->ports_option, side->spec);
   *colon = 0;
-  PetscCall(PhlexSceneFindPart(j->scene, body, &side->part));
+  PetscCall(PhlexPartFind(nparts, parts, ground, body, &side->part));
   PetscCheck(side->part, j->comm, PETSC_ERR_USER_INPUT, "joint %s: option %s: no body named '%s'", j->name, j->ports_option, body);
   PetscCall(PhlexPartFindPort(side->part, colon + 1, &side->port));
   if (side->port < 0) {
@@ -283,14 +284,15 @@ static PetscErrorCode ResolveSide(PhlexJoint j, PetscInt s)
 }
 
 /*@C
-  PhlexJointResolve - finds the joint's parts and ports (after the parts' set-up) and selects its rows
+  PhlexJointResolve - finds the joint's parts and ports among the scene's parts (after their set-up) and selects its
+  rows
 
   Collective
 @*/
-PetscErrorCode PhlexJointResolve(PhlexJoint j)
+PetscErrorCode PhlexJointResolve(PhlexJoint j, PetscInt nparts, const PhlexPart parts[], PhlexPart ground)
 {
   PetscFunctionBeginUser;
-  for (PetscInt s = 0; s < 2; s++) PetscCall(ResolveSide(j, s));
+  for (PetscInt s = 0; s < 2; s++) PetscCall(ResolveSide(j, s, nparts, parts, ground));
   PetscCheck(!(PhlexPartIsGround(j->side[0].part) && PhlexPartIsGround(j->side[1].part)), j->comm, PETSC_ERR_USER_INPUT, "joint %s: both ports are the ground (-%sports)", j->name, j->prefix);
   PetscCheck(!(j->side[0].part == j->side[1].part && j->side[0].port == j->side[1].port), j->comm, PETSC_ERR_USER_INPUT, "joint %s: a port cannot be joined to itself (-%sports %s,%s)", j->name, j->prefix, j->side[0].spec, j->side[1].spec);
   for (PetscInt s = 0; s < 2; s++)
@@ -327,7 +329,7 @@ static PetscErrorCode SidePlacement(PhlexJoint j, PetscInt s, const PhlexPartVec
 @*/
 PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb)
 {
-  const PhlexUnits   *u = &j->scene->units;
+  const PhlexUnits   *u = j->units;
   const PhlexPartVec *X[2] = {Xa, Xb};
   PetscReal           xp[2][3], Rp[2][9], Rf[2][9], xJ[3];
 
@@ -411,7 +413,7 @@ PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint j, const PhlexPartVec *Xa, co
 @*/
 PetscErrorCode PhlexJointEvaluate(PhlexJoint j, PetscReal t, const PetscReal *q, const PetscReal *qd)
 {
-  const PetscReal T = j->scene->units.time;
+  const PetscReal T = j->units->time;
   PetscReal       y[6];
 
   PetscFunctionBeginUser;
@@ -514,7 +516,7 @@ static void Relative(PhlexJoint j, PetscReal D[6])
 /* g_k(t): the prescribed relative velocity of row k (non-dimensional) */
 static PetscErrorCode Source(PhlexJoint j, PetscInt k, PetscReal t, PetscReal *g)
 {
-  const PhlexUnits *u = &j->scene->units;
+  const PhlexUnits *u = j->units;
   PetscReal         f;
 
   PetscFunctionBeginUser;
@@ -742,7 +744,7 @@ PetscErrorCode PhlexJointBorderMultTransposeLocal(PhlexJoint j, PhlexPart part, 
       for (PetscInt k = 0; k < PHLEX_PORT_SUMS; k++) ls[k] = 0.0;
       continue;
     }
-    PetscCall((*part->ops.portlinearlocal)(part, j->side[s].port, xu, au, xv, ls));
+    PetscCall((*part->fieldops->portlinearlocal)(part, j->side[s].port, xu, au, xv, ls));
   }
   PetscFunctionReturn(0);
 }
@@ -759,7 +761,7 @@ PetscErrorCode PhlexJointBorderMultTransposeSummed(PhlexJoint j, PhlexPart part,
   for (PetscInt s = 0; s < 2; s++) {
     PetscReal dy[6], rows[7];
     if (j->side[s].part != part) continue;
-    PetscCall((*part->ops.portlinearsummed)(part, j->side[s].port, xu, au, xv, sums + s * PHLEX_PORT_SUMS, NULL, dy));
+    PetscCall((*part->fieldops->portlinearsummed)(part, j->side[s].port, xu, au, xv, sums + s * PHLEX_PORT_SUMS, NULL, dy));
     PetscCall(RowsFromPortChange(j, s, dy, rows));
     for (PetscInt k = 0; k < j->nc; k++) y[j->qoff + k] += rows[k];
   }
@@ -782,7 +784,7 @@ PetscErrorCode PhlexJointBorderRows(PhlexJoint j, PhlexPart part, Mat Y, PetscRe
     PetscReal *dy;
     if (j->side[s].part != part) continue;
     PetscCall(PetscMalloc1(6 * k, &dy));
-    PetscCall((*part->ops.portlinearblock)(part, j->side[s].port, Y, shiftinv, dy));
+    PetscCall((*part->fieldops->portlinearblock)(part, j->side[s].port, Y, shiftinv, dy));
     for (PetscInt col = 0; col < k; col++) {
       PetscReal rows[7];
       PetscCall(RowsFromPortChange(j, s, dy + 6 * col, rows));
@@ -806,7 +808,7 @@ PetscErrorCode PhlexJointBorderCoefficients(PhlexJoint j, PhlexPart part, PetscR
   for (PetscInt s = 0; s < 2; s++) {
     PetscInt c0;
     if (j->side[s].part != part) continue;
-    PetscCall((*part->ops.portbasiscolumn)(part, j->side[s].port, &c0));
+    PetscCall((*part->fieldops->portbasiscolumn)(part, j->side[s].port, &c0));
     if (c0 < 0) continue; /* no field force on this port (a frame patch) */
     for (PetscInt k = 0; k < j->nc; k++) {
       PetscReal e[7] = {0, 0, 0, 0, 0, 0, 0}, wk[6], w[2][6];
@@ -861,7 +863,7 @@ PetscErrorCode PhlexJointRigidGradient(PhlexJoint j, PetscReal *G, PetscInt ld)
 @*/
 PetscErrorCode PhlexJointDrivePosition(PhlexJoint j, PetscReal t, PetscReal *x)
 {
-  const PhlexUnits *u = &j->scene->units;
+  const PhlexUnits *u = j->units;
   PetscReal         F;
 
   PetscFunctionBeginUser;
@@ -929,7 +931,7 @@ PetscErrorCode PhlexJointGap(PhlexJoint j, PetscReal t, const PhlexPartVec *Xa, 
   PhlexCross(j->frame + 6, Ee3, perp); /* the misalignment of the axis: e3 x (E e3) */
   if (j->type == PHLEX_JOINT_PRESCRIBED) {
     /* the port point and orientation against their prescribed paths x0 + v F(t), rotation vector w F(t) */
-    const PhlexUnits *u = &j->scene->units;
+    const PhlexUnits *u = j->units;
     PetscReal         F;
     PetscCall(PhlexProfileIntegrate(j->drive_profile, t, &F));
     for (PetscInt k = 0; k < 3; k++) {
@@ -1091,7 +1093,7 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
 @*/
 PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
 {
-  const PhlexUnits *u = &j->scene->units;
+  const PhlexUnits *u = j->units;
   PetscReal         wJ[6], mo[6], gap[7];
   PetscInt          nm;
 

@@ -1149,25 +1149,25 @@ static PetscErrorCode FlexBorderCoefficients(PhlexPart part, PetscReal *beta, Pe
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
 {
   PetscFunctionBeginUser;
-  part->ops.evaluatebegin       = FlexEvaluateBegin;
-  part->ops.evaluate            = FlexEvaluate;
-  part->ops.residual            = FlexResidual;
-  part->ops.jacobian            = FlexJacobian;
-  part->ops.poststep            = FlexPostStep;
-  part->ops.fieldoperators      = FlexFieldOperators;
-  part->ops.mixedoperators      = FlexMixedOperators;
-  part->ops.bordermult          = FlexBorderMult;
-  part->ops.bordermulttransposelocal = FlexBorderMultTransposeLocal;
-  part->ops.borderbasis         = FlexBorderBasis;
-  part->ops.borderrows          = FlexBorderRows;
-  part->ops.bordercoefficients  = FlexBorderCoefficients;
-  part->ops.portoutput          = FlexPortOutput;
-  part->ops.portlinear          = FlexPortLinear;
-  part->ops.portlinearlocal     = FlexPortLinearLocal;
-  part->ops.portlinearsummed    = FlexPortLinearSummed;
-  part->ops.portlinearblock     = FlexPortLinearBlock;
-  part->ops.portforce           = FlexPortForce;
-  part->ops.portbasiscolumn     = FlexPortBasisColumn;
-  part->ops.portplacement       = FlexPortPlacement;
+  part->ops.evaluate      = FlexEvaluate;
+  part->ops.residual      = FlexResidual;
+  part->ops.jacobian      = FlexJacobian;
+  part->ops.poststep      = FlexPostStep;
+  part->ops.portoutput    = FlexPortOutput;
+  part->ops.portlinear    = FlexPortLinear;
+  part->ops.portforce     = FlexPortForce;
+  part->ops.portplacement = FlexPortPlacement;
+  part->fieldops->evaluatebegin            = FlexEvaluateBegin;
+  part->fieldops->fieldoperators           = FlexFieldOperators;
+  part->fieldops->mixedoperators           = FlexMixedOperators;
+  part->fieldops->bordermult               = FlexBorderMult;
+  part->fieldops->bordermulttransposelocal = FlexBorderMultTransposeLocal;
+  part->fieldops->borderbasis              = FlexBorderBasis;
+  part->fieldops->borderrows               = FlexBorderRows;
+  part->fieldops->bordercoefficients       = FlexBorderCoefficients;
+  part->fieldops->portlinearlocal          = FlexPortLinearLocal;
+  part->fieldops->portlinearsummed         = FlexPortLinearSummed;
+  part->fieldops->portlinearblock          = FlexPortLinearBlock;
+  part->fieldops->portbasiscolumn          = FlexPortBasisColumn;
   PetscFunctionReturn(0);
 }

@@ -141,7 +141,7 @@ PetscErrorCode PhlexFlexibleSpinSetUp(PhlexFlexible b, const PhlexUnits *u)
 
 /*@C
   PhlexFlexibleSpinRate - gets or sets the rate of a body's prescribed spin about its axis [rad/s] (part contract
-  ops.spinrate: the linearised analysis sweeps it); -1 on get for a body without -spin
+  analysisops->spinrate: the linearised analysis sweeps it); -1 on get for a body without -spin
 
   Collective
 @*/

@@ -21,7 +21,8 @@ static PetscErrorCode PhlexPartFinalizePackage_Private(void)
   Not collective
 
   Notes:
-  A new kind (a reduced modal body, say) is one file implementing PhlexPartOps and one call of this function.
+  A new kind is one file implementing the core table PhlexPartOps (and, for a body with field unknowns or analyses of
+  its own, PhlexPartFieldOps or PhlexPartAnalysisOps) and one call of this function.
 @*/
 PetscErrorCode PhlexPartRegister(const char name[], PetscErrorCode (*create)(PhlexPart))
 {
@@ -120,6 +121,8 @@ PetscErrorCode PhlexPartDestroy(PhlexPart *part)
   PetscFunctionBeginUser;
   if (!p) PetscFunctionReturn(0);
   if (p->ops.destroy) PetscCall((*p->ops.destroy)(p));
+  PetscCall(PetscFree(p->fieldops));
+  PetscCall(PetscFree(p->analysisops));
   PetscCall(PetscFree2(p->qkind, p->qname));
   PetscCall(PetscFree3(p->ports, p->wrench, p->port_used));
   PetscCall(ISDestroy(&p->isu));
@@ -141,6 +144,7 @@ PetscErrorCode PhlexPartDestroy(PhlexPart *part)
 PetscErrorCode PhlexPartSetUpLayout(PhlexPart p, PetscInt nv, PetscInt Nv, PetscInt ns, PetscInt Ns, PetscInt nq)
 {
   PetscFunctionBeginUser;
+  PetscCheck(!Nv || p->fieldops, p->comm, PETSC_ERR_PLIB, "part %s of kind %s has field unknowns but no field table (PhlexPartFieldOps)", p->name, p->type);
   p->nu = p->nv = nv;
   p->Nu = p->Nv = Nv;
   p->ns         = ns;
@@ -160,6 +164,24 @@ PetscErrorCode PhlexPartSetDof(PhlexPart p, PetscInt k, PhlexDofKind kind, const
   PetscCheck(k >= 0 && k < p->nq, PETSC_COMM_SELF, PETSC_ERR_PLIB, "discrete unknown %" PetscInt_FMT " of a part with %" PetscInt_FMT, k, p->nq);
   p->qkind[k] = kind;
   PetscCall(PetscStrncpy(p->qname[k], name, sizeof(p->qname[k])));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPartFind - the part of a given name among parts (NULL if none; "ground" is the ground)
+@*/
+PetscErrorCode PhlexPartFind(PetscInt nparts, const PhlexPart parts[], PhlexPart ground, const char name[], PhlexPart *part)
+{
+  PetscBool same;
+
+  PetscFunctionBeginUser;
+  *part = NULL;
+  PetscCall(PetscStrcmp(name, "ground", &same));
+  if (same) *part = ground;
+  for (PetscInt k = 0; k < nparts; k++) {
+    PetscCall(PetscStrcmp(parts[k]->name, name, &same));
+    if (same) *part = parts[k];
+  }
   PetscFunctionReturn(0);
 }
 

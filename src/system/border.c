@@ -45,7 +45,7 @@ static PetscErrorCode MatMult_Bvq(Mat A, Vec x, Vec y)
   PetscCall(PhlexSystemGetFieldBlocks(sys, PHLEX_FIELD_VELOCITY, y, yi));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexPart p = sys->fparts[i];
-    PetscCall((*p->ops.bordermult)(p, xq + p->qoff, yi[i]));
+    PetscCall((*p->fieldops->bordermult)(p, xq + p->qoff, yi[i]));
     for (PetscInt k = 0; k < sys->njoints; k++)
       if (PhlexJointTouches(sys->joints[k], p)) PetscCall(PhlexJointBorderMult(sys->joints[k], sys->shift, xq, p, yi[i]));
   }
@@ -76,7 +76,7 @@ static PetscErrorCode BorderRowsSum(PhlexSystem sys, PetscInt i0, PetscInt i1, V
   PetscCall(PetscMalloc2(n, &loc, n, &sums));
   for (PetscInt i = i0; i < i1; i++) {
     PhlexPart p = sys->fparts[i];
-    PetscCall((*p->ops.bordermulttransposelocal)(p, u[i - i0], au, v[i - i0], loc + off));
+    PetscCall((*p->fieldops->bordermulttransposelocal)(p, u[i - i0], au, v[i - i0], loc + off));
     off += p->nq;
     for (PetscInt k = 0; k < sys->njoints; k++) {
       if (!PhlexJointTouches(sys->joints[k], p)) continue;
@@ -195,7 +195,7 @@ static PetscErrorCode BorderRows(void *ctx, PetscInt i, Mat Y, PetscReal *out)
   PetscFunctionBeginUser;
   PetscCall(MatGetSize(Y, NULL, &k));
   for (PetscInt r = 0; r < sys->nq * k; r++) out[r] = 0.0;
-  PetscCall((*p->ops.borderrows)(p, Y, out + p->qoff, sys->nq));
+  PetscCall((*p->fieldops->borderrows)(p, Y, out + p->qoff, sys->nq));
   for (PetscInt j = 0; j < sys->njoints; j++)
     if (PhlexJointTouches(sys->joints[j], p)) PetscCall(PhlexJointBorderRows(sys->joints[j], p, Y, 1.0 / sys->shift, out, sys->nq));
   PetscFunctionReturn(0);
@@ -211,7 +211,7 @@ static PetscErrorCode BorderCoefficients(void *ctx, PetscInt i, PetscReal *beta)
   PetscFunctionBeginUser;
   PetscCall(MatGetSize(sys->border.W[i], NULL, &k));
   for (PetscInt r = 0; r < sys->nq * k; r++) beta[r] = 0.0;
-  PetscCall((*p->ops.bordercoefficients)(p, beta + k * p->qoff, k));
+  PetscCall((*p->fieldops->bordercoefficients)(p, beta + k * p->qoff, k));
   for (PetscInt j = 0; j < sys->njoints; j++)
     if (PhlexJointTouches(sys->joints[j], p)) PetscCall(PhlexJointBorderCoefficients(sys->joints[j], p, sys->shift, beta, k));
   PetscFunctionReturn(0);
@@ -268,12 +268,12 @@ PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem sys)
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexPart           p = sys->fparts[i];
     PhlexFieldOperators ops;
-    PetscCall((*p->ops.fieldoperators)(p, &ops));
+    PetscCall((*p->fieldops->fieldoperators)(p, &ops));
     bd->A[i]   = ops.Sv;
     bd->off[i] = off;
     bd->n[i]   = p->nv;
     off += p->nv;
-    PetscCall((*p->ops.borderbasis)(p, &bd->W[i]));
+    PetscCall((*p->fieldops->borderbasis)(p, &bd->W[i]));
   }
   bd->qoff = off;
   PetscFunctionReturn(0);

@@ -112,7 +112,7 @@ PetscErrorCode PhlexSystemGetStressMaps(PhlexSystem sys, const char *who, PhlexS
   PetscCall(PetscCalloc2(sys->nfparts, &maps->B, sys->nfparts, &maps->K));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
     PetscCheck(ops.B && ops.Kc, sys->comm, PETSC_ERR_PLIB, "SNES %s: part %" PetscInt_FMT " has no cell-by-cell stress maps", who, i);
     PetscCall(PetscObjectReference((PetscObject)ops.B));
     PetscCall(PetscObjectReference((PetscObject)ops.Kc));
@@ -283,7 +283,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     Vec                 ri;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
     PetscCall(VecGetSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
     PetscCall(VecAYPX(ri, -1.0, ops.load));
     PetscCall(VecRestoreSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));

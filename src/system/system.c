@@ -186,7 +186,7 @@ PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem sys)
     PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
     PetscCall(MatNestSetSubMat(sys->J, S, V, sys->Jsv));
     for (PetscInt i = 0; i < sys->nfparts; i++)
-      if (sys->fparts[i]->ops.mixedoperators) PetscCall((*sys->fparts[i]->ops.mixedoperators)(sys->fparts[i], PETSC_FALSE));
+      if (sys->fparts[i]->fieldops->mixedoperators) PetscCall((*sys->fparts[i]->fieldops->mixedoperators)(sys->fparts[i], PETSC_FALSE));
     sys->mixed_released = PETSC_TRUE;
   }
   PetscFunctionReturn(0);
@@ -203,8 +203,8 @@ static PetscErrorCode RestoreCoupling(PhlexSystem sys)
   PetscCall(PetscMalloc1(sys->nfparts, &m));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
-    if (sys->fparts[i]->ops.mixedoperators) PetscCall((*sys->fparts[i]->ops.mixedoperators)(sys->fparts[i], PETSC_TRUE));
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    if (sys->fparts[i]->fieldops->mixedoperators) PetscCall((*sys->fparts[i]->fieldops->mixedoperators)(sys->fparts[i], PETSC_TRUE));
+    PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
     m[i] = ops.G;
   }
   PetscCall(MatDestroy(&sys->Jsv));
@@ -234,7 +234,7 @@ PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem sys)
   PetscCall(RestoreCoupling(sys));
   if (sys->Ms) PetscFunctionReturn(0);
   PetscCall(PetscMalloc2(sys->nfparts, &ops, sys->nfparts, &m));
-  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops[i]));
+  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops[i]));
   PetscCall(AssembleStressBlock(sys, ops, &sys->Ms));
   PetscCall(MatDestroy(&sys->Jss));
   PetscCall(MatDuplicate(sys->Ms, MAT_COPY_VALUES, &sys->Jss));
@@ -308,12 +308,12 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
     for (PetscInt side = 0; side < 2; side++) {
       PhlexPart p    = sys->joints[k]->side[side].part;
       PetscReal rate = -1.0;
-      if (p && p->ops.spinrate) PetscCall((*p->ops.spinrate)(p, PETSC_FALSE, &rate));
+      if (p && PhlexPartAnalysisOp(p, spinrate)) PetscCall((*p->analysisops->spinrate)(p, PETSC_FALSE, &rate));
       PetscCheck(rate < 0, sys->comm, PETSC_ERR_USER_INPUT, "joint %s: body %s turns on a prescribed spin (-%sspin), in its own rotating frame; it cannot be jointed to other parts (model the hub as a driven revolute joint and the body as floating)", sys->joints[k]->name, p->name, p->prefix);
     }
   PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &ops));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops[i]));
+    PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops[i]));
     nlocal[PHLEX_FIELD_DISPLACEMENT] += sys->fparts[i]->nu;
     nlocal[PHLEX_FIELD_STRESS] += sys->fparts[i]->ns;
     nlocal[PHLEX_FIELD_VELOCITY] += sys->fparts[i]->nv;
@@ -618,7 +618,7 @@ static PetscErrorCode EvaluateAll(PhlexSystem sys, PetscReal t, Vec X, Vec Xdot,
   /* every part's local work first, then the sums (split_sum.c): bodies whole on different processes in parallel */
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
-    if (p->ops.evaluatebegin) PetscCall((*p->ops.evaluatebegin)(p, t, &pX[i], Xdot ? &pXd[i] : NULL));
+    if (p->fieldops) PetscCall((*p->fieldops->evaluatebegin)(p, t, &pX[i], Xdot ? &pXd[i] : NULL));
   }
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
@@ -764,7 +764,7 @@ PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, PetscInt which, Mat
   PetscCall(PetscMalloc1(PetscMax(sys->nfparts, 1), &m));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
-    PetscCall((*sys->fparts[i]->ops.fieldoperators)(sys->fparts[i], &ops));
+    PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
     m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : (which == 2 ? ops.K : (which == 3 ? ops.Kstate : ops.Gyro)));
   }
   PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, N));
@@ -923,7 +923,7 @@ PetscErrorCode PhlexSystemEnergy(PhlexSystem sys, PetscReal t, Vec X, PetscReal 
   /* every part's local sums first, then their reductions (split_sum.c) */
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
-    if (p->ops.energybegin) PetscCall((*p->ops.energybegin)(p, &pv[i]));
+    if (p->fieldops) PetscCall((*p->fieldops->energybegin)(p, &pv[i]));
   }
   for (PetscInt i = 0; i < sys->nparts; i++) {
     PhlexPart p = sys->parts[i];
