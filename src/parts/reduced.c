@@ -247,7 +247,7 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
   const PhlexUnits *u = part->units;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " normal modes and the attachment modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " %s modes and the %s modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "fixed-interface" : "normal", r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "constraint" : "attachment", r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PetscViewerASCIIPrintf(viewer, "the full body it reduces:\n"));
   PetscCall(PetscViewerASCIIPushTab(viewer));
