@@ -6,9 +6,13 @@
 #define PHLEX_PRIVATE_REDUCED_H
 
 typedef enum {
-  PHLEX_REDUCTION_FREE_INTERFACE /* the body's own normal modes (clamped at its frame patch, or free on mean axes)
-                                    plus the static attachment modes of its ports */
+  PHLEX_REDUCTION_FREE_INTERFACE, /* the body's own normal modes (clamped at its frame patch, or free on mean axes)
+                                     plus the static attachment modes of its ports */
+  PHLEX_REDUCTION_CRAIG_BAMPTON   /* the fixed-interface normal modes (frame patch clamped and every listed port's six
+                                     rigid-average motions held, B_q^T u = 0) plus the static constraint modes of the
+                                     ports (unit rigid-average motion of one, the others held, least strain energy) */
 } PhlexReductionType;
+#define PHLEX_REDUCTION_NTYPES 2
 PETSC_EXTERN const char *const PhlexReductionTypes[];
 
 typedef struct {
@@ -22,7 +26,8 @@ typedef struct {
   PetscReal *Svol;     /* 3 m: int phi_k (uniform body forces) */
   PetscReal *P;        /* 6 m per port: its output map B_q^T Phi, row d (translation 0-2, rotation 3-5) at 6 m q + m d + k */
   PetscReal *lambda;   /* the reduced eigenvalues (diagonal of Kr) */
-  PetscReal *lambda_full; /* nnormal: the full body's eigenvalues of the normal modes in the basis */
+  PetscReal *lambda_full; /* nnormal: the full body's eigenvalues of the normal modes in the basis (craig_bampton: of
+                             the body with its ports held) */
   PhlexInertia inertia; /* the whole body about P: m, s0, E0, vol, svol */
 } PhlexReducedModel;
 

@@ -38,6 +38,8 @@ typedef struct {
   PetscReal          beta[3]; /* body force density at the evaluated time */
   PetscReal          power_ext, t_eval;
   PetscViewer        rigid_csv, ports_csv, modal_csv;
+  PetscReal          expect_held[64], expect_full[64], expect_rtol; /* self-checks of the basis (-reduction_expect_*) */
+  PetscInt           nexpect_held, nexpect_full;
 } Reduced;
 
 /* ------------------------------------------------------------------------------------------------------------ */
@@ -48,6 +50,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   Reduced      *r = (Reduced *)part->data;
   PhlexFlexible b;
   PetscInt      type = 0;
+  PetscBool     set_held = PETSC_FALSE, set_full = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   /* the full body reads its options under the same prefix: the scene of a reduced body is that of the full one */
@@ -58,11 +61,18 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscCall((*r->full->ops.setfromoptions)(r->full));
   r->fb = b  = (PhlexFlexible)r->full->data;
   r->nmodes  = 10;
+  r->expect_rtol  = 1e-6;
+  r->nexpect_held = r->nexpect_full = 64;
   PetscOptionsBegin(part->comm, part->prefix, "Reduced body options", NULL);
   PetscCall(PetscOptionsString("-reduced_file", "Reduced body file (HDF5): read if it exists (refused if built for another body), else built and written; empty: built in memory at every run", "ReducedSetFromOptions", r->file, r->file, sizeof(r->file), NULL));
-  PetscCall(PetscOptionsEList("-reduction", "Basis of the reduction: free_interface (the body's normal modes with its frame held, plus the static attachment modes of its ports)", "ReducedSetFromOptions", PhlexReductionTypes, 1, PhlexReductionTypes[type], &type, NULL));
-  PetscCall(PetscOptionsInt("-reduction_modes", "Normal modes in the basis (the attachment modes of the ports, six each, come in addition)", "ReducedSetFromOptions", r->nmodes, &r->nmodes, NULL));
+  PetscCall(PetscOptionsEList("-reduction", "Basis of the reduction: free_interface (the body's normal modes with its frame held, plus the static attachment modes of its ports), craig_bampton (the normal modes with its frame and its ports' rigid averages held, plus the static constraint modes of its ports)", "ReducedSetFromOptions", PhlexReductionTypes, PHLEX_REDUCTION_NTYPES, PhlexReductionTypes[type], &type, NULL));
+  PetscCall(PetscOptionsInt("-reduction_modes", "Normal modes in the basis (craig_bampton: fixed-interface modes; the static modes of the ports, six each, come in addition)", "ReducedSetFromOptions", r->nmodes, &r->nmodes, NULL));
+  PetscCall(PetscOptionsRealArray("-reduction_expect_held_frequencies", "Self-check: the full body's frequencies with its frame and ports held [Hz] (craig_bampton: those of its fixed-interface modes, compared within -reduction_expect_rtol)", "ReducedSetFromOptions", r->expect_held, &r->nexpect_held, &set_held));
+  PetscCall(PetscOptionsRealArray("-reduction_expect_full_frequencies", "Self-check: the full body's lowest frequencies with its frame held [Hz]: the reduced ones must bound them from above (Rayleigh-Ritz), and with craig_bampton lie below the held ones, which lie below the reduced ones 6 per port further (interlacing)", "ReducedSetFromOptions", r->expect_full, &r->nexpect_full, &set_full));
+  PetscCall(PetscOptionsReal("-reduction_expect_rtol", "Relative tolerance of -reduction_expect_held_frequencies, and the slack of the bounds of -reduction_expect_full_frequencies", "ReducedSetFromOptions", r->expect_rtol, &r->expect_rtol, NULL));
   PetscOptionsEnd();
+  if (!set_held) r->nexpect_held = 0;
+  if (!set_full) r->nexpect_full = 0;
   r->type = (PhlexReductionType)type;
   PetscCheck(r->nmodes >= 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_modes must be >= 0, got %" PetscInt_FMT, part->name, part->prefix, r->nmodes);
   PetscCheck(b->floating || b->frame_patch[0], part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced fixed body needs the clamp of its frame (-%sframe_patch <surface>): a free fixed body has no reduced model", part->name, part->prefix);
@@ -87,6 +97,48 @@ static PetscErrorCode ReducedGeometry(PhlexPart part, PhlexScaleHints *h)
   /* the same scales as the full body: swapping one for the other changes nothing else in the scene */
   r->full->process_cells = part->process_cells;
   PetscCall((*r->full->ops.geometry)(r->full, h));
+  PetscFunctionReturn(0);
+}
+
+/* the self-checks of the basis: the held frequencies (-reduction_expect_held_frequencies) within a relative tolerance;
+   Rayleigh-Ritz's upper bounds of the full body's frequencies (-reduction_expect_full_frequencies), and with
+   craig_bampton the interlacing of its held (fixed-interface) frequencies between the reduced ones: the reduced space V
+   holds the fixed-interface modes, and V with the 6 p port averages held is exactly their span (a constraint mode's
+   interface values are independent), so by Cauchy's interlacing (a constraint of codimension 6 p)
+   reduced_k <= held_k <= reduced_{k + 6 p}; all with the slack -reduction_expect_rtol */
+static PetscErrorCode ReducedExpectFrequencies(PhlexPart part, Reduced *r)
+{
+  const PhlexUnits *u = part->units;
+  const PetscReal   tol = r->expect_rtol, f0 = 1.0 / (2 * PETSC_PI * u->time);
+  const PetscInt    m = r->md.m, nh = r->md.nnormal, shift = 6 * r->nports;
+  PetscReal        *fr, *fh;
+  char              what[PHLEX_NAME_LEN + 64];
+
+  PetscFunctionBeginUser;
+  if (!r->nexpect_held && !r->nexpect_full) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc2(m, &fr, PetscMax(nh, 1), &fh));
+  for (PetscInt k = 0; k < m; k++) fr[k] = PetscSqrtReal(PetscMax(r->md.lambda[k], 0.0)) * f0;
+  for (PetscInt k = 0; k < nh; k++) fh[k] = PetscSqrtReal(PetscMax(r->md.lambda_full[k], 0.0)) * f0;
+  if (r->nexpect_held) {
+    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s: held frequencies", part->name));
+    PetscCall(PhlexExpectValues(part->comm, what, "-reduction_expect_held_frequencies", nh, fh, r->nexpect_held, r->expect_held, tol));
+  }
+  if (r->nexpect_full) {
+    const PetscInt n = PetscMin(r->nexpect_full, m);
+    PetscReal      worst = 0.0;
+    for (PetscInt k = 0; k < n; k++) {
+      PetscCheck(fr[k] >= r->expect_full[k] * (1 - tol), part->comm, PETSC_ERR_USER, "body %s: reduced frequency %" PetscInt_FMT ": FAIL: %.10g Hz below the full body's %.10g Hz (Rayleigh-Ritz bounds it from above; slack %.1e, -reduction_expect_full_frequencies)", part->name, k + 1, (double)fr[k], (double)r->expect_full[k], (double)tol);
+      worst = PetscMax(worst, fr[k] / r->expect_full[k] - 1);
+    }
+    PetscCall(PetscInfo(NULL, "body %s: the first %" PetscInt_FMT " reduced frequencies exceed the full body's by %g at most (relative)\n", part->name, n, (double)worst));
+    if (r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports)
+      for (PetscInt k = 0; k < nh; k++) {
+        PetscCheck(fr[k] <= fh[k] * (1 + tol), part->comm, PETSC_ERR_USER, "body %s: FAIL: reduced frequency %" PetscInt_FMT " %.10g Hz above held frequency %" PetscInt_FMT " %.10g Hz (interlacing)", part->name, k + 1, (double)fr[k], k + 1, (double)fh[k]);
+        if (k + shift < m) PetscCheck(fh[k] <= fr[k + shift] * (1 + tol), part->comm, PETSC_ERR_USER, "body %s: FAIL: held frequency %" PetscInt_FMT " %.10g Hz above reduced frequency %" PetscInt_FMT " %.10g Hz (interlacing)", part->name, k + 1, (double)fh[k], k + shift + 1, (double)fr[k + shift]);
+      }
+    PetscCall(PetscPrintf(part->comm, "body %s: reduced frequencies: PASS (upper bounds of %" PetscInt_FMT " full frequencies%s)\n", part->name, n, r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? ", interlaced with the held ones" : ""));
+  }
+  PetscCall(PetscFree2(fr, fh));
   PetscFunctionReturn(0);
 }
 
@@ -122,6 +174,7 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   PetscCheck(r->md.nports == b->nports, part->comm, PETSC_ERR_PLIB, "body %s: the reduced model has %" PetscInt_FMT " ports, the body %" PetscInt_FMT, part->name, r->md.nports, b->nports);
   m = r->m      = r->md.m;
   r->nports     = b->nports;
+  PetscCall(ReducedExpectFrequencies(part, r));
   r->floating   = b->floating;
   r->full_inertia = (PetscBool)(b->floating && !b->frozen_inertia);
   r->ie         = r->floating ? 18 : 0;
@@ -194,14 +247,15 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
   const PhlexUnits *u = part->units;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " normal modes and the attachment modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " %s modes and the %s modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "fixed-interface" : "normal", r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "constraint" : "attachment", r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PetscViewerASCIIPrintf(viewer, "the full body it reduces:\n"));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PhlexPartView(r->full, viewer));
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscCall(ViewFrequencies(viewer, "reduced frequencies [Hz]:", r->m, r->md.lambda, u));
-  PetscCall(ViewFrequencies(viewer, "full body's frequencies of the normal modes in the basis [Hz]:", r->md.nnormal, r->md.lambda_full, u));
+  if (r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports) PetscCall(ViewFrequencies(viewer, "full body's frequencies with its ports held (the fixed-interface modes in the basis) [Hz]:", r->md.nnormal, r->md.lambda_full, u));
+  else PetscCall(ViewFrequencies(viewer, "full body's frequencies of the normal modes in the basis [Hz]:", r->md.nnormal, r->md.lambda_full, u));
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscFunctionReturn(0);
 }

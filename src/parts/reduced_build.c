@@ -10,6 +10,10 @@
    basis is Mv-orthonormalised and rotated by a Rayleigh-Ritz step so that the reduced mass is I and the reduced
    stiffness diagonal.
 
+   Basis (craig_bampton): the fixed-interface modes (the frame patch clamped and the listed ports' rigid averages
+   held, B^T u = 0; FixedInterfaceModes) plus the ports' constraint modes (CraigBamptonVectors); the same
+   orthonormalisation and Rayleigh-Ritz step. A body without listed ports gets the free-interface basis.
+
    Projection: a Galerkin projection keeps the port-Hamiltonian structure (reduced mass Phi^T Mv Phi symmetric positive
    definite, the interconnection skew, the port maps B_q^T Phi and their transposes), so a lossless reduced body keeps
    its quadratic energy under the implicit midpoint rule like the full one. The floating frame needs the inertia
@@ -19,7 +23,7 @@
 #include <private/reduced.h>
 #include <petscviewerhdf5.h>
 
-const char *const PhlexReductionTypes[] = {"free_interface", "PhlexReductionType", "PHLEX_REDUCTION_", NULL};
+const char *const PhlexReductionTypes[] = {"free_interface", "craig_bampton", "PhlexReductionType", "PHLEX_REDUCTION_", NULL};
 
 /* the rigid fields of the body's velocity space, Mv-orthonormal (mean axes) */
 static PetscErrorCode RigidFields(PhlexFlexible b, Vec R[6])
@@ -148,6 +152,243 @@ static PetscErrorCode AttachmentModes(PhlexPart part, PetscReal lambda1, Vec **p
   PetscFunctionReturn(0);
 }
 
+/* out[k] = (K + shift Mv)^{-1} rhs[k] (MUMPS Cholesky, options prefix <body>reduction_; one refinement step) */
+static PetscErrorCode StiffnessSolve(PhlexPart part, PetscReal shift, PetscInt n, Vec rhs[], Vec out[])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  KSP           ksp;
+  PC            pc;
+  Mat           A;
+  Vec           r, dx;
+  char          prefix[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(MatDuplicate(b->K, MAT_COPY_VALUES, &A));
+  if (shift != 0.0) PetscCall(MatAXPY(A, shift, b->Mv, DIFFERENT_NONZERO_PATTERN));
+  PetscCall(KSPCreate(b->comm, &ksp));
+  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sreduction_", part->prefix));
+  PetscCall(KSPSetOptionsPrefix(ksp, prefix));
+  PetscCall(KSPSetOperators(ksp, A, A));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(KSPSetFromOptions(ksp));
+  PetscCall(VecDuplicate(rhs[0], &r));
+  PetscCall(VecDuplicate(rhs[0], &dx));
+  for (PetscInt k = 0; k < n; k++) {
+    PetscCall(VecDuplicate(rhs[k], &out[k]));
+    PetscCall(KSPSolve(ksp, rhs[k], out[k]));
+    PetscCall(MatMult(A, out[k], r));
+    PetscCall(VecAYPX(r, -1.0, rhs[k]));
+    PetscCall(KSPSolve(ksp, r, dx));
+    PetscCall(VecAXPY(out[k], 1.0, dx));
+  }
+  PetscCall(VecDestroy(&r));
+  PetscCall(VecDestroy(&dx));
+  PetscCall(KSPDestroy(&ksp));
+  PetscCall(MatDestroy(&A));
+  PetscFunctionReturn(0);
+}
+
+/* S = B^T Z (6 nports x ncols, column-major): the ports' rigid averages of the fields Z */
+static PetscErrorCode InterfaceValues(PhlexFlexible b, PetscInt ncols, Vec Z[], PetscReal *S)
+{
+  const PetscInt n = 6 * b->nports;
+  PetscScalar   *d;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(n, &d));
+  for (PetscInt j = 0; j < ncols; j++) {
+    for (PetscInt q = 0; q < b->nports; q++) PetscCall(VecMDot(Z[j], 6, b->ports[q].dist, d + 6 * q));
+    for (PetscInt i = 0; i < n; i++) S[i + n * j] = PetscRealPart(d[i]);
+  }
+  PetscCall(PetscFree(d));
+  PetscFunctionReturn(0);
+}
+
+/* Craig-Bampton's fixed-interface normal modes: K phi = lambda Mv phi on W = {u : B^T u = 0} (the frame patch clamped
+   by the field's space, every listed port's six rigid averages held). With A = K + shift Mv (SPD; shift > 0 only on
+   mean axes, where K is singular) and Z = A^{-1} B, W is the A-orthogonal complement of span Z (Z^T A u = B^T u), so the
+   constrained problem is the pencil (Mv, A) in the A inner product deflated by Z: SLEPc's Krylov-Schur on A^{-1} Mv
+   (EPS_GHEP, B = A, ST shift 0) orthogonalises its basis against the deflation space in the inner product of A, and
+   the eigenpairs of the A-orthogonally projected operator are exactly the Galerkin eigenpairs on W (mu = 1/(lambda +
+   shift)). No penalty, no multiplier unknowns. Each vector is then projected on W once more (u - Z S^{-1} B^T u, S =
+   B^T Z: round-off), its eigenvalue taken as its Rayleigh quotient, and Mv-normalised. */
+static PetscErrorCode FixedInterfaceModes(PhlexPart part, PetscInt nmodes, PetscReal shift, PetscInt nz, Vec Z[], const PetscReal *S, PetscReal *lambda, Vec *vecs)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  Mat           A;
+  EPS           eps;
+  ST            st;
+  KSP           ksp;
+  PC            pc;
+  PetscInt      nconv;
+  PetscReal    *Sinv, cmax = 0.0;
+  PetscBLASInt  bn, info, *ipiv;
+  Vec           w;
+  char          prefix[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(MatDuplicate(b->K, MAT_COPY_VALUES, &A));
+  if (shift != 0.0) PetscCall(MatAXPY(A, shift, b->Mv, DIFFERENT_NONZERO_PATTERN));
+  PetscCall(EPSCreate(b->comm, &eps));
+  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sreduction_", part->prefix));
+  PetscCall(EPSSetOptionsPrefix(eps, prefix));
+  PetscCall(EPSSetOperators(eps, b->Mv, A));
+  PetscCall(EPSSetProblemType(eps, EPS_GHEP));
+  PetscCall(EPSSetType(eps, EPSKRYLOVSCHUR));
+  PetscCall(EPSSetWhichEigenpairs(eps, EPS_LARGEST_MAGNITUDE));
+  PetscCall(EPSSetDimensions(eps, nmodes, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(EPSSetTolerances(eps, 1e-12, PETSC_DEFAULT));
+  PetscCall(EPSSetDeflationSpace(eps, nz, Z));
+  PetscCall(EPSSetPurify(eps, PETSC_FALSE)); /* purification applies A^{-1} Mv, which leaves W */
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STSetType(st, STSHIFT));
+  PetscCall(STSetShift(st, 0.0));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(EPSSetFromOptions(eps));
+  PetscCall(EPSSolve(eps));
+  PetscCall(EPSGetConverged(eps, &nconv));
+  PetscCheck(nconv >= nmodes, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " fixed-interface modes of the reduction converged (-%sreduction_modes; the eigensolver takes -%sreduction_eps_*)", b->name, nconv, nmodes, b->prefix, b->prefix);
+  /* S^{-1} (S symmetric positive definite: B^T A^{-1} B with B of full column rank) */
+  PetscCall(PetscMalloc2(nz * nz, &Sinv, nz, &ipiv));
+  for (PetscInt i = 0; i < nz * nz; i++) Sinv[i] = 0.0;
+  for (PetscInt i = 0; i < nz; i++) Sinv[i + nz * i] = 1.0;
+  {
+    PetscReal *Sc;
+    PetscCall(PetscMalloc1(nz * nz, &Sc));
+    PetscCall(PetscArraycpy(Sc, S, nz * nz));
+    PetscCall(PetscBLASIntCast(nz, &bn));
+    PetscCallBLAS("LAPACKgesv", LAPACKgesv_(&bn, &bn, Sc, &bn, ipiv, Sinv, &bn, &info));
+    PetscCheck(!info, b->comm, PETSC_ERR_USER_INPUT, "body %s: the ports' rigid averages are dependent (LAPACK gesv info %d): two listed ports on the same surface?", b->name, (int)info);
+    PetscCall(PetscFree(Sc));
+  }
+  PetscCall(MatCreateVecs(b->K, &w, NULL));
+  for (PetscInt k = 0; k < nmodes; k++) {
+    PetscScalar  kr, ki, num, den;
+    PetscReal   *g, *c, g0 = 0.0, g1 = 0.0;
+    PetscScalar *cs;
+    PetscCall(MatCreateVecs(b->K, &vecs[k], NULL));
+    PetscCall(EPSGetEigenpair(eps, k, &kr, &ki, vecs[k], NULL));
+    PetscCall(PetscMalloc3(nz, &g, nz, &c, nz, &cs));
+    PetscCall(InterfaceValues(b, 1, &vecs[k], g)); /* nz values: B^T phi (one column) */
+    for (PetscInt i = 0; i < nz; i++) {
+      c[i] = 0.0;
+      for (PetscInt j = 0; j < nz; j++) c[i] += Sinv[i + nz * j] * g[j];
+      cs[i] = -c[i];
+    }
+    PetscCall(VecMAXPY(vecs[k], nz, cs, Z));
+    PetscCall(MatMult(b->Mv, vecs[k], w));
+    PetscCall(VecDot(vecs[k], w, &den));
+    PetscCall(VecScale(vecs[k], 1.0 / PetscSqrtReal(PetscRealPart(den))));
+    PetscCall(MatMult(b->K, vecs[k], w));
+    PetscCall(VecDot(vecs[k], w, &num));
+    lambda[k] = PetscRealPart(num);
+    for (PetscInt i = 0; i < nz; i++) g0 = PetscMax(g0, PetscAbsReal(g[i]));
+    PetscCall(InterfaceValues(b, 1, &vecs[k], g));
+    for (PetscInt i = 0; i < nz; i++) g1 = PetscMax(g1, PetscAbsReal(g[i]));
+    cmax = PetscMax(cmax, g1);
+    PetscCall(PetscInfo(NULL, "body %s: fixed-interface mode %" PetscInt_FMT ": lambda %.15g (eigensolver %.15g), max |B^T phi| %g before the projection, %g after\n", b->name, k, (double)lambda[k], (double)(1.0 / PetscRealPart(kr) - shift), (double)g0, (double)g1));
+    PetscCall(PetscFree3(g, c, cs));
+  }
+  PetscCall(PetscInfo(NULL, "body %s: %" PetscInt_FMT " fixed-interface modes, max |B^T phi| %g\n", b->name, nmodes, (double)cmax));
+  PetscCall(VecDestroy(&w));
+  PetscCall(PetscFree2(Sinv, ipiv));
+  PetscCall(EPSDestroy(&eps));
+  PetscCall(MatDestroy(&A));
+  PetscFunctionReturn(0);
+}
+
+/* The Craig-Bampton vectors of a body with listed ports: nmodes fixed-interface modes, then the ports' static modes.
+   Clamped at the frame patch (K SPD) the static modes are the constraint modes: the field of least strain energy with
+   the rigid averages B^T psi = e_j (unit motion of one port component, every other held), psi = Z S^{-1} with
+   Z = K^{-1} B, S = B^T Z (K psi = B mu: loads on the ports only). On mean axes K is singular: the fixed-interface
+   modes use A = K + lambda1 Mv and lose their rigid content afterwards (the mean-axes conditions), and the static
+   modes are the inertia-relief attachment modes of free_interface, whose span holds the rigid-free part of every
+   constraint mode (a constraint mode solves K psi = B mu with a self-equilibrated mu) and six more vectors. */
+static PetscErrorCode CraigBamptonVectors(PhlexPart part, PetscInt nmodes, Vec *Phi, PetscInt *nb, PetscReal *lambda_full)
+{
+  PhlexFlexible   b         = (PhlexFlexible)part->data;
+  const PetscBool mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
+  PetscReal       lambda1   = 0.0, *S;
+  PetscInt        npsi, nz = 6 * b->nports;
+  Vec            *psi, *Z, *dist, *vecs;
+
+  PetscFunctionBeginUser;
+  if (mean_axes) {
+    /* the shift: the first free elastic eigenvalue (that of the attachment modes' solves) */
+    PetscInt   nconv, nrigid;
+    PetscReal *lam;
+    PetscCall(PhlexFlexibleComputeModes(part, 1, &nconv, &nrigid, &lam, NULL, NULL, NULL));
+    PetscCheck(nconv > 6, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the first free elastic mode did not converge", b->name);
+    lambda1 = lam[6];
+    PetscCall(PetscFree(lam));
+  }
+  PetscCall(AttachmentModes(part, lambda1, &psi, &npsi));
+  PetscCall(PetscMalloc4(nz, &dist, nz, &Z, nz * nz, &S, PetscMax(nmodes, 1), &vecs));
+  for (PetscInt q = 0; q < b->nports; q++)
+    for (PetscInt d = 0; d < 6; d++) dist[6 * q + d] = b->ports[q].dist[d];
+  if (mean_axes) PetscCall(StiffnessSolve(part, lambda1, nz, dist, Z));
+  else
+    for (PetscInt k = 0; k < nz; k++) {
+      PetscCall(VecDuplicate(psi[k], &Z[k]));
+      PetscCall(VecCopy(psi[k], Z[k])); /* K^{-1} B */
+    }
+  PetscCall(InterfaceValues(b, nz, Z, S));
+  for (PetscInt i = 0; i < nz; i++) /* symmetric in exact arithmetic */
+    for (PetscInt j = 0; j < i; j++) S[i + nz * j] = S[j + nz * i] = 0.5 * (S[i + nz * j] + S[j + nz * i]);
+  if (nmodes) PetscCall(FixedInterfaceModes(part, nmodes, lambda1, nz, Z, S, lambda_full, vecs));
+  *nb = 0;
+  if (mean_axes && nmodes) {
+    Vec R[6], work;
+    PetscCall(RigidFields(b, R));
+    PetscCall(VecDuplicate(vecs[0], &work));
+    for (PetscInt k = 0; k < nmodes; k++) PetscCall(RemoveRigid(b, R, vecs[k], work));
+    PetscCall(VecDestroy(&work));
+    for (PetscInt j = 0; j < 6; j++) PetscCall(VecDestroy(&R[j]));
+  }
+  for (PetscInt k = 0; k < nmodes; k++) Phi[(*nb)++] = vecs[k];
+  if (!mean_axes) {
+    /* the constraint modes psi_j = sum_i Z_i (S^{-1})_ij */
+    PetscReal   *Sinv, *Sc;
+    PetscBLASInt bn, info, *ipiv;
+    PetscCall(PetscMalloc3(nz * nz, &Sinv, nz * nz, &Sc, nz, &ipiv));
+    PetscCall(PetscArraycpy(Sc, S, nz * nz));
+    for (PetscInt i = 0; i < nz * nz; i++) Sinv[i] = 0.0;
+    for (PetscInt i = 0; i < nz; i++) Sinv[i + nz * i] = 1.0;
+    PetscCall(PetscBLASIntCast(nz, &bn));
+    PetscCallBLAS("LAPACKgesv", LAPACKgesv_(&bn, &bn, Sc, &bn, ipiv, Sinv, &bn, &info));
+    PetscCheck(!info, b->comm, PETSC_ERR_USER_INPUT, "body %s: the ports' rigid averages are dependent (LAPACK gesv info %d)", b->name, (int)info);
+    for (PetscInt j = 0; j < nz; j++) {
+      PetscScalar *c;
+      PetscCall(PetscMalloc1(nz, &c));
+      for (PetscInt i = 0; i < nz; i++) c[i] = Sinv[i + nz * j];
+      PetscCall(VecSet(psi[j], 0.0));
+      PetscCall(VecMAXPY(psi[j], nz, c, Z));
+      PetscCall(PetscFree(c));
+    }
+    {
+      /* their interface values: the identity to round-off */
+      PetscReal dev = 0.0;
+      PetscCall(InterfaceValues(b, nz, psi, Sc));
+      for (PetscInt i = 0; i < nz; i++)
+        for (PetscInt j = 0; j < nz; j++) dev = PetscMax(dev, PetscAbsReal(Sc[i + nz * j] - (i == j ? 1.0 : 0.0)));
+      PetscCall(PetscInfo(NULL, "body %s: %" PetscInt_FMT " constraint modes, max |B^T psi - I| %g\n", b->name, nz, (double)dev));
+    }
+    PetscCall(PetscFree3(Sinv, Sc, ipiv));
+  }
+  for (PetscInt k = 0; k < npsi; k++) Phi[(*nb)++] = psi[k];
+  for (PetscInt k = 0; k < nz; k++) PetscCall(VecDestroy(&Z[k]));
+  PetscCall(PetscFree(psi));
+  PetscCall(PetscFree4(dist, Z, S, vecs));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexReducedBuild - the reduced model of a flexible body (set up, its FE operators assembled): basis, projected
   operators and inertia invariants (non-dimensional, the body's units)
@@ -169,28 +410,37 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscI
   PetscBool       floating = b->floating;
 
   PetscFunctionBeginUser;
-  /* the normal modes of the field on its own space: clamped at the frame patch (a floating body's frame patch is its
-     field's Dirichlet part: the modes of the field, not those of the body with its frame), free on mean axes */
-  if (!mean_axes) b->floating = PETSC_FALSE;
-  PetscCall(PhlexFlexibleComputeModes(part, nmodes, &nconv, &nrigid, &lambda, &vecs, NULL, NULL));
-  b->floating = floating;
-  {
-    const PetscInt r0 = mean_axes ? 6 : 0; /* ComputeModes puts the frame's six rigid modes (zero fields) first */
-    PetscCheck(nconv - r0 >= nmodes, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " normal modes of the reduction converged (-%sreduction_modes)", b->name, nconv - r0, nmodes, b->prefix);
+  if (type == PHLEX_REDUCTION_CRAIG_BAMPTON && b->nports) {
+    /* with no listed port the fixed interface is the frame patch alone (or nothing, on mean axes): free_interface's
+       basis, which is then Craig-Bampton's */
     model->nnormal = nmodes;
-    PetscCall(PetscMalloc1(nmodes, &model->lambda_full));
-    for (PetscInt k = 0; k < nmodes; k++) model->lambda_full[k] = lambda[r0 + k];
-    lambda1 = nmodes ? lambda[r0] : 1.0;
-    for (PetscInt k = 0; k < r0; k++) PetscCall(VecDestroy(&vecs[k]));
+    PetscCall(PetscMalloc1(PetscMax(nmodes, 1), &model->lambda_full));
     PetscCall(PetscMalloc1(nmodes + 6 * b->nports, &Phi));
-    for (PetscInt k = 0; k < nmodes; k++) Phi[nb++] = vecs[r0 + k];
-    for (PetscInt k = r0 + nmodes; k < nconv; k++) PetscCall(VecDestroy(&vecs[k]));
-    PetscCall(PetscFree(vecs));
-    PetscCall(PetscFree(lambda));
+    PetscCall(CraigBamptonVectors(part, nmodes, Phi, &nb, model->lambda_full));
+  } else {
+    /* the normal modes of the field on its own space: clamped at the frame patch (a floating body's frame patch is its
+       field's Dirichlet part: the modes of the field, not those of the body with its frame), free on mean axes */
+    if (!mean_axes) b->floating = PETSC_FALSE;
+    PetscCall(PhlexFlexibleComputeModes(part, nmodes, &nconv, &nrigid, &lambda, &vecs, NULL, NULL));
+    b->floating = floating;
+    {
+      const PetscInt r0 = mean_axes ? 6 : 0; /* ComputeModes puts the frame's six rigid modes (zero fields) first */
+      PetscCheck(nconv - r0 >= nmodes, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " normal modes of the reduction converged (-%sreduction_modes)", b->name, nconv - r0, nmodes, b->prefix);
+      model->nnormal = nmodes;
+      PetscCall(PetscMalloc1(nmodes, &model->lambda_full));
+      for (PetscInt k = 0; k < nmodes; k++) model->lambda_full[k] = lambda[r0 + k];
+      lambda1 = nmodes ? lambda[r0] : 1.0;
+      for (PetscInt k = 0; k < r0; k++) PetscCall(VecDestroy(&vecs[k]));
+      PetscCall(PetscMalloc1(nmodes + 6 * b->nports, &Phi));
+      for (PetscInt k = 0; k < nmodes; k++) Phi[nb++] = vecs[r0 + k];
+      for (PetscInt k = r0 + nmodes; k < nconv; k++) PetscCall(VecDestroy(&vecs[k]));
+      PetscCall(PetscFree(vecs));
+      PetscCall(PetscFree(lambda));
+    }
+    PetscCall(AttachmentModes(part, lambda1, &psi, &npsi));
+    for (PetscInt k = 0; k < npsi; k++) Phi[nb++] = psi[k];
+    PetscCall(PetscFree(psi));
   }
-  PetscCall(AttachmentModes(part, lambda1, &psi, &npsi));
-  for (PetscInt k = 0; k < npsi; k++) Phi[nb++] = psi[k];
-  PetscCall(PetscFree(psi));
   PetscCheck(nb > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: the reduced basis is empty: ask for normal modes (-%sreduction_modes) or list ports", b->name, b->prefix);
 
   /* Mv-orthonormal, twice (the attachment modes are nearly dependent on the low modes); a vector whose norm falls
@@ -344,7 +594,6 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscI
   for (PetscInt j = 0; j < m; j++) PetscCall(VecDestroy(&Phi[j]));
   PetscCall(PetscFree(Phi));
   PetscCall(VecDestroy(&work));
-  (void)type; /* one kind of basis so far */
   PetscFunctionReturn(0);
 }
 
@@ -428,7 +677,8 @@ PetscErrorCode PhlexReducedProvenance(PhlexPart part, PhlexReductionType type, P
     PetscReal ft  = 0.0;
     PetscBool set = PETSC_FALSE;
     PetscCall(PetscOptionsGetReal(NULL, NULL, "-modes_target_frequency", &ft, &set));
-    PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " normal modes %s %.15g Hz", PhlexReductionTypes[type], nmodes, set ? "nearest" : "from", set ? (double)ft : 0.0));
+    if (type == PHLEX_REDUCTION_CRAIG_BAMPTON && b->nports) PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " fixed-interface modes from 0 Hz", PhlexReductionTypes[type], nmodes));
+    else PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " normal modes %s %.15g Hz", PhlexReductionTypes[type], nmodes, set ? "nearest" : "from", set ? (double)ft : 0.0));
   }
   PetscFunctionReturn(0);
 }
