@@ -40,7 +40,7 @@ typedef enum {
   PHLEX_DOF_VELOCITY,        /* a frame's or point mass's velocity */
   PHLEX_DOF_IMPULSE,         /* a multiplier's impulse */
   PHLEX_DOF_ELASTIC,         /* an elastic coordinate (non-dimensional displacement) */
-  PHLEX_DOF_ELASTIC_VELOCITY /* its rate */
+  PHLEX_DOF_ELASTIC_VELOCITY /* its rate: a part's n-th elastic velocity is the rate of its n-th elastic coordinate */
 } PhlexDofKind;
 
 /* Offsets of a moving frame's unknowns among a part's discrete unknowns (-1: absent): position r of the frame
@@ -228,6 +228,7 @@ PETSC_INTERN PetscErrorCode PhlexPartGetVec(PhlexPart, Vec, PetscReal *, PhlexPa
 PETSC_INTERN PetscErrorCode PhlexPartRestoreVec(PhlexPart, Vec, PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexPartCreateGround(MPI_Comm, PhlexPart *);
 PETSC_INTERN PetscBool      PhlexPartIsGround(PhlexPart);
+PETSC_INTERN PetscBool      PhlexPartIsElastic(PhlexPart);
 PETSC_INTERN PetscErrorCode PhlexPortSeriesOpen(PhlexOutput, const char[], PetscInt, const char *const[], PetscViewer *);
 PETSC_INTERN PetscErrorCode PhlexPortSeriesEntry(PetscViewer, const PhlexUnits *, const PetscReal[6], PetscBool, const PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexPortSeriesPosition(PetscViewer, const PhlexUnits *, const PetscReal[3]);

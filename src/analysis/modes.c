@@ -159,8 +159,13 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     PetscCall(PetscOptionsGetBool(NULL, NULL, "-phlex_check_stress_maps", &check, NULL));
     PetscCheck(!check, scene->comm, PETSC_ERR_USER_INPUT, "-phlex_check_stress_maps checks the stress maps of a transient or linearised analysis; a modal analysis (stiffness and mass only) does not build them");
   }
-  for (PetscInt k = 0; k < scene->nparts; k++)
-    if (PhlexPartAnalysisOp(scene->parts[k], modes)) nbodies++;
+  for (PetscInt k = 0; k < scene->nparts; k++) {
+    PhlexPart p = scene->parts[k];
+    /* a body that deforms but has no modes of its own here (a reduced body: its elastic coordinates are a basis of
+       the full body's modes) would be left out silently */
+    PetscCheck(PhlexPartAnalysisOp(p, modes) || !PhlexPartIsElastic(p), scene->comm, PETSC_ERR_SUP, "modal analysis: body %s has elastic coordinates (-%stype %s), not a field of its own: this analysis computes the modes of full bodies only; use -%stype flexible (a transient run prints the reduced body's frequencies and those of the full body's normal modes in its basis)", p->name, p->prefix, p->type, p->prefix);
+    if (PhlexPartAnalysisOp(p, modes)) nbodies++;
+  }
   PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible body)");
   for (PetscInt k = 0; k < scene->nparts; k++) {
     PhlexPart p    = scene->parts[k];

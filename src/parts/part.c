@@ -186,6 +186,21 @@ PetscErrorCode PhlexPartFind(PetscInt nparts, const PhlexPart parts[], PhlexPart
 }
 
 /*@C
+  PhlexPartIsElastic - whether a part deforms: field unknowns (a flexible body) or elastic coordinates (a reduced
+  body's eta, PHLEX_DOF_ELASTIC); its ports may then move and turn relative to its frame
+
+  Not collective
+@*/
+PetscBool PhlexPartIsElastic(PhlexPart p)
+{
+  if (!p || PhlexPartIsGround(p)) return PETSC_FALSE;
+  if (p->Nv) return PETSC_TRUE;
+  for (PetscInt k = 0; k < p->nq; k++)
+    if (p->qkind[k] == PHLEX_DOF_ELASTIC) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
+/*@C
   PhlexPartSetPorts - allocates the port table of a part (names and points filled by the kind)
 @*/
 PetscErrorCode PhlexPartSetPorts(PhlexPart p, PetscInt n)

@@ -136,7 +136,7 @@ PetscErrorCode PhlexAssemblyRedundancy(PhlexSystem sys, Vec X, PetscInt *ndroppe
     for (PetscInt i = 0; i < n; i++) {
       PhlexJoint j = sys->joints[jidx[i]];
       if (!redundant[i]) continue;
-      PetscCheck(j->side[0].part->Nv || j->side[1].part->Nv, sys->comm, PETSC_ERR_USER_INPUT, "joint %s: its component %s is redundant for the rigid motion and neither of its bodies is flexible: -joints_redundant keep needs a flexible body to take up the over-constraint (use drop)", j->name, j->rowname[ridx[i]]);
+      PetscCheck(PhlexPartIsElastic(j->side[0].part) || PhlexPartIsElastic(j->side[1].part), sys->comm, PETSC_ERR_USER_INPUT, "joint %s: its component %s is redundant for the rigid motion and neither of its bodies is flexible: -joints_redundant keep needs a flexible body to take up the over-constraint (use drop)", j->name, j->rowname[ridx[i]]);
     }
     PetscCall(PetscPrintf(sys->comm, "Redundant constraints for the rigid motion kept (-joints_redundant keep; the flexible bodies take them up): %s\n", report));
     *ndropped = 0;

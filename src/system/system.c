@@ -972,7 +972,8 @@ PetscErrorCode PhlexSystemJointSidesRestore(PhlexSystem sys, PhlexJoint j, Vec X
 
 /*@C
   PhlexSystemUpdateJoints - the joints' directions and arms for a step of length dt from the accepted state X
-  (PhlexJointUpdateGeometry), at the displacements extrapolated to the middle of the step, u + dt/2 u' (u' = v)
+  (PhlexJointUpdateGeometry), at the displacements extrapolated to the middle of the step, u + dt/2 u' (u' = v),
+  and a reduced body's elastic coordinates likewise, eta + dt/2 eta' (eta' = zeta)
 
   Collective
 
@@ -986,10 +987,11 @@ PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem sys, Vec X, PetscReal dt)
   PetscBool flexible = PETSC_FALSE;
 
   PetscFunctionBeginUser;
-  /* only a flexible port turns relative to its body frame */
+  /* only the port of a deforming part (a flexible body's field, a reduced body's elastic coordinates) turns
+     relative to its body frame */
   for (PetscInt k = 0; k < sys->njoints; k++)
     for (PetscInt s = 0; s < 2; s++)
-      if (sys->joints[k]->side[s].part->Nv) flexible = PETSC_TRUE;
+      if (PhlexPartIsElastic(sys->joints[k]->side[s].part)) flexible = PETSC_TRUE;
   if (!flexible) PetscFunctionReturn(0);
   sys->eval_id[0] = 0; /* the joints' geometry changes */
   if (!sys->Xwork) PetscCall(VecDuplicate(X, &sys->Xwork));
@@ -1004,6 +1006,19 @@ PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem sys, Vec X, PetscReal dt)
     PetscCall(VecRestoreSubVector(Xm, sys->is[PHLEX_FIELD_DISPLACEMENT], &um));
   }
   PetscCall(PhlexSystemGather(sys, Xm, sys->q));
+  /* elastic coordinates likewise, eta + dt/2 eta' (eta' = zeta: a part's n-th elastic velocity is the rate of its
+     n-th elastic coordinate) */
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart p  = sys->parts[i];
+    PetscInt  iv = 0;
+    for (PetscInt ie = 0; ie < p->nq; ie++) {
+      if (p->qkind[ie] != PHLEX_DOF_ELASTIC) continue;
+      while (iv < p->nq && p->qkind[iv] != PHLEX_DOF_ELASTIC_VELOCITY) iv++;
+      PetscCheck(iv < p->nq, sys->comm, PETSC_ERR_PLIB, "body %s: elastic coordinate %s has no velocity", p->name, p->qname[ie]);
+      sys->q[p->qoff + ie] += 0.5 * dt / sys->scene->units.time * sys->q[p->qoff + iv];
+      iv++;
+    }
+  }
   for (PetscInt k = 0; k < sys->njoints; k++) {
     PhlexPartVec pv[2];
     PetscCall(PhlexSystemJointSides(sys, sys->joints[k], Xm, sys->q, pv));
