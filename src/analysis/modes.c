@@ -161,12 +161,11 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
   }
   for (PetscInt k = 0; k < scene->nparts; k++) {
     PhlexPart p = scene->parts[k];
-    /* a body that deforms but has no modes of its own here (a reduced body: its elastic coordinates are a basis of
-       the full body's modes) would be left out silently */
-    PetscCheck(PhlexPartAnalysisOp(p, modes) || !PhlexPartIsElastic(p), scene->comm, PETSC_ERR_SUP, "modal analysis: body %s has elastic coordinates (-%stype %s), not a field of its own: this analysis computes the modes of full bodies only; use -%stype flexible (a transient run prints the reduced body's frequencies and those of the full body's normal modes in its basis)", p->name, p->prefix, p->type, p->prefix);
+    /* a body that deforms but has no modes of its own would be left out silently */
+    PetscCheck(PhlexPartAnalysisOp(p, modes) || !PhlexPartIsElastic(p), scene->comm, PETSC_ERR_SUP, "modal analysis: body %s has elastic coordinates (-%stype %s) but no modal analysis of its own", p->name, p->prefix, p->type);
     if (PhlexPartAnalysisOp(p, modes)) nbodies++;
   }
-  PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible body)");
+  PetscCheck(nbodies, scene->comm, PETSC_ERR_USER_INPUT, "modal analysis: the scene has no body with elastic modes (a flexible or reduced body)");
   for (PetscInt k = 0; k < scene->nparts; k++) {
     PhlexPart p    = scene->parts[k];
     PetscReal rate = -1;
@@ -206,7 +205,11 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
       PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d,%s\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0, part->name));
     }
     if (shapes) PetscCall((*part->analysisops->modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid, NULL));
-    if (o.nrefine > 0) PetscCall(ConvergenceStudy(scene, part, o.nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid, o.order_expect, o.order_tol));
+    else if (scene->output->fields) PetscCall(PetscPrintf(scene->comm, "  mode shapes of body %s not written: its model (-%stype %s) holds no basis vectors to draw them with\n", part->name, part->prefix, part->type));
+    if (o.nrefine > 0) {
+      if (PhlexPartAnalysisOp(part, refine)) PetscCall(ConvergenceStudy(scene, part, o.nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid, o.order_expect, o.order_tol));
+      else PetscCall(PetscPrintf(scene->comm, "  no convergence study of body %s: its model (-%stype %s) has no refinement (-modes_convergence_refinements)\n", part->name, part->prefix, part->type));
+    }
     if (nexp) {
       nfexp = nconv - nrigid;
       PetscCall(PetscMalloc1(PetscMax(nfexp, 1), &fexp));

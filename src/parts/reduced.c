@@ -880,6 +880,134 @@ static PetscErrorCode ReducedOutputClose(PhlexPart part)
   PetscFunctionReturn(0);
 }
 
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Modal analysis (the analysis table)                                                                            */
+
+/* The body's pencil at rest, the Rayleigh-Ritz projection on [rigid | Phi] of the full body's (flexible_modes.c:
+   (K, Mv) of a fixed body, FloatingPencil of a floating one): on (v_P, w | zeta) for a floating body, zeta for a
+   fixed one (n x n, symmetric),
+     K = diag(0, Kr),   M = [[M6, C], [C^T, Mr]],   C = [int rho phi_k ; int rho x x phi_k] (column k),
+   M6 the frame's rigid mass: the kinetic energy of v_P + w x x + Phi zeta. With mean axes the basis is Mv-orthogonal
+   to the rigid fields and C vanishes (to round-off). */
+static PetscErrorCode ReducedPencil(Reduced *r, PetscInt *n, PetscReal **K, PetscReal **M)
+{
+  const PetscInt m = r->m, o = r->floating ? 6 : 0, N = o + m;
+
+  PetscFunctionBeginUser;
+  *n = N;
+  PetscCall(PetscCalloc2(N * N, K, N * N, M));
+  for (PetscInt i = 0; i < m; i++)
+    for (PetscInt j = 0; j < m; j++) {
+      (*K)[N * (o + i) + o + j] = r->md.Kr[m * i + j];
+      (*M)[N * (o + i) + o + j] = r->md.Mr[m * i + j];
+    }
+  if (r->floating) {
+    PetscReal M6[36];
+    PetscCall(PhlexFrameRigidMass(&r->md.inertia, M6));
+    for (PetscInt i = 0; i < 6; i++)
+      for (PetscInt j = 0; j < 6; j++) (*M)[N * i + j] = M6[6 * i + j];
+    for (PetscInt k = 0; k < m; k++) {
+      const PetscReal *S = r->md.S + 3 * k, *W = r->md.W + 9 * k; /* W[3 b + c] = int rho x_b phi_k,c */
+      const PetscReal  c[6] = {S[0], S[1], S[2], W[5] - W[7], W[6] - W[2], W[1] - W[3]};
+      for (PetscInt i = 0; i < 6; i++) (*M)[N * i + o + k] = (*M)[N * (o + k) + i] = c[i];
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/* The modes of a reduced body: K x = lambda M x on its pencil at rest (ReducedPencil),
+  dense and small, by LAPACK (sygv); a floating body's six rigid modes first, as the full body's
+
+  (every process holds the model and solves the same problem). Rayleigh-Ritz: every eigenvalue bounds the full body's of the same rank from above, and the full body's normal modes
+  in the basis (those with the frame held: all of a fixed body's, a floating body's on mean axes) come out exactly.
+  At most the basis's m elastic modes exist; nev nearest -modes_target_frequency, else the lowest. No mode shapes
+  (vecs, rigid must be NULL): the reduced model holds no basis vectors. */
+static PetscErrorCode ReducedComputeModes(PhlexPart part, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
+{
+  Reduced     *r = (Reduced *)part->data;
+  PetscInt     n, nr, ne, first;
+  PetscReal   *K, *M, *A, *B, *w, *work, lmin = PETSC_MAX_REAL, rigid_below, nrmk = 0, nrmm = 0, ftarget = -1, work1;
+  PetscBLASInt bn, lwork = -1, info, one = 1;
+  PetscBool    target;
+
+  PetscFunctionBeginUser;
+  PetscCheck(!vecs && !rigid, part->comm, PETSC_ERR_SUP, "body %s: a reduced body's mode shapes need its basis vectors, which the reduced model does not hold", part->name);
+  PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscCall(ReducedPencil(r, &n, &K, &M));
+  PetscCall(PetscMalloc3(n * n, &A, n * n, &B, n, &w));
+  PetscCall(PetscArraycpy(A, K, n * n));
+  PetscCall(PetscArraycpy(B, M, n * n));
+  PetscCall(PetscBLASIntCast(n, &bn));
+  PetscCallBLAS("LAPACKsygv", LAPACKsygv_(&one, "V", "U", &bn, A, &bn, B, &bn, w, &work1, &lwork, &info));
+  lwork = (PetscBLASInt)work1;
+  PetscCall(PetscMalloc1(lwork, &work));
+  PetscCallBLAS("LAPACKsygv", LAPACKsygv_(&one, "V", "U", &bn, A, &bn, B, &bn, w, work, &lwork, &info));
+  PetscCheck(!info, part->comm, PETSC_ERR_LIB, "body %s: LAPACK sygv failed on the reduced pencil (info %d: the reduced mass is not positive definite if > %d)", part->name, (int)info, (int)n);
+  PetscCall(PetscFree(work));
+  /* rigid: |lambda| below 1e-6 of the lowest reduced eigenvalue with the frame held (the flexible body's rule with its
+     frequency scale) */
+  for (PetscInt k = 0; k < r->m; k++)
+    if (r->md.lambda[k] > 0) lmin = PetscMin(lmin, r->md.lambda[k]);
+  rigid_below = 1e-6 * lmin;
+  nr          = 0;
+  for (PetscInt k = 0; k < n; k++)
+    if (PetscAbsReal(w[k]) < rigid_below) nr++;
+  ne = PetscMin(nev, n - nr);
+  if (nev > n - nr) PetscCall(PetscPrintf(part->comm, "body %s: its basis has %" PetscInt_FMT " elastic modes, fewer than the %" PetscInt_FMT " asked for (-modes_nev): all are given\n", part->name, n - nr, nev));
+  /* the ne elastic eigenvalues nearest the target (a contiguous run of the ascending ones), else the lowest */
+  PetscCall(PetscOptionsGetReal(NULL, NULL, "-modes_target_frequency", &ftarget, &target));
+  first = nr;
+  if (target && ftarget > 0) {
+    const PetscReal sigma = PetscSqr(2.0 * PETSC_PI * ftarget * part->units->time);
+    while (first + ne < n && PetscAbsReal(w[first + ne] - sigma) < PetscAbsReal(w[first] - sigma)) first++;
+  }
+  for (PetscInt i = 0; i < n; i++) {
+    PetscReal sk = 0, sm = 0; /* the infinity norms */
+    for (PetscInt j = 0; j < n; j++) {
+      sk += PetscAbsReal(K[n * i + j]);
+      sm += PetscAbsReal(M[n * i + j]);
+    }
+    nrmk = PetscMax(nrmk, sk);
+    nrmm = PetscMax(nrmm, sm);
+  }
+  *nconv  = nr + ne;
+  *nrigid = nr;
+  PetscCall(PetscMalloc1(*nconv, lambda));
+  if (resid) PetscCall(PetscMalloc1(*nconv, resid));
+  for (PetscInt i = 0; i < *nconv; i++) {
+    const PetscInt   e = i < nr ? i : first + (i - nr);
+    const PetscReal *x = A + n * e, lam = w[e];
+    PetscReal        res = 0, xn = 0;
+    (*lambda)[i] = lam;
+    if (!resid) continue;
+    /* ||K x - lambda M x||_2 / (|lambda| ||x||_2); a rigid mode's backward error / ((||K|| + |lambda| ||M||) ||x||) */
+    for (PetscInt a = 0; a < n; a++) {
+      PetscReal s = 0;
+      for (PetscInt b = 0; b < n; b++) s += (K[n * a + b] - lam * M[n * a + b]) * x[b];
+      res += s * s;
+      xn += x[a] * x[a];
+    }
+    res = PetscSqrtReal(res), xn = PetscSqrtReal(xn);
+    (*resid)[i] = i < nr ? res / ((nrmk + PetscAbsReal(lam) * nrmm) * xn) : res / (PetscAbsReal(lam) * xn);
+  }
+  PetscCall(PetscFree3(A, B, w));
+  PetscCall(PetscFree2(K, M));
+  PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* "clamped" or "floating" (a reduced fixed body is clamped at its frame patch), its coordinates; 6 rigid-body modes
+   for a floating body, -1 (not counted) for a clamped one */
+static PetscErrorCode ReducedModesKind(PhlexPart part, char buf[], size_t len, PetscInt *nrigid)
+{
+  Reduced *r = (Reduced *)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(buf, len, "%s; reduced, %" PetscInt_FMT " elastic coordinates", r->floating ? "floating" : "clamped", r->m));
+  *nrigid = r->floating ? 6 : -1;
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexPartCreate_Reduced - a reduced flexible body (part kind "reduced")
 @*/
@@ -889,6 +1017,7 @@ PetscErrorCode PhlexPartCreate_Reduced(PhlexPart part)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&r));
+  PetscCall(PetscNew(&part->analysisops));
   part->data               = r;
   part->ops.setfromoptions = ReducedSetFromOptions;
   part->ops.geometry       = ReducedGeometry;
@@ -911,5 +1040,7 @@ PetscErrorCode PhlexPartCreate_Reduced(PhlexPart part)
   part->ops.outputopen     = ReducedOutputOpen;
   part->ops.outputstep     = ReducedOutputStep;
   part->ops.outputclose    = ReducedOutputClose;
+  part->analysisops->modes     = ReducedComputeModes;
+  part->analysisops->modeskind = ReducedModesKind;
   PetscFunctionReturn(0);
 }
