@@ -15,7 +15,12 @@
        [C   0 ] [nu] = w^2    [0  0] [nu]
    a symmetric generalized eigenproblem with the constraints kept in a saddle point, solved by SLEPc with
    shift-and-invert (an indefinite factorisation). Mechanism modes (zero frequency: the constrained rigid motions)
-   are counted from the rank of C on the discrete velocities, reported and deflated from the frequency list.
+   are counted from the rank of C on the frames' velocities, reported and deflated from the frequency list.
+
+   Elastic coordinates (a reduced body's eta, u = Phi eta) are a body's displacement on discrete unknowns: their rows
+   s E_ee eta + A_ez zeta = 0 (eta' = zeta) eliminate them like the field's displacement, and their stiffness, the
+   A part of the elastic velocities' rows in their columns (Kr eta), becomes K_zz = -A_ze E_ee^{-1} A_ez on the
+   elastic velocities zeta, which are kept with the frames' velocities.
 
    Everything that does not depend on the configuration is built once: K and M of the field (body frame), the
    eigensolver and the symbolic factorisation; per configuration only the constraint rows and the frame couplings are
@@ -206,6 +211,8 @@ typedef struct {
   PetscInt    nqv, nqi, nQ; /* discrete velocities, impulses, both */
   PetscInt   *qmap;         /* discrete unknown -> Q index (-1: a configuration unknown, dropped) */
   PetscInt   *Qq;           /* Q index -> discrete unknown */
+  PetscInt    ne;           /* elastic coordinates (eliminated: their stiffness goes onto their velocities) */
+  PetscInt   *Ee;           /* their discrete unknowns */
   Mat         K, Mvv;       /* field stiffness (stress eliminated; with a stressed or spinning state's K_sigma + Cen) and mass */
   Mat         Gyr;          /* the fields' gyroscopic (Coriolis) matrix about a spin, or NULL */
   Mat         A, B, A1;     /* the saddle-point pencil (the same nonzero pattern in every configuration); A1 its Coriolis part */
@@ -393,16 +400,19 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
   PetscFunctionReturn(0);
 }
 
-/* the discrete unknowns kept (velocities, impulses) and dropped (configuration) */
+/* the discrete unknowns kept (velocities of frames and points, elastic velocities, impulses), eliminated (elastic
+   coordinates) and dropped (configuration) */
 static PetscErrorCode BuildDiscreteMap(Pencil *p)
 {
   PhlexSystem sys = p->sys;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc2(PetscMax(sys->nq, 1), &p->qmap, PetscMax(sys->nq, 1), &p->Qq));
+  PetscCall(PetscMalloc3(PetscMax(sys->nq, 1), &p->qmap, PetscMax(sys->nq, 1), &p->Qq, PetscMax(sys->nq, 1), &p->Ee));
   for (PetscInt k = 0; k < sys->nq; k++) p->qmap[k] = -1;
   for (PetscInt k = 0; k < sys->nq; k++)
-    if (sys->qkind[k] == PHLEX_DOF_VELOCITY) p->Qq[p->nqv] = k, p->qmap[k] = p->nqv++;
+    if (sys->qkind[k] == PHLEX_DOF_VELOCITY || sys->qkind[k] == PHLEX_DOF_ELASTIC_VELOCITY) p->Qq[p->nqv] = k, p->qmap[k] = p->nqv++;
+  for (PetscInt k = 0; k < sys->nq; k++)
+    if (sys->qkind[k] == PHLEX_DOF_ELASTIC) p->Ee[p->ne++] = k;
   p->nQ = p->nqv;
   for (PetscInt k = 0; k < sys->nq; k++)
     if (sys->qkind[k] == PHLEX_DOF_IMPULSE) p->Qq[p->nQ] = k, p->qmap[k] = p->nQ++;
@@ -410,7 +420,7 @@ static PetscErrorCode BuildDiscreteMap(Pencil *p)
   PetscFunctionReturn(0);
 }
 
-/* The state at rest: velocities and impulses zero (the configuration and the stress as they are) */
+/* The state at rest: velocities and impulses zero (the configuration, the elastic coordinates and the stress as they are) */
 static PetscErrorCode SetRest(Pencil *p)
 {
   PhlexSystem sys = p->sys;
@@ -424,7 +434,7 @@ static PetscErrorCode SetRest(Pencil *p)
   }
   PetscCall(PhlexSystemGather(sys, p->X, sys->q));
   for (PetscInt k = 0; k < sys->nq; k++)
-    if (sys->qkind[k] != PHLEX_DOF_CONFIGURATION) sys->q[k] = 0.0;
+    if (sys->qkind[k] == PHLEX_DOF_VELOCITY || sys->qkind[k] == PHLEX_DOF_ELASTIC_VELOCITY || sys->qkind[k] == PHLEX_DOF_IMPULSE) sys->q[k] = 0.0;
   PetscCall(PhlexSystemScatter(sys, sys->q, p->X));
   PetscFunctionReturn(0);
 }
@@ -454,10 +464,54 @@ static PetscErrorCode Borders(Pencil *p, Mat *BE, Mat *BA, PetscReal *DE, PetscR
   PetscFunctionReturn(0);
 }
 
+/* The stiffness of the elastic coordinates on the kept velocities: their rows s E_ee eta + A_eQ x_Q = 0 (eta' =
+   zeta) give eta = -E_ee^{-1} A_eQ x_Q / s, and the velocities' rows' A part in their columns, A_Qe eta, multiplied
+   by s as the velocity rows are (the field's K likewise), K_QQ = -A_Qe E_ee^{-1} A_eQ (nqv x nqv, row-major; the
+   symmetric Kr of a reduced body). Checks that the elastic rows have no other terms (no A part among elastic
+   coordinates or in the configuration or impulse columns, no E part outside E_ee) and that K_QQ is symmetric. */
+static PetscErrorCode ElasticStiffness(Pencil *p, const PetscReal *DE, const PetscReal *DA, PetscReal dmax, PetscReal *Kq)
+{
+  PhlexSystem    sys = p->sys;
+  const PetscInt nq = sys->nq, ne = p->ne, nqv = p->nqv;
+  PetscReal     *E, *X, worst = 0, kmax = 0, asym = 0;
+  PetscBLASInt   n, nrhs, info, *piv;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc3(ne * ne, &E, ne * nqv, &X, ne, &piv));
+  for (PetscInt a = 0; a < ne; a++) {
+    const PetscInt i = p->Ee[a];
+    for (PetscInt j = 0; j < nq; j++) {
+      const PetscInt jj = p->qmap[j];
+      if (sys->qkind[j] == PHLEX_DOF_ELASTIC) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]));
+      else worst = PetscMax(worst, PetscAbsReal(DE[i * nq + j]) + (jj >= 0 && jj < nqv ? 0.0 : PetscAbsReal(DA[i * nq + j])));
+    }
+    for (PetscInt b = 0; b < ne; b++) E[b * ne + a] = DE[i * nq + p->Ee[b]];       /* column-major */
+    for (PetscInt jj = 0; jj < nqv; jj++) X[jj * ne + a] = DA[i * nq + p->Qq[jj]]; /* column-major */
+  }
+  PetscCheck(worst <= 1e-10 * dmax, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the elastic coordinates' rows are not eta' = zeta at the linearisation point (a term of relative size %g): the configuration is not at rest", (double)(worst / dmax));
+  PetscCall(PetscBLASIntCast(ne, &n));
+  PetscCall(PetscBLASIntCast(nqv, &nrhs));
+  PetscCallBLAS("LAPACKgesv", LAPACKgesv_(&n, &nrhs, E, &n, piv, X, &n, &info));
+  PetscCheck(!info, sys->comm, PETSC_ERR_PLIB, "linearized analysis: the elastic coordinates' rate block is singular (LAPACK gesv info %d)", (int)info);
+  for (PetscInt ii = 0; ii < nqv; ii++)
+    for (PetscInt jj = 0; jj < nqv; jj++) {
+      PetscReal k = 0;
+      for (PetscInt a = 0; a < ne; a++) k -= DA[p->Qq[ii] * nq + p->Ee[a]] * X[jj * ne + a];
+      Kq[ii * nqv + jj] = k;
+      kmax              = PetscMax(kmax, PetscAbsReal(k));
+    }
+  for (PetscInt ii = 0; ii < nqv; ii++)
+    for (PetscInt jj = 0; jj < ii; jj++) asym = PetscMax(asym, PetscAbsReal(Kq[ii * nqv + jj] - Kq[jj * nqv + ii]));
+  PetscCheck(asym <= 1e-10 * kmax, sys->comm, PETSC_ERR_PLIB, "linearized analysis: the stiffness of the elastic coordinates is not symmetric (relative deviation %g)", (double)(asym / PetscMax(kmax, PETSC_SMALL)));
+  PetscCall(PetscFree3(E, X, piv));
+  PetscFunctionReturn(0);
+}
+
 /* The pencil at the current configuration:
      A = [[K, Cv^T], [Cv, [[0, Cq^T], [Cq, 0]]]],   B = [[M, Mvq], [Mqv, [[Mqq, 0], [0, 0]]]]
    on (v | discrete velocities, impulses); Cv = -E_{v,imp}^T (the force distribution of the impulses, transposed),
-   Mvq = E_{v,vel}, Cq = A_{imp,vel}, Mqq = E_{vel,vel}. Checks: at rest (no A part among velocities), the discrete
+   Mvq = E_{v,vel}, Cq = A_{imp,vel}, Mqq = E_{vel,vel}; the velocities' own block of A is the elastic coordinates'
+   stiffness (ElasticStiffness), zero without them. Checks: at rest (no A part among velocities), the discrete
    rows of the system against these (the power-preserving structure), the configuration unknowns inert. */
 static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
 {
@@ -465,22 +519,25 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
   const PetscInt     nq = sys->nq, nQ = p->nQ, nqv = p->nqv;
   PetscMPIInt        rank;
   PetscInt           nvl = 0, Ql;
-  PetscReal         *DE, *DA, dmax = 0, worst = 0;
+  PetscReal         *DE, *DA, *Kq = NULL, dmax = 0, worst = 0;
   Mat                BE = NULL, BA = NULL, AvQ = NULL, BvQ = NULL, AQv = NULL, BQv = NULL, AQQ, BQQ, N, blocks[4];
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(sys->comm, &rank));
   Ql = rank == 0 ? nQ : 0;
   PetscCall(PetscMalloc2(PetscMax(nq * nq, 1), &DE, PetscMax(nq * nq, 1), &DA));
+  if (p->ne) PetscCall(PetscCalloc1(nqv * nqv, &Kq));
   PetscCall(Borders(p, &BE, &BA, DE, DA));
   for (PetscInt k = 0; k < nq * nq; k++) dmax = PetscMax(dmax, PetscAbsReal(DE[k]));
   dmax = PetscMax(dmax, p->scale);
-  /* at rest: no A part among the velocities, no coupling of the configuration into the kept rows */
+  /* at rest: no A part among the velocities, no coupling of the configuration into the kept rows (of the elastic
+     coordinates only their stiffness, the A part of the velocities' rows) */
   for (PetscInt i = 0; i < nq; i++)
     for (PetscInt j = 0; j < nq; j++) {
       const PetscInt ii = p->qmap[i], jj = p->qmap[j];
       if (ii < 0) continue;
-      if (jj < 0) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]) + PetscAbsReal(DE[i * nq + j]));
+      if (jj < 0 && sys->qkind[j] == PHLEX_DOF_ELASTIC) worst = PetscMax(worst, PetscAbsReal(DE[i * nq + j]) + (ii < nqv ? 0.0 : PetscAbsReal(DA[i * nq + j])));
+      else if (jj < 0) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]) + PetscAbsReal(DE[i * nq + j]));
       else if (ii < nqv && jj < nqv) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]));
     }
   PetscCheck(worst <= 1e-10 * dmax, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration is not at rest or is loaded (a term of relative size %g couples the frames' positions or velocities into their equations: gravity, a preload, a spinning body); linearise about an unloaded configuration at rest", (double)(worst / dmax));
@@ -493,6 +550,7 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       else worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j] + DE[j * nq + i]));
     }
   PetscCheck(worst <= 1e-9 * dmax, sys->comm, PETSC_ERR_PLIB, "linearized analysis: the discrete block is not of the symmetric saddle-point form (deviation %g): a part or joint breaks the power-preserving structure", (double)(worst / dmax));
+  if (p->ne) PetscCall(ElasticStiffness(p, DE, DA, dmax, Kq));
 
   /* field couplings: columns of the border, in Q order, and their transposes (AIJ) */
   if (BE) {
@@ -578,7 +636,7 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       for (PetscInt jj = 0; jj < nQ; jj++) {
         const PetscInt i = p->Qq[ii], j = p->Qq[jj];
         PetscReal      a = 0, b = 0;
-        if (ii < nqv && jj < nqv) b = DE[i * nq + j];
+        if (ii < nqv && jj < nqv) b = DE[i * nq + j], a = Kq ? Kq[ii * nqv + jj] : 0.0;
         else if (ii >= nqv && jj < nqv) a = DA[i * nq + j];
         else if (ii < nqv && jj >= nqv) a = DA[j * nq + i];
         PetscCall(MatSetValue(AQQ, ii, jj, a, INSERT_VALUES));
@@ -590,18 +648,23 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
   PetscCall(MatAssemblyEnd(AQQ, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(BQQ, MAT_FINAL_ASSEMBLY));
 
-  /* mechanism modes: the discrete velocities the constraints leave free, nqv - rank(Cq) (their field is zero: a
-     frame patch clamps it, mean axes constrain its rigid content) */
+  /* mechanism modes: the frames' and points' velocities the constraints leave free, nf - rank(Cq) on them (their
+     field is zero: a frame patch clamps it, mean axes constrain its rigid content; elastic velocities have stiffness) */
   {
     PetscReal   *C, *s, work[1];
-    PetscBLASInt m = (PetscBLASInt)p->nqi, n = (PetscBLASInt)nqv, lwork = -1, info, one = 1;
+    PetscInt     nf = 0, *fcol;
+    PetscBLASInt m = (PetscBLASInt)p->nqi, n, lwork = -1, info, one = 1;
     PetscInt     rnk = 0;
-    *nmech = nqv;
+    PetscCall(PetscMalloc1(PetscMax(nqv, 1), &fcol));
+    for (PetscInt jj = 0; jj < nqv; jj++)
+      if (sys->qkind[p->Qq[jj]] == PHLEX_DOF_VELOCITY) fcol[nf++] = jj;
+    n      = (PetscBLASInt)nf;
+    *nmech = nf;
     if (m && n) {
       PetscReal *w;
       PetscCall(PetscMalloc2(m * n, &C, PetscMin(m, n), &s));
       for (PetscInt ii = 0; ii < m; ii++)
-        for (PetscInt jj = 0; jj < n; jj++) C[jj * m + ii] = DA[p->Qq[nqv + ii] * nq + p->Qq[jj]]; /* column-major */
+        for (PetscInt jj = 0; jj < n; jj++) C[jj * m + ii] = DA[p->Qq[nqv + ii] * nq + p->Qq[fcol[jj]]]; /* column-major */
       PetscCallBLAS("LAPACKgesvd", LAPACKgesvd_("N", "N", &m, &n, C, &m, s, NULL, &one, NULL, &one, work, &lwork, &info));
       lwork = (PetscBLASInt)work[0];
       PetscCall(PetscMalloc1(lwork, &w));
@@ -609,12 +672,14 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       PetscCheck(!info, sys->comm, PETSC_ERR_LIB, "LAPACK gesvd failed (%d)", (int)info);
       for (PetscInt k = 0; k < PetscMin(m, n); k++)
         if (s[k] > 1e-10 * s[0]) rnk++;
-      *nmech = nqv - rnk;
+      *nmech = nf - rnk;
       PetscCall(PetscFree(w));
       PetscCall(PetscFree2(C, s));
     }
+    PetscCall(PetscFree(fcol));
   }
   PetscCall(PetscFree2(DE, DA));
+  PetscCall(PetscFree(Kq));
   /* a fixed body without a clamp moves rigidly inside its field: six more zero modes (joints on it are not counted) */
   for (PetscInt f = 0; f < sys->nfparts; f++) {
     PhlexPart part = sys->fparts[f];
@@ -701,9 +766,9 @@ static PetscErrorCode CheckEquilibrium(Pencil *p)
   }
   PetscCall(PhlexSystemGather(sys, F, sys->fq));
   for (PetscInt k = 0; k < sys->nq; k++)
-    if (sys->qkind[k] == PHLEX_DOF_VELOCITY) fq = PetscMax(fq, PetscAbsReal(sys->fq[k]));
+    if (sys->qkind[k] == PHLEX_DOF_VELOCITY || sys->qkind[k] == PHLEX_DOF_ELASTIC_VELOCITY) fq = PetscMax(fq, PetscAbsReal(sys->fq[k]));
   PetscCall(VecDestroy(&F));
-  PetscCheck(fv <= 1e-12 && fq <= 1e-12, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration is not an equilibrium at rest (the momentum equations are off by %g in the fields, %g in the frames and points, non-dimensional): a load acts at t = 0 (a port, frame or body force) or the initial displacement or stress is not free of load; the analysis linearises about an unloaded configuration at rest", (double)fv, (double)fq);
+  PetscCheck(fv <= 1e-12 && fq <= 1e-12, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration is not an equilibrium at rest (the momentum equations are off by %g in the fields, %g in the frames, points and elastic coordinates, non-dimensional): a load acts at t = 0 (a port, frame or body force) or the initial displacement or stress is not free of load; the analysis linearises about an unloaded configuration at rest", (double)fv, (double)fq);
   PetscFunctionReturn(0);
 }
 
@@ -789,7 +854,13 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
   }
   PetscCall(EPSSolve(eps));
   PetscCall(EPSGetConverged(eps, &nconv));
-  PetscCheck(nconv >= want, p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: the eigensolver converged %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs wanted (%" PetscInt_FMT " mechanism modes + -linearized_nev %" PetscInt_FMT "); see -linearized_eps_monitor, -linearized_eps_ncv", nconv, want, nmech, nev);
+  if (nconv < want) {
+    PetscInt N;
+    PetscCall(MatGetSize(p->A, &N, NULL));
+    /* a small pencil (reduced bodies of few coordinates) may have fewer finite eigenvalues than wanted */
+    PetscCheck(want <= N - 2 * p->nqi, p->sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: %" PetscInt_FMT " modes wanted (%" PetscInt_FMT " mechanism modes + -linearized_nev %" PetscInt_FMT "), but the pencil has %" PetscInt_FMT " velocities and %" PetscInt_FMT " constraint rows, at most %" PetscInt_FMT " modes: lower -linearized_nev (or give the reduced bodies more coordinates)", want, nmech, nev, N - p->nqi, p->nqi, N - 2 * p->nqi);
+    SETERRQ(p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: the eigensolver converged %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs wanted (%" PetscInt_FMT " mechanism modes + -linearized_nev %" PetscInt_FMT "); see -linearized_eps_monitor, -linearized_eps_ncv", nconv, want, nmech, nev);
+  }
   s->n = want;
   PetscCall(PetscCalloc3(want, &s->theta, want, &s->resid, want, &s->growth));
   if (vectors) PetscCall(PetscCalloc1(want, &s->x));
@@ -914,7 +985,7 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
   PetscCall(PhlexSystemGather(sys, p->X, sys->q)); /* the configuration (placements) */
   for (PetscInt i = 0; i < s->n; i++) lambda[i] = s->theta[i];
   /* one scale per mode for the whole assembly: its largest nodal field or frame velocity is 1 (so the bodies' shapes
-     meet at the joints) */
+     meet at the joints; elastic velocities are modal amplitudes, not velocities of points) */
   PetscCall(PetscMalloc1(s->n, &scale));
   for (PetscInt i = 0; i < s->n; i++) {
     Vec       xV, xQ;
@@ -925,7 +996,8 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
     PetscCall(VecGetSubVector(s->x[i], p->isQ, &xQ));
     PetscCall(RootValues(sys->comm, xQ, p->nQ, qv));
     PetscCall(VecRestoreSubVector(s->x[i], p->isQ, &xQ));
-    for (PetscInt k = 0; k < p->nqv; k++) m = PetscMax(m, PetscAbsReal(qv[k]));
+    for (PetscInt k = 0; k < p->nqv; k++)
+      if (sys->qkind[p->Qq[k]] == PHLEX_DOF_VELOCITY) m = PetscMax(m, PetscAbsReal(qv[k]));
     scale[i] = m > 0 ? 1.0 / m : 1.0;
   }
   for (PetscInt f = 0; f < sys->nfparts; f++) {
@@ -961,6 +1033,8 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
     }
     for (PetscInt i = 0; i < s->n; i++) PetscCall(VecDestroy(&vecs[i]));
   }
+  for (PetscInt i = 0; i < sys->nparts; i++)
+    if (!sys->parts[i]->fieldops && PhlexPartIsElastic(sys->parts[i])) PetscCall(PetscPrintf(sys->comm, "  mode shapes of body %s not written: its model (-%stype %s) holds no basis vectors to draw them with\n", sys->parts[i]->name, sys->parts[i]->prefix, sys->parts[i]->type));
   PetscCall(PetscFree4(qv, rigid, lambda, vecs));
   PetscCall(PetscFree(scale));
   PetscFunctionReturn(0);
@@ -1054,18 +1128,11 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(scene->gravity[k], g[k], sizeof(g[k]));
     SETERRQ(scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has gravity (-gravity %s,%s,%s): the analysis linearises about an unloaded configuration at rest", g[0], g[1], g[2]);
   }
-  for (PetscInt k = 0; k < scene->nparts; k++) {
-    /* the pencil keeps the discrete velocities and impulses and drops the configuration: elastic coordinates (a
-       reduced body's stiffness) have no place in it yet */
-    const PhlexPart p = scene->parts[k];
-    for (PetscInt i = 0; i < p->nq; i++)
-      PetscCheck(p->qkind[i] != PHLEX_DOF_ELASTIC, scene->comm, PETSC_ERR_SUP, "linearized analysis: body %s has elastic coordinates (-%stype %s), whose stiffness lies on discrete unknowns: this analysis linearises the field blocks of full bodies only; use -%stype flexible", p->name, p->prefix, p->type, p->prefix);
-  }
   {
     PetscBool flexible = PETSC_FALSE;
     for (PetscInt k = 0; k < scene->nparts; k++)
       if (PhlexPartAnalysisOp(scene->parts[k], modes)) flexible = PETSC_TRUE;
-    PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body; rigid bodies and point masses on joints have no elastic modes about rest");
+    PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body (nor a reduced one); rigid bodies and point masses on joints have no elastic modes about rest");
   }
   PetscCall(PetscMemzero(&p, sizeof(p)));
   p.coriolis = o.coriolis;
@@ -1125,7 +1192,8 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCall(PetscPrintf(scene->comm, " of joint %s (drive position %s to %s %s)", joint->name, a, b, uname));
   }
   PetscCall(PetscPrintf(scene->comm, ", %" PetscInt_FMT " elastic frequencies each\n", o.nev));
-  PetscCall(PetscPrintf(scene->comm, "  pencil: %" PetscInt_FMT " field velocities, %" PetscInt_FMT " discrete velocities, %" PetscInt_FMT " constraint rows (stress eliminated, positions at rest dropped)\n", Nd, p.nqv, p.nqi));
+  if (p.ne) PetscCall(PetscPrintf(scene->comm, "  pencil: %" PetscInt_FMT " field velocities, %" PetscInt_FMT " discrete velocities (%" PetscInt_FMT " elastic), %" PetscInt_FMT " constraint rows (stress and elastic coordinates eliminated, positions at rest dropped)\n", Nd, p.nqv, p.ne, p.nqi));
+  else PetscCall(PetscPrintf(scene->comm, "  pencil: %" PetscInt_FMT " field velocities, %" PetscInt_FMT " discrete velocities, %" PetscInt_FMT " constraint rows (stress eliminated, positions at rest dropped)\n", Nd, p.nqv, p.nqi));
 
   PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_modes.csv", "configuration,position,mode,kind,frequency_hz,omega_rad_s,relative_residual,growth_rate_1_s", &csv));
   PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_sweep.csv", NULL, &sweep));
@@ -1216,7 +1284,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(MatDestroy(&p.Mvv));
   PetscCall(ISDestroy(&p.isV));
   PetscCall(ISDestroy(&p.isQ));
-  PetscCall(PetscFree2(p.qmap, p.Qq));
+  PetscCall(PetscFree3(p.qmap, p.Qq, p.Ee));
   PetscCall(VecDestroy(&p.X));
   PetscCall(VecDestroy(&p.Xdot));
   PetscCall(PhlexSystemDestroy(&p.sys));
