@@ -32,8 +32,8 @@ PETSC_EXTERN const char *const PhlexFieldNames[];
 
 /* What a discrete unknown is: checkpoints name it, adaptive steps leave impulses out of the error norm, the
    consistent start replaces velocities (a frame's and elastic ones) only, the redundancy check and the loop closure
-   move frames only (configuration and velocity of a frame), the linearised analysis keeps velocities and elastic
-   coordinates. Elastic coordinates (a reduced body's eta, u = Phi eta) and their velocities (zeta) are a body's
+   move frames only (configuration and velocity of a frame), the linearised analysis keeps velocities (elastic ones
+   too) and impulses and eliminates elastic coordinates onto their velocities (their stiffness). Elastic coordinates (a reduced body's eta, u = Phi eta) and their velocities (zeta) are a body's
    deformation, not its frame's motion. */
 typedef enum {
   PHLEX_DOF_CONFIGURATION,   /* a frame's position and rotation, a point mass's position */
