@@ -8,16 +8,30 @@
 typedef enum {
   PHLEX_REDUCTION_FREE_INTERFACE, /* the body's own normal modes (clamped at its frame patch, or free on mean axes)
                                      plus the static attachment modes of its ports */
-  PHLEX_REDUCTION_CRAIG_BAMPTON   /* the fixed-interface normal modes (frame patch clamped and every listed port's six
+  PHLEX_REDUCTION_CRAIG_BAMPTON,  /* the fixed-interface normal modes (frame patch clamped and every listed port's six
                                      rigid-average motions held, B_q^T u = 0) plus the static constraint modes of the
                                      ports (unit rigid-average motion of one, the others held, least strain energy) */
+  PHLEX_REDUCTION_KRYLOV          /* moment matching of the ports' transfer function: block Krylov spaces
+                                     K_r((K - w^2 Mv)^{-1} Mv, (K - w^2 Mv)^{-1} B) at given expansion frequencies */
 } PhlexReductionType;
-#define PHLEX_REDUCTION_NTYPES 2
+#define PHLEX_REDUCTION_NTYPES 3
 PETSC_EXTERN const char *const PhlexReductionTypes[];
+
+#define PHLEX_KRYLOV_MAX_FREQUENCIES 16
+
+/* the kind of basis and its parameters (what the provenance records) */
+typedef struct {
+  PhlexReductionType type;
+  PetscInt           nmodes;        /* free_interface, craig_bampton: normal modes in the basis */
+  PetscInt           krylov_order;  /* krylov: block steps per expansion frequency */
+  PetscInt           nfrequencies;  /* krylov: expansion frequencies */
+  PetscBool          krylov_frame_loads; /* krylov: the frame's inertia loads Mv R (and the weight) as inputs too */
+  PetscReal          frequencies[PHLEX_KRYLOV_MAX_FREQUENCIES]; /* [Hz] (SI) */
+} PhlexReduction;
 
 typedef struct {
   PetscInt   m;        /* basis size */
-  PetscInt   nnormal;  /* normal modes among the basis vectors' span */
+  PetscInt   nnormal;  /* normal modes among the basis vectors' span (krylov: none) */
   PetscInt   nports;   /* the full body's listed ports (its port maps follow their order) */
   PetscReal *Mr, *Kr;  /* Phi^T Mv Phi, Phi^T K Phi (m x m, row-major; the basis makes them I and diagonal) */
   PetscReal *S;        /* 3 m: int rho phi_k (component c at 3 k + c) */
@@ -31,11 +45,13 @@ typedef struct {
   PhlexInertia inertia; /* the whole body about P: m, s0, E0, vol, svol */
 } PhlexReducedModel;
 
-PETSC_INTERN PetscErrorCode PhlexReducedBuild(PhlexPart, PhlexReductionType, PetscInt, PhlexReducedModel *);
+PETSC_INTERN PetscErrorCode PhlexReducedBuild(PhlexPart, const PhlexReduction *, PhlexReducedModel *);
 PETSC_INTERN PetscErrorCode PhlexReducedModelDestroy(PhlexReducedModel *);
-PETSC_INTERN PetscErrorCode PhlexReducedWrite(MPI_Comm, const char[], const char[], const PhlexReducedModel *, const PhlexUnits *, const char[]);
+PETSC_INTERN PetscErrorCode PhlexReducedWrite(MPI_Comm, const char[], const char[], const PhlexReducedModel *, const PhlexUnits *, const char[], const PhlexReduction *);
 PETSC_INTERN PetscErrorCode PhlexReducedRead(MPI_Comm, const char[], const char[], const char[], const PhlexUnits *, PhlexReducedModel *);
 PETSC_INTERN PetscErrorCode PhlexReducedModelRoundTrip(PhlexReducedModel *, const PhlexUnits *);
-PETSC_INTERN PetscErrorCode PhlexReducedProvenance(PhlexPart, PhlexReductionType, PetscInt, char[], size_t);
+PETSC_INTERN PetscErrorCode PhlexReducedProvenance(PhlexPart, const PhlexReduction *, char[], size_t);
+PETSC_INTERN PetscErrorCode PhlexReducedViewTransfer(PhlexPart, const PhlexReducedModel *, PetscInt, const PetscReal[]);
+PETSC_INTERN PetscErrorCode PhlexReducedExpectMoments(PhlexPart, const PhlexReduction *, const PhlexReducedModel *, PetscReal);
 
 #endif

@@ -40,6 +40,9 @@ typedef struct {
   PetscViewer        rigid_csv, ports_csv, modal_csv;
   PetscReal          expect_held[64], expect_full[64], expect_rtol; /* self-checks of the basis (-reduction_expect_*) */
   PetscInt           nexpect_held, nexpect_full;
+  PhlexReduction     red;   /* the kind of basis and its parameters (r->type, r->nmodes repeated in it) */
+  PetscReal          view_transfer[64], expect_moments_rtol; /* self-checks of the transfer function */
+  PetscInt           nview_transfer;
 } Reduced;
 
 /* ------------------------------------------------------------------------------------------------------------ */
@@ -50,7 +53,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   Reduced      *r = (Reduced *)part->data;
   PhlexFlexible b;
   PetscInt      type = 0;
-  PetscBool     set_held = PETSC_FALSE, set_full = PETSC_FALSE;
+  PetscBool     set_held = PETSC_FALSE, set_full = PETSC_FALSE, set_modes = PETSC_FALSE, set_order = PETSC_FALSE, set_freq = PETSC_FALSE, set_view = PETSC_FALSE, set_fl = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   /* the full body reads its options under the same prefix: the scene of a reduced body is that of the full one */
@@ -63,10 +66,20 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   r->nmodes  = 10;
   r->expect_rtol  = 1e-6;
   r->nexpect_held = r->nexpect_full = 64;
+  r->nview_transfer          = 64;
+  r->expect_moments_rtol     = 0.0;
+  r->red.krylov_order        = 2;
+  r->red.nfrequencies        = PHLEX_KRYLOV_MAX_FREQUENCIES;
+  r->red.frequencies[0]      = 0.0;
   PetscOptionsBegin(part->comm, part->prefix, "Reduced body options", NULL);
   PetscCall(PetscOptionsString("-reduced_file", "Reduced body file (HDF5): read if it exists (refused if built for another body), else built and written; empty: built in memory at every run", "ReducedSetFromOptions", r->file, r->file, sizeof(r->file), NULL));
-  PetscCall(PetscOptionsEList("-reduction", "Basis of the reduction: free_interface (the body's normal modes with its frame held, plus the static attachment modes of its ports), craig_bampton (the normal modes with its frame and its ports' rigid averages held, plus the static constraint modes of its ports)", "ReducedSetFromOptions", PhlexReductionTypes, PHLEX_REDUCTION_NTYPES, PhlexReductionTypes[type], &type, NULL));
-  PetscCall(PetscOptionsInt("-reduction_modes", "Normal modes in the basis (craig_bampton: fixed-interface modes; the static modes of the ports, six each, come in addition)", "ReducedSetFromOptions", r->nmodes, &r->nmodes, NULL));
+  PetscCall(PetscOptionsEList("-reduction", "Basis of the reduction: free_interface (the body's normal modes with its frame held, plus the static attachment modes of its ports), craig_bampton (the normal modes with its frame and its ports' rigid averages held, plus the static constraint modes of its ports), krylov (moment matching of the ports' transfer function: block Krylov spaces at -reduction_krylov_frequencies)", "ReducedSetFromOptions", PhlexReductionTypes, PHLEX_REDUCTION_NTYPES, PhlexReductionTypes[type], &type, NULL));
+  PetscCall(PetscOptionsInt("-reduction_modes", "Normal modes in the basis (craig_bampton: fixed-interface modes; the static modes of the ports, six each, come in addition)", "ReducedSetFromOptions", r->nmodes, &r->nmodes, &set_modes));
+  PetscCall(PetscOptionsInt("-reduction_krylov_order", "krylov: block steps per expansion frequency (each a block of 6 vectors per listed port; r steps match 2 r moments of the ports' transfer function)", "ReducedSetFromOptions", r->red.krylov_order, &r->red.krylov_order, &set_order));
+  PetscCall(PetscOptionsRealArray("-reduction_krylov_frequencies", "krylov: expansion frequencies [Hz] (0: the static moments, whose first block is the ports' attachment modes)", "ReducedSetFromOptions", r->red.frequencies, &r->red.nfrequencies, &set_freq));
+  PetscCall(PetscOptionsBool("-reduction_krylov_frame_loads", "krylov: the frame's inertia loads on the field (Mv times its six rigid fields: a unit acceleration of the frame, gravity) as inputs beside the ports' loads (6 more vectors per block; not on mean axes)", "ReducedSetFromOptions", r->red.krylov_frame_loads, &r->red.krylov_frame_loads, &set_fl));
+  PetscCall(PetscOptionsRealArray("-reduction_view_transfer", "Self-check: prints the relative error of the reduced ports' transfer function against the full body's at these frequencies [Hz]", "ReducedSetFromOptions", r->view_transfer, &r->nview_transfer, &set_view));
+  PetscCall(PetscOptionsReal("-reduction_expect_moments_rtol", "Self-check (krylov): the first 2 r moments of the ports' transfer function at each expansion frequency equal the full body's within this relative tolerance (0: no check)", "ReducedSetFromOptions", r->expect_moments_rtol, &r->expect_moments_rtol, NULL));
   PetscCall(PetscOptionsRealArray("-reduction_expect_held_frequencies", "Self-check: the full body's frequencies with its frame and ports held [Hz] (craig_bampton: those of its fixed-interface modes, compared within -reduction_expect_rtol)", "ReducedSetFromOptions", r->expect_held, &r->nexpect_held, &set_held));
   PetscCall(PetscOptionsRealArray("-reduction_expect_full_frequencies", "Self-check: the full body's lowest frequencies with its frame held [Hz]: the reduced ones must bound them from above (Rayleigh-Ritz), and with craig_bampton lie below the held ones, which lie below the reduced ones 6 per port further (interlacing)", "ReducedSetFromOptions", r->expect_full, &r->nexpect_full, &set_full));
   PetscCall(PetscOptionsReal("-reduction_expect_rtol", "Relative tolerance of -reduction_expect_held_frequencies, and the slack of the bounds of -reduction_expect_full_frequencies", "ReducedSetFromOptions", r->expect_rtol, &r->expect_rtol, NULL));
@@ -74,6 +87,21 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   if (!set_held) r->nexpect_held = 0;
   if (!set_full) r->nexpect_full = 0;
   r->type = (PhlexReductionType)type;
+  if (!set_view) r->nview_transfer = 0;
+  if (!set_freq) r->red.nfrequencies = 1;
+  r->red.type   = r->type;
+  r->red.nmodes = r->nmodes;
+  if (r->type == PHLEX_REDUCTION_KRYLOV) {
+    PetscCheck(!set_modes, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_modes does not apply to -%sreduction krylov: its basis is %" PetscInt_FMT " block steps (-%sreduction_krylov_order) per expansion frequency (-%sreduction_krylov_frequencies)", part->name, part->prefix, part->prefix, r->red.krylov_order, part->prefix, part->prefix);
+    PetscCheck(b->nports > 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction krylov matches the transfer function of the listed ports (-%sports): the body has none, and its frame patch alone is held, no input; list a port or choose -%sreduction free_interface", part->name, part->prefix, part->prefix, part->prefix);
+    PetscCheck(!r->red.krylov_frame_loads || !(b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES), part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_krylov_frame_loads: on mean axes the frame's inertia loads have no elastic response (the field is held Mv-orthogonal to the rigid fields)", part->name, part->prefix);
+    PetscCheck(r->red.krylov_order >= 1, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_krylov_order must be >= 1, got %" PetscInt_FMT, part->name, part->prefix, r->red.krylov_order);
+    PetscCheck(r->red.nfrequencies >= 1, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_krylov_frequencies: give at least one frequency [Hz]", part->name, part->prefix);
+    for (PetscInt i = 0; i < r->red.nfrequencies; i++) PetscCheck(r->red.frequencies[i] >= 0.0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_krylov_frequencies: frequency %" PetscInt_FMT " is %g Hz, must be >= 0", part->name, part->prefix, i + 1, (double)r->red.frequencies[i]);
+  } else {
+    PetscCheck(!set_order && !set_freq && !set_fl, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%s%s applies to -%sreduction krylov, not %s", part->name, part->prefix, set_order ? "reduction_krylov_order" : (set_freq ? "reduction_krylov_frequencies" : "reduction_krylov_frame_loads"), part->prefix, PhlexReductionTypes[r->type]);
+    PetscCheck(r->expect_moments_rtol == 0.0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_expect_moments_rtol checks a Krylov basis's moments (-%sreduction krylov), not %s", part->name, part->prefix, part->prefix, PhlexReductionTypes[r->type]);
+  }
   PetscCheck(r->nmodes >= 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_modes must be >= 0, got %" PetscInt_FMT, part->name, part->prefix, r->nmodes);
   PetscCheck(b->floating || b->frame_patch[0], part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced fixed body needs the clamp of its frame (-%sframe_patch <surface>): a free fixed body has no reduced model", part->name, part->prefix);
   PetscCheck(!b->stiffening && !b->spinning, part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced body has no %s (its basis is that of the linear body at rest, and the stiffening would need the stress of every basis pair): use the full body (-%stype flexible)", part->name, b->stiffening ? "geometric stiffening (-geometric_stiffening)" : "prescribed spin (-spin)", part->prefix);
@@ -156,7 +184,7 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   PetscCall((*r->full->ops.setup)(r->full));
   b = r->fb;
   PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", part->name));
-  PetscCall(PhlexReducedProvenance(r->full, r->type, r->nmodes, prov, sizeof(prov)));
+  PetscCall(PhlexReducedProvenance(r->full, &r->red, prov, sizeof(prov)));
   if (r->file[0]) {
     /* rank 0 decides, so that every process reads or every process builds */
     PetscMPIInt rank;
@@ -166,15 +194,17 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   }
   if (exists) PetscCall(PhlexReducedRead(part->comm, r->file, who, prov, part->units, &r->md));
   else {
-    PetscCall(PhlexReducedBuild(r->full, r->type, r->nmodes, &r->md));
+    PetscCall(PhlexReducedBuild(r->full, &r->red, &r->md));
     PetscCall(PhlexReducedModelRoundTrip(&r->md, part->units));
     r->built = PETSC_TRUE;
-    if (r->file[0]) PetscCall(PhlexReducedWrite(part->comm, r->file, part->name, &r->md, part->units, prov));
+    if (r->file[0]) PetscCall(PhlexReducedWrite(part->comm, r->file, part->name, &r->md, part->units, prov, &r->red));
   }
   PetscCheck(r->md.nports == b->nports, part->comm, PETSC_ERR_PLIB, "body %s: the reduced model has %" PetscInt_FMT " ports, the body %" PetscInt_FMT, part->name, r->md.nports, b->nports);
   m = r->m      = r->md.m;
   r->nports     = b->nports;
   PetscCall(ReducedExpectFrequencies(part, r));
+  if (r->nview_transfer) PetscCall(PhlexReducedViewTransfer(r->full, &r->md, r->nview_transfer, r->view_transfer));
+  if (r->expect_moments_rtol > 0.0) PetscCall(PhlexReducedExpectMoments(r->full, &r->red, &r->md, r->expect_moments_rtol));
   r->floating   = b->floating;
   r->full_inertia = (PetscBool)(b->floating && !b->frozen_inertia);
   r->ie         = r->floating ? 18 : 0;
@@ -247,7 +277,15 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
   const PhlexUnits *u = part->units;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " %s modes and the %s modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "fixed-interface" : "normal", r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "constraint" : "attachment", r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
+  if (r->type == PHLEX_REDUCTION_KRYLOV) {
+    char   at[32 * PHLEX_KRYLOV_MAX_FREQUENCIES] = "";
+    size_t n;
+    for (PetscInt i = 0; i < r->red.nfrequencies; i++) {
+      PetscCall(PetscStrlen(at, &n));
+      PetscCall(PetscSNPrintf(at + n, sizeof(at) - n, "%s%.6g", i ? ", " : "", (double)r->red.frequencies[i]));
+    }
+    PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (krylov basis: %" PetscInt_FMT " block steps at %s Hz from the load vectors of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, r->red.krylov_order, at, r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
+  } else PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " %s modes and the %s modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "fixed-interface" : "normal", r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "constraint" : "attachment", r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PetscViewerASCIIPrintf(viewer, "the full body it reduces:\n"));
   PetscCall(PetscViewerASCIIPushTab(viewer));
@@ -255,7 +293,7 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscCall(ViewFrequencies(viewer, "reduced frequencies [Hz]:", r->m, r->md.lambda, u));
   if (r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports) PetscCall(ViewFrequencies(viewer, "full body's frequencies with its ports held (the fixed-interface modes in the basis) [Hz]:", r->md.nnormal, r->md.lambda_full, u));
-  else PetscCall(ViewFrequencies(viewer, "full body's frequencies of the normal modes in the basis [Hz]:", r->md.nnormal, r->md.lambda_full, u));
+  else if (r->type != PHLEX_REDUCTION_KRYLOV) PetscCall(ViewFrequencies(viewer, "full body's frequencies of the normal modes in the basis [Hz]:", r->md.nnormal, r->md.lambda_full, u));
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscFunctionReturn(0);
 }

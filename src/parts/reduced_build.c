@@ -14,6 +14,22 @@
    held, B^T u = 0; FixedInterfaceModes) plus the ports' constraint modes (CraigBamptonVectors); the same
    orthonormalisation and Rayleigh-Ritz step. A body without listed ports gets the free-interface basis.
 
+   Basis (krylov): moment matching of the ports' transfer function (KrylovVectors). With the frame held, the field's
+   dynamics under the port wrenches w is Mv u'' + K u = B w (B = [b->ports[q].dist[d]], the load vectors whose
+   transposes give the rigid averages, the collocated outputs y = B^T u'), so H(s) = s G(s^2) with the dynamic
+   compliance G(mu) = B^T (mu Mv + K)^{-1} B. About an expansion frequency w0 (mu0 = -w0^2, A0 = K - w0^2 Mv),
+   G(mu) = sum_j (-(mu - mu0))^j B^T (A0^{-1} Mv)^j A0^{-1} B; the block Krylov space K_r(A0^{-1} Mv, A0^{-1} B) holds
+   the vectors of the first r moments, and a Galerkin projection on it (V^T Mv V, V^T K V, V^T B: the same V on the
+   input and output sides, the collocation of phlex's ports) matches the first 2 r moments of G at mu0: Bai and Su's
+   structure-preserving second-order Arnoldi (SOAR, SIAM J. Sci. Comput. 26 (2005) 1692) and Freund's
+   Pade-via-Krylov for symmetric second-order systems (Freund, "Pade-type model reduction of second-order and
+   higher-order linear dynamical systems", 2005): a one-sided congruence projection of a symmetric system matches
+   twice the moments of the one-sided space. The error H - H_r is then O((s - s0)^{2 r}) about s0 = i w0 (about 0:
+   O(s^{4 r + 1}), G being a function of s^2). The default expansion is 0 Hz: the Krylov space of K^{-1} Mv from
+   K^{-1} B, whose first block is the ports' static attachment modes. On mean axes (K singular) the loads lose their
+   rigid resultant and the fields their rigid content as in AttachmentModes (the frame held on mean axes: the field
+   constrained to int rho u = 0, int rho x x u = 0). The projection keeps the pH structure like the other bases.
+
    Projection: a Galerkin projection keeps the port-Hamiltonian structure (reduced mass Phi^T Mv Phi symmetric positive
    definite, the interconnection skew, the port maps B_q^T Phi and their transposes), so a lossless reduced body keeps
    its quadratic energy under the implicit midpoint rule like the full one. The floating frame needs the inertia
@@ -23,7 +39,7 @@
 #include <private/reduced.h>
 #include <petscviewerhdf5.h>
 
-const char *const PhlexReductionTypes[] = {"free_interface", "craig_bampton", "PhlexReductionType", "PHLEX_REDUCTION_", NULL};
+const char *const PhlexReductionTypes[] = {"free_interface", "craig_bampton", "krylov", "PhlexReductionType", "PHLEX_REDUCTION_", NULL};
 
 /* the rigid fields of the body's velocity space, Mv-orthonormal (mean axes) */
 static PetscErrorCode RigidFields(PhlexFlexible b, Vec R[6])
@@ -304,6 +320,221 @@ static PetscErrorCode FixedInterfaceModes(PhlexPart part, PetscInt nmodes, Petsc
   PetscFunctionReturn(0);
 }
 
+/* A solver of (K - omega^2 Mv) x = f on the field space with the frame held: MUMPS (LDL^T for an indefinite
+   matrix, above the first frequency), options prefix <body>reduction_. On mean axes the load loses its rigid
+   resultant (f - Mv R R^T f) and the solution its rigid content; at omega = 0 K is singular there and the solve takes
+   K + lambda1 Mv with refinements on K, as AttachmentModes (the inertia-relief static solve). */
+typedef struct {
+  PhlexFlexible b;
+  PetscBool     mean_axes, relief;
+  Mat           A;
+  KSP           ksp;
+  Vec           R[6], f, r, dx, work;
+} ShiftedSolver;
+
+static PetscErrorCode ShiftedSolverCreate(PhlexPart part, PetscReal omega2, PetscReal lambda1, ShiftedSolver *s)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PC            pc;
+  PetscReal     shift;
+  char          prefix[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(s, sizeof(*s)));
+  s->b         = b;
+  s->mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
+  s->relief    = (s->mean_axes && omega2 == 0.0) ? PETSC_TRUE : PETSC_FALSE;
+  shift        = s->relief ? lambda1 : -omega2;
+  PetscCall(MatDuplicate(b->K, MAT_COPY_VALUES, &s->A));
+  if (shift != 0.0) PetscCall(MatAXPY(s->A, shift, b->Mv, DIFFERENT_NONZERO_PATTERN));
+  PetscCall(MatSetOption(s->A, MAT_SYMMETRIC, PETSC_TRUE));
+  if (shift < 0.0) PetscCall(MatSetOption(s->A, MAT_SPD, PETSC_FALSE));
+  if (s->mean_axes) PetscCall(RigidFields(b, s->R));
+  PetscCall(KSPCreate(b->comm, &s->ksp));
+  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sreduction_", part->prefix));
+  PetscCall(KSPSetOptionsPrefix(s->ksp, prefix));
+  PetscCall(KSPSetOperators(s->ksp, s->A, s->A));
+  PetscCall(KSPSetType(s->ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(s->ksp, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(KSPSetFromOptions(s->ksp));
+  PetscCall(MatCreateVecs(b->Mv, &s->f, NULL));
+  PetscCall(VecDuplicate(s->f, &s->r));
+  PetscCall(VecDuplicate(s->f, &s->dx));
+  PetscCall(VecDuplicate(s->f, &s->work));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ShiftedSolverDestroy(ShiftedSolver *s)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 6; k++) PetscCall(VecDestroy(&s->R[k]));
+  PetscCall(VecDestroy(&s->f));
+  PetscCall(VecDestroy(&s->r));
+  PetscCall(VecDestroy(&s->dx));
+  PetscCall(VecDestroy(&s->work));
+  PetscCall(KSPDestroy(&s->ksp));
+  PetscCall(MatDestroy(&s->A));
+  PetscFunctionReturn(0);
+}
+
+/* x = (K - omega^2 Mv)^{-1} rhs (x created), one refinement step. On mean axes at omega = 0: refinements on K (each
+   divides the error in mode i by 1 + lambda_i / lambda1 >= 2) until the residual is 1e-12 of the load, as
+   AttachmentModes, or it stops falling at round-off (three refinements in a row without falling below 3/4 of the
+   smallest so far, 2-norm): the later Krylov blocks' loads Mv x are smooth, their solutions large, and their
+   residuals stall above 1e-12 ||f|| (observed on the crank-slider's coupler: the residual halving at each refinement
+   down to a normwise backward error ||f - K x|| / (||K|| ||x|| + ||f||) of 5e-17 after 28). Not earlier: a backward
+   error of 1e-14 still leaves the lowest mode's error up to ||K|| / lambda1 times larger in the solution (the
+   moments were off by 1e-6 so). Refused if the backward error (infinity norms) is then above 1e-13. */
+static PetscErrorCode ShiftedSolverSolve(ShiftedSolver *s, Vec rhs, Vec *x)
+{
+  PhlexFlexible b = s->b;
+  Mat           op = s->relief ? b->K : s->A;
+  PetscReal     fn, rn = 0.0, kn = 0.0, xn = 0.0, rmin = PETSC_MAX_REAL;
+  PetscInt      it, stall = 0;
+
+  PetscFunctionBeginUser;
+  if (s->relief) PetscCall(MatNorm(b->K, NORM_INFINITY, &kn));
+  PetscCall(VecCopy(rhs, s->f));
+  if (s->mean_axes) {
+    PetscScalar c[6];
+    PetscCall(VecMDot(s->f, 6, s->R, c));
+    PetscCall(VecSet(s->work, 0.0));
+    PetscCall(VecMAXPY(s->work, 6, c, s->R));
+    PetscCall(MatMult(b->Mv, s->work, s->r));
+    PetscCall(VecAXPY(s->f, -1.0, s->r)); /* f - Mv R R^T f: no resultant */
+  }
+  PetscCall(VecDuplicate(s->f, x));
+  PetscCall(KSPSolve(s->ksp, s->f, *x));
+  PetscCall(VecNorm(s->f, NORM_INFINITY, &fn));
+  for (it = 0; it < (s->relief ? 200 : 1); it++) {
+    if (s->mean_axes) PetscCall(RemoveRigid(b, s->R, *x, s->work));
+    PetscCall(MatMult(op, *x, s->r));
+    PetscCall(VecAYPX(s->r, -1.0, s->f));
+    PetscCall(VecNorm(s->r, NORM_INFINITY, &rn));
+    PetscCall(VecNorm(*x, NORM_INFINITY, &xn));
+    if (s->relief) {
+      PetscReal r2;
+      PetscCall(VecNorm(s->r, NORM_2, &r2));
+      stall = r2 > 0.75 * rmin ? stall + 1 : 0;
+      rmin  = PetscMin(rmin, r2);
+      if (rn <= 1e-12 * fn || stall >= 3) break;
+    }
+    PetscCall(KSPSolve(s->ksp, s->r, s->dx));
+    PetscCall(VecAXPY(*x, 1.0, s->dx));
+  }
+  PetscCheck(!s->relief || rn <= 1e-12 * fn || rn <= 1e-13 * (kn * xn + fn), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: a static solve of the Krylov reduction did not converge on mean axes (backward error %g after %" PetscInt_FMT " refinements)", b->name, (double)(rn / (kn * xn + fn)), it);
+  if (s->mean_axes) PetscCall(RemoveRigid(b, s->R, *x, s->work));
+  PetscFunctionReturn(0);
+}
+
+/* the first free elastic eigenvalue of a body on mean axes (the shift of its static solves), else 0 */
+static PetscErrorCode ReliefShift(PhlexPart part, PetscReal *lambda1)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscInt      nconv, nrigid;
+  PetscReal    *lam;
+
+  PetscFunctionBeginUser;
+  *lambda1 = 0.0;
+  if (!(b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES)) PetscFunctionReturn(0);
+  PetscCall(PhlexFlexibleComputeModes(part, 1, &nconv, &nrigid, &lam, NULL, NULL, NULL));
+  PetscCheck(nconv > 6, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the first free elastic mode did not converge", b->name);
+  *lambda1 = lam[6];
+  PetscCall(PetscFree(lam));
+  PetscFunctionReturn(0);
+}
+
+/* The Krylov vectors (paper Section 5.3; the moment matching in the comment at the top): at each expansion frequency
+   w0 the blocks X_0 = A0^{-1} B, X_j = A0^{-1} Mv X_{j-1} (j < order), each block Mv-orthogonalised against every vector
+   kept so far (this point's and the previous points'; classical Gram-Schmidt, twice), the next block formed from the
+   orthonormalised one (block Arnoldi: the same space as the powers, without their loss of rank). A vector whose Mv-norm
+   falls below 1e-8 of its own before the orthogonalisation is dependent (a port load already spanned, or a converged
+   direction: what is left of it is the solves' round-off, relative 1e-12 or less, amplified by the cancellation) and is
+   dropped (deflation: the space is the same, the block smaller). */
+static PetscErrorCode KrylovVectors(PhlexPart part, const PhlexReduction *red, Vec **Phi, PetscInt *nb)
+{
+  PhlexFlexible     b = (PhlexFlexible)part->data;
+  const PhlexUnits *u = part->units;
+  const PetscInt    nz = 6 * b->nports, nin = nz + (red->krylov_frame_loads ? 6 : 0), cap = nin * red->krylov_order * red->nfrequencies;
+  PetscReal         lambda1 = 0.0;
+  PetscInt          ndrop = 0;
+  Vec              *MPhi, *rhs, R[6] = {NULL};
+  PetscScalar      *d;
+
+  PetscFunctionBeginUser;
+  PetscCheck(nz > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction krylov matches the transfer function of the listed ports (-%sports): the body has none (the frame patch alone is held, no input)", b->name, b->prefix, b->prefix);
+  for (PetscInt i = 0; i < red->nfrequencies; i++)
+    if (red->frequencies[i] == 0.0) PetscCall(ReliefShift(part, &lambda1));
+  PetscCall(PetscMalloc1(cap, Phi));
+  PetscCall(PetscMalloc3(cap, &MPhi, nin, &rhs, cap, &d));
+  if (red->krylov_frame_loads) {
+    /* the frame's inertia loads on the field (and a fixed body's weight): Mv times the rigid fields, the loads of a
+       unit acceleration of the frame; on mean axes they have no elastic response (refused by the options) */
+    PetscCheck(!(b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES), b->comm, PETSC_ERR_SUP, "body %s: -%sreduction_krylov_frame_loads: on mean axes the frame's inertia loads have no elastic response", b->name, b->prefix);
+    PetscCall(RigidFields(b, R));
+    for (PetscInt k = 0; k < 6; k++) {
+      Vec x;
+      PetscCall(VecDuplicate(R[k], &x));
+      PetscCall(MatMult(b->Mv, R[k], x));
+      PetscCall(VecDestroy(&R[k]));
+      R[k] = x;
+    }
+  }
+  *nb = 0;
+  for (PetscInt i = 0; i < red->nfrequencies; i++) {
+    const PetscReal omega = 2 * PETSC_PI * red->frequencies[i] * u->time;
+    ShiftedSolver   solver;
+    PetscInt        nrhs = nin, kept = 0;
+
+    PetscCall(ShiftedSolverCreate(part, omega * omega, lambda1, &solver));
+    for (PetscInt q = 0; q < b->nports; q++)
+      for (PetscInt c = 0; c < 6; c++) rhs[6 * q + c] = b->ports[q].dist[c];
+    for (PetscInt k = nz; k < nin; k++) rhs[k] = R[k - nz];
+    for (PetscInt step = 0; step < red->krylov_order && nrhs > 0; step++) {
+      const PetscInt first = *nb;
+      for (PetscInt j = 0; j < nrhs; j++) {
+        Vec       x;
+        PetscReal n0, n1;
+        PetscCall(ShiftedSolverSolve(&solver, rhs[j], &x));
+        PetscCall(MatMult(b->Mv, x, solver.work));
+        PetscCall(VecDot(x, solver.work, &d[0]));
+        n0 = PetscSqrtReal(PetscRealPart(d[0]));
+        for (PetscInt pass = 0; pass < 2 && *nb > 0; pass++) {
+          PetscCall(VecMDot(x, *nb, MPhi, d));
+          for (PetscInt k = 0; k < *nb; k++) d[k] = -d[k];
+          PetscCall(VecMAXPY(x, *nb, d, *Phi));
+        }
+        PetscCall(MatMult(b->Mv, x, solver.work));
+        PetscCall(VecDot(x, solver.work, &d[0]));
+        n1 = PetscSqrtReal(PetscRealPart(d[0]));
+        if (!(n1 > 1e-8 * n0)) {
+          PetscCall(PetscInfo(NULL, "body %s: Krylov vector %" PetscInt_FMT " of block %" PetscInt_FMT " at %.6g Hz dropped (relative norm %g after the orthogonalisation)\n", b->name, j, step, (double)red->frequencies[i], (double)(n1 / n0)));
+          PetscCall(VecDestroy(&x));
+          ndrop++;
+          continue;
+        }
+        PetscCall(VecScale(x, 1.0 / n1));
+        PetscCall(VecDuplicate(x, &MPhi[*nb]));
+        PetscCall(MatMult(b->Mv, x, MPhi[*nb]));
+        (*Phi)[(*nb)++] = x;
+      }
+      /* the next block: A0^{-1} Mv applied to this block's orthonormalised vectors */
+      nrhs = *nb - first;
+      for (PetscInt j = 0; j < nrhs; j++) rhs[j] = MPhi[first + j];
+      kept += nrhs;
+    }
+    PetscCall(PetscInfo(NULL, "body %s: %" PetscInt_FMT " Krylov vectors at %.6g Hz\n", b->name, kept, (double)red->frequencies[i]));
+    PetscCall(ShiftedSolverDestroy(&solver));
+  }
+  PetscCall(PetscInfo(NULL, "body %s: %" PetscInt_FMT " Krylov vectors, %" PetscInt_FMT " dropped\n", b->name, *nb, ndrop));
+  for (PetscInt k = 0; k < *nb; k++) PetscCall(VecDestroy(&MPhi[k]));
+  for (PetscInt k = 0; k < 6; k++) PetscCall(VecDestroy(&R[k]));
+  PetscCall(PetscFree3(MPhi, rhs, d));
+  PetscFunctionReturn(0);
+}
+
 /* The Craig-Bampton vectors of a body with listed ports: nmodes fixed-interface modes, then the ports' static modes.
    Clamped at the frame patch (K SPD) the static modes are the constraint modes: the field of least strain energy with
    the rigid averages B^T psi = e_j (unit motion of one port component, every other held), psi = Z S^{-1} with
@@ -397,11 +628,13 @@ static PetscErrorCode CraigBamptonVectors(PhlexPart part, PetscInt nmodes, Vec *
 
   Input Parameters:
 + part    - the full flexible body
-. type    - the kind of basis
-- nmodes  - normal modes in the basis (the ports' attachment modes come in addition)
+- red     - the kind of basis and its parameters (free_interface, craig_bampton: the normal modes in the basis, the
+            ports' static modes coming in addition; krylov: the block steps and expansion frequencies)
 @*/
-PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscInt nmodes, PhlexReducedModel *model)
+PetscErrorCode PhlexReducedBuild(PhlexPart part, const PhlexReduction *red, PhlexReducedModel *model)
 {
+  const PhlexReductionType type   = red->type;
+  const PetscInt           nmodes = red->nmodes;
   PhlexFlexible   b         = (PhlexFlexible)part->data;
   const PetscBool mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
   PetscInt        nconv, nrigid, npsi, nb = 0, m;
@@ -410,7 +643,11 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, PhlexReductionType type, PetscI
   PetscBool       floating = b->floating;
 
   PetscFunctionBeginUser;
-  if (type == PHLEX_REDUCTION_CRAIG_BAMPTON && b->nports) {
+  if (type == PHLEX_REDUCTION_KRYLOV) {
+    model->nnormal = 0;
+    PetscCall(PetscMalloc1(1, &model->lambda_full));
+    PetscCall(KrylovVectors(part, red, &Phi, &nb));
+  } else if (type == PHLEX_REDUCTION_CRAIG_BAMPTON && b->nports) {
     /* with no listed port the fixed interface is the frame patch alone (or nothing, on mean axes): free_interface's
        basis, which is then Craig-Bampton's */
     model->nnormal = nmodes;
@@ -646,8 +883,10 @@ static PetscErrorCode FileHash(MPI_Comm comm, const char path[], unsigned long l
 
   Collective
 @*/
-PetscErrorCode PhlexReducedProvenance(PhlexPart part, PhlexReductionType type, PetscInt nmodes, char buf[], size_t len)
+PetscErrorCode PhlexReducedProvenance(PhlexPart part, const PhlexReduction *red, char buf[], size_t len)
 {
+  const PhlexReductionType type   = red->type;
+  const PetscInt           nmodes = red->nmodes;
   PhlexFlexible      b = (PhlexFlexible)part->data;
   unsigned long long hash;
   long long          size;
@@ -677,7 +916,15 @@ PetscErrorCode PhlexReducedProvenance(PhlexPart part, PhlexReductionType type, P
     PetscReal ft  = 0.0;
     PetscBool set = PETSC_FALSE;
     PetscCall(PetscOptionsGetReal(NULL, NULL, "-modes_target_frequency", &ft, &set));
-    if (type == PHLEX_REDUCTION_CRAIG_BAMPTON && b->nports) PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " fixed-interface modes from 0 Hz", PhlexReductionTypes[type], nmodes));
+    if (type == PHLEX_REDUCTION_KRYLOV) {
+      PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " block steps at ", PhlexReductionTypes[type], red->krylov_order));
+      for (PetscInt i = 0; i < red->nfrequencies; i++) {
+        PetscCall(PetscStrlen(buf, &n));
+        PetscCall(PetscSNPrintf(buf + n, len - n, "%s%.15g", i ? "," : "", (double)red->frequencies[i]));
+      }
+      PetscCall(PetscStrlen(buf, &n));
+      PetscCall(PetscSNPrintf(buf + n, len - n, " Hz%s", red->krylov_frame_loads ? ", with the frame's inertia loads" : ""));
+    } else if (type == PHLEX_REDUCTION_CRAIG_BAMPTON && b->nports) PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " fixed-interface modes from 0 Hz", PhlexReductionTypes[type], nmodes));
     else PetscCall(PetscSNPrintf(buf + n, len - n, "; reduction=%s, %" PetscInt_FMT " normal modes %s %.15g Hz", PhlexReductionTypes[type], nmodes, set ? "nearest" : "from", set ? (double)ft : 0.0));
   }
   PetscFunctionReturn(0);
@@ -724,7 +971,7 @@ static PetscErrorCode WriteScaled(PetscViewer v, const char name[], PetscInt n, 
 
   Collective
 @*/
-PetscErrorCode PhlexReducedWrite(MPI_Comm comm, const char path[], const char body[], const PhlexReducedModel *md, const PhlexUnits *u, const char provenance[])
+PetscErrorCode PhlexReducedWrite(MPI_Comm comm, const char path[], const char body[], const PhlexReducedModel *md, const PhlexUnits *u, const char provenance[], const PhlexReduction *red)
 {
   PetscViewer   v;
   char          tmp[PETSC_MAX_PATH_LEN], when[64];
@@ -743,6 +990,11 @@ PetscErrorCode PhlexReducedWrite(MPI_Comm comm, const char path[], const char bo
   PetscCall(PhlexCheckpointWriteInt(v, "/reduced", "basis_size", m));
   PetscCall(PhlexCheckpointWriteInt(v, "/reduced", "normal_modes", md->nnormal));
   PetscCall(PhlexCheckpointWriteInt(v, "/reduced", "ports", np));
+  PetscCall(PhlexCheckpointWriteString(v, "/reduced", "reduction", PhlexReductionTypes[red->type]));
+  if (red->type == PHLEX_REDUCTION_KRYLOV) {
+    PetscCall(PhlexCheckpointWriteInt(v, "/reduced", "krylov_order", red->krylov_order));
+    PetscCall(PhlexCheckpointWriteReals(v, "/reduced", "krylov_frequencies", red->nfrequencies, red->frequencies)); /* Hz */
+  }
   PetscCall(WriteScaled(v, "mass", m * m, md->Mr, f.M));
   PetscCall(WriteScaled(v, "stiffness", m * m, md->Kr, f.K));
   PetscCall(WriteScaled(v, "int_rho_phi", 3 * m, md->S, f.S));
@@ -909,5 +1161,166 @@ PetscErrorCode PhlexReducedModelRoundTrip(PhlexReducedModel *md, const PhlexUnit
   RoundTrip(9, md->inertia.E0, f.E0);
   RoundTrip(1, &md->inertia.vol, f.vol);
   RoundTrip(3, md->inertia.svol, f.svol);
+  PetscFunctionReturn(0);
+}
+
+/* ------------------------------------------------------------------------------------------------------------ */
+/* Self-checks of the ports' transfer function: the dynamic compliance G(-w^2) = B^T (K - w^2 Mv)^{-1} B (H(i w) =
+   i w G: the same relative error for w > 0, and G is H's limit over i w at 0) of the full body (sparse solves) and of
+   the reduced one (P (Kr - w^2 Mr)^{-1} P^T, dense), and their moments about the Krylov expansion frequencies.       */
+
+/* C <- (Kr - sigma Mr)^{-1} C (m x nc, column-major) */
+static PetscErrorCode ReducedSolve(MPI_Comm comm, const PhlexReducedModel *md, PetscReal sigma, PetscInt nc, PetscReal *C)
+{
+  const PetscInt m = md->m;
+  PetscReal     *A;
+  PetscBLASInt   bm, bn, info, *ipiv;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc2(m * m, &A, m, &ipiv));
+  for (PetscInt i = 0; i < m; i++)
+    for (PetscInt j = 0; j < m; j++) A[i + m * j] = md->Kr[m * i + j] - sigma * md->Mr[m * i + j];
+  PetscCall(PetscBLASIntCast(m, &bm));
+  PetscCall(PetscBLASIntCast(nc, &bn));
+  PetscCallBLAS("LAPACKgesv", LAPACKgesv_(&bm, &bn, A, &bm, ipiv, C, &bm, &info));
+  PetscCheck(!info, comm, PETSC_ERR_LIB, "the reduced dynamic stiffness is singular at this frequency (LAPACK gesv info %d)", (int)info);
+  PetscCall(PetscFree2(A, ipiv));
+  PetscFunctionReturn(0);
+}
+
+/* Gr = P C (nz x nz, column-major) from C (m x nz) */
+static void ReducedOutputs(const PhlexReducedModel *md, const PetscReal *C, PetscReal *Gr)
+{
+  const PetscInt m = md->m, nz = 6 * md->nports;
+  for (PetscInt a = 0; a < nz; a++)
+    for (PetscInt c = 0; c < nz; c++) {
+      PetscReal s = 0.0;
+      for (PetscInt k = 0; k < m; k++) s += md->P[m * a + k] * C[k + m * c];
+      Gr[a + nz * c] = s;
+    }
+}
+
+/* max_ab |G_ab - Gr_ab| / sqrt(|G_aa G_bb|): a relative error that the ports' units (forces and moments, lengths and
+   angles) do not change (G -> D G D for any diagonal scaling D) */
+static PetscReal ScaledError(PetscInt nz, const PetscReal *G, const PetscReal *Gr)
+{
+  PetscReal e = 0.0;
+  for (PetscInt a = 0; a < nz; a++)
+    for (PetscInt c = 0; c < nz; c++) {
+      const PetscReal s = PetscSqrtReal(PetscAbsReal(G[a + nz * a] * G[c + nz * c]));
+      e                 = PetscMax(e, PetscAbsReal(G[a + nz * c] - Gr[a + nz * c]) / PetscMax(s, PETSC_SMALL * PETSC_SMALL));
+    }
+  return e;
+}
+
+/*@C
+  PhlexReducedViewTransfer - prints the relative error of the reduced ports' transfer function against the full body's
+  at given frequencies (self-check -reduction_view_transfer)
+
+  Collective
+
+  Input Parameters:
++ part - the full flexible body (set up)
+. md   - the reduced model
+. nf   - number of frequencies
+- f    - the frequencies [Hz]
+@*/
+PetscErrorCode PhlexReducedViewTransfer(PhlexPart part, const PhlexReducedModel *md, PetscInt nf, const PetscReal f[])
+{
+  PhlexFlexible  b  = (PhlexFlexible)part->data;
+  const PetscInt nz = 6 * b->nports, m = md->m;
+  PetscReal      lambda1 = 0.0, *G, *Gr, *C;
+  Vec           *X;
+
+  PetscFunctionBeginUser;
+  PetscCheck(nz > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_view_transfer: the body has no listed ports (-%sports), no transfer function", b->name, b->prefix, b->prefix);
+  for (PetscInt i = 0; i < nf; i++)
+    if (f[i] == 0.0) PetscCall(ReliefShift(part, &lambda1));
+  PetscCall(PetscMalloc4(nz * nz, &G, nz * nz, &Gr, m * nz, &C, nz, &X));
+  for (PetscInt i = 0; i < nf; i++) {
+    const PetscReal omega = 2 * PETSC_PI * f[i] * part->units->time;
+    ShiftedSolver   solver;
+    PetscCall(ShiftedSolverCreate(part, omega * omega, lambda1, &solver));
+    for (PetscInt q = 0; q < b->nports; q++)
+      for (PetscInt d = 0; d < 6; d++) PetscCall(ShiftedSolverSolve(&solver, b->ports[q].dist[d], &X[6 * q + d]));
+    PetscCall(InterfaceValues(b, nz, X, G));
+    for (PetscInt k = 0; k < nz; k++) PetscCall(VecDestroy(&X[k]));
+    PetscCall(ShiftedSolverDestroy(&solver));
+    for (PetscInt a = 0; a < nz; a++)
+      for (PetscInt k = 0; k < m; k++) C[k + m * a] = md->P[m * a + k];
+    PetscCall(ReducedSolve(b->comm, md, omega * omega, nz, C));
+    ReducedOutputs(md, C, Gr);
+    PetscCall(PetscPrintf(b->comm, "body %s: ports' transfer function at %.6g Hz: reduced against full, rel. error %.2e\n", b->name, (double)f[i], (double)ScaledError(nz, G, Gr)));
+  }
+  PetscCall(PetscFree4(G, Gr, C, X));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexReducedExpectMoments - self-check of a Krylov basis (-reduction_expect_moments_rtol): at each expansion
+  frequency w0 the reduced model's moments of the ports' dynamic compliance, B^T (A0^{-1} Mv)^j A0^{-1} B with
+  A0 = K - w0^2 Mv (the Taylor coefficients of G in s^2 about -w0^2, up to the sign and j!), equal the full body's for
+  j < 2 r (r block steps) within rtol; fails otherwise. Prints the verdict and the relative error of moment 2 r, the
+  first that the basis does not match in general.
+
+  Collective
+@*/
+PetscErrorCode PhlexReducedExpectMoments(PhlexPart part, const PhlexReduction *red, const PhlexReducedModel *md, PetscReal rtol)
+{
+  PhlexFlexible  b  = (PhlexFlexible)part->data;
+  const PetscInt nz = 6 * b->nports, m = md->m, r = red->krylov_order;
+  PetscReal      lambda1 = 0.0, *G, *Gr, *C, *C2;
+  Vec           *X, *MX;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < red->nfrequencies; i++)
+    if (red->frequencies[i] == 0.0) PetscCall(ReliefShift(part, &lambda1));
+  PetscCall(PetscMalloc4(nz * nz, &G, nz * nz, &Gr, m * nz, &C, m * nz, &C2));
+  PetscCall(PetscMalloc2(nz, &X, nz, &MX));
+  for (PetscInt i = 0; i < red->nfrequencies; i++) {
+    const PetscReal omega = 2 * PETSC_PI * red->frequencies[i] * part->units->time, sigma = omega * omega;
+    ShiftedSolver   solver;
+    PetscReal       worst = 0.0, last = 0.0;
+    PetscCall(ShiftedSolverCreate(part, sigma, lambda1, &solver));
+    for (PetscInt q = 0; q < b->nports; q++)
+      for (PetscInt d = 0; d < 6; d++) PetscCall(ShiftedSolverSolve(&solver, b->ports[q].dist[d], &X[6 * q + d]));
+    for (PetscInt a = 0; a < nz; a++)
+      for (PetscInt k = 0; k < m; k++) C[k + m * a] = md->P[m * a + k];
+    PetscCall(ReducedSolve(b->comm, md, sigma, nz, C));
+    for (PetscInt j = 0; j <= 2 * r; j++) {
+      PetscReal e;
+      PetscCall(InterfaceValues(b, nz, X, G));
+      ReducedOutputs(md, C, Gr);
+      e = ScaledError(nz, G, Gr);
+      PetscCall(PetscInfo(NULL, "body %s: moment %" PetscInt_FMT " at %.6g Hz: relative error %g\n", b->name, j, (double)red->frequencies[i], (double)e));
+      if (j < 2 * r) {
+        PetscCheck(e <= rtol, b->comm, PETSC_ERR_USER, "body %s: FAIL: moment %" PetscInt_FMT " of the ports' transfer function at %.6g Hz: relative error %.3e > tolerance %.3e (-%sreduction_expect_moments_rtol; a Krylov basis of %" PetscInt_FMT " block steps matches moments 0 to %" PetscInt_FMT ")", b->name, j, (double)red->frequencies[i], (double)e, (double)rtol, b->prefix, r, 2 * r - 1);
+        worst = PetscMax(worst, e);
+      } else last = e;
+      if (j == 2 * r) break;
+      /* the next moment: X <- A0^{-1} Mv X, C <- (Kr - sigma Mr)^{-1} Mr C */
+      for (PetscInt k = 0; k < nz; k++) {
+        PetscCall(VecDuplicate(X[k], &MX[k]));
+        PetscCall(MatMult(b->Mv, X[k], MX[k]));
+        PetscCall(VecDestroy(&X[k]));
+        PetscCall(ShiftedSolverSolve(&solver, MX[k], &X[k]));
+        PetscCall(VecDestroy(&MX[k]));
+      }
+      for (PetscInt c = 0; c < nz; c++)
+        for (PetscInt a = 0; a < m; a++) {
+          PetscReal s = 0.0;
+          for (PetscInt k = 0; k < m; k++) s += md->Mr[m * a + k] * C[k + m * c];
+          C2[a + m * c] = s;
+        }
+      PetscCall(PetscArraycpy(C, C2, m * nz));
+      PetscCall(ReducedSolve(b->comm, md, sigma, nz, C));
+    }
+    PetscCall(PetscInfo(NULL, "body %s: moments 0-%" PetscInt_FMT " at %.6g Hz: largest relative error %g\n", b->name, 2 * r - 1, (double)red->frequencies[i], (double)worst));
+    PetscCall(PetscPrintf(b->comm, "body %s: moments 0-%" PetscInt_FMT " of the ports' transfer function at %.6g Hz: PASS (rel. error <= %.0e); moment %" PetscInt_FMT ": rel. error %.2e\n", b->name, 2 * r - 1, (double)red->frequencies[i], (double)rtol, 2 * r, (double)last));
+    for (PetscInt k = 0; k < nz; k++) PetscCall(VecDestroy(&X[k]));
+    PetscCall(ShiftedSolverDestroy(&solver));
+  }
+  PetscCall(PetscFree4(G, Gr, C, C2));
+  PetscCall(PetscFree2(X, MX));
   PetscFunctionReturn(0);
 }
