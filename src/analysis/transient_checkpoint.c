@@ -356,7 +356,7 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
   {
     PetscInt mine = 0;
     for (PetscInt i = 0; i < m->sys->nparts; i++)
-      if (m->sys->parts[i]->Nv) mine++;
+      if (PhlexPartIsElastic(m->sys->parts[i])) mine++; /* a field writer each: flexible and reduced bodies */
     if (!m->scene->output->fields) mine = 0;
     PetscCheck(mine == fields, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written %s field output (-output_fields %d): restart with the same", file, fields ? "with" : "without", fields ? 1 : 0);
   }
