@@ -174,6 +174,13 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
     r->built = PETSC_TRUE;
     if (r->file[0]) PetscCall(PhlexReducedWrite(part->comm, r->file, part->name, &r->md, part->units, prov));
   }
+  {
+    /* the checkpoint's fingerprint of the part (transient_checkpoint.c): the provenance of its model, so that a restart
+       never reads elastic coordinates of another basis (another mesh, material, frame, ports or reduction) */
+    unsigned long long h = 1469598103934665603ULL; /* FNV-1a, 64 bits */
+    for (const char *c = prov; *c; c++) h = (h ^ (unsigned char)*c) * 1099511628211ULL;
+    PetscCall(PetscSNPrintf(part->numbering, sizeof(part->numbering), "model#%016llx", h));
+  }
   PetscCheck(r->md.nports == b->nports, part->comm, PETSC_ERR_PLIB, "body %s: the reduced model has %" PetscInt_FMT " ports, the body %" PetscInt_FMT, part->name, r->md.nports, b->nports);
   m = r->m      = r->md.m;
   r->nports     = b->nports;
