@@ -125,6 +125,7 @@ PETSC_INTERN PetscErrorCode PhlexFieldWriterStress(PhlexFieldWriter, Vec, PetscR
 PETSC_INTERN PetscErrorCode PhlexFieldWriterSetOutputRotation(PhlexFieldWriter, const PetscReal[9]);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterSetGeometryField(PhlexFieldWriter, const char[]);
 PETSC_INTERN PetscErrorCode PhlexFieldWriterDestroy(PhlexFieldWriter *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleWriteFields(PhlexFlexible, PhlexFieldWriter, const PhlexFrameState *, PetscReal, Vec, Vec, Vec); /* flexible.c */
 
 /* checkpoint.c: checkpoint files (HDF5), written atomically */
 PETSC_INTERN PetscErrorCode PhlexCheckpointOpenWrite(MPI_Comm, const char[], char[], PetscViewer *);

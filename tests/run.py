@@ -337,6 +337,7 @@ FEATURES = {
 TOOLS = {
     "paraview": "pvbatch",
     "xvfb": "Xvfb",
+    "h5dump": "h5dump",  # Debian's hdf5-tools: tests/tools/compare_fields.py reads field files with it
 }
 
 NAME_RE = re.compile(r"[A-Za-z0-9_.+-]+")

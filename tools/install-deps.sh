@@ -3,7 +3,7 @@
 # Called by 'make deps' (and by 'make run' / 'make check' when PETSc, SLEPc, gmsh or mpiexec is missing).
 set -eu
 
-packages="petsc-dev slepc-dev libyaml-dev gmsh libmetis-dev libopenblas0-serial openmpi-bin pkg-config make python3 python3-numpy python3-matplotlib"
+packages="petsc-dev slepc-dev libyaml-dev gmsh libmetis-dev libopenblas0-serial openmpi-bin pkg-config make python3 python3-numpy python3-matplotlib hdf5-tools"
 
 missing=""
 for p in $packages; do

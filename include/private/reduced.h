@@ -43,12 +43,17 @@ typedef struct {
   PetscReal *lambda_full; /* nnormal: the full body's eigenvalues of the normal modes in the basis (craig_bampton: of
                              the body with its ports held) */
   PhlexInertia inertia; /* the whole body about P: m, s0, E0, vol, svol */
+  /* the fields of the basis (field output only): NULL until built, or read from the file (PhlexReducedReadBasis) */
+  Vec      *Phi;             /* m: the basis vectors in the full body's velocity space (u = Phi eta, v = Phi zeta) */
+  Vec      *Psi;             /* m: their stress recovery modes Ms^{-1} G phi_k in its stress space (Sigma = Psi eta) */
+  char      numbering[48];   /* the full body's numbering of its unknowns the vectors are in (part->numbering) */
 } PhlexReducedModel;
 
 PETSC_INTERN PetscErrorCode PhlexReducedBuild(PhlexPart, const PhlexReduction *, PhlexReducedModel *);
 PETSC_INTERN PetscErrorCode PhlexReducedModelDestroy(PhlexReducedModel *);
 PETSC_INTERN PetscErrorCode PhlexReducedWrite(MPI_Comm, const char[], const char[], const PhlexReducedModel *, const PhlexUnits *, const char[], const PhlexReduction *);
 PETSC_INTERN PetscErrorCode PhlexReducedRead(MPI_Comm, const char[], const char[], const char[], const PhlexUnits *, PhlexReducedModel *);
+PETSC_INTERN PetscErrorCode PhlexReducedReadBasis(PhlexPart, const char[], const char[], const PhlexUnits *, PhlexReducedModel *);
 PETSC_INTERN PetscErrorCode PhlexReducedModelRoundTrip(PhlexReducedModel *, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexReducedProvenance(PhlexPart, const PhlexReduction *, char[], size_t);
 PETSC_INTERN PetscErrorCode PhlexReducedViewTransfer(PhlexPart, const PhlexReducedModel *, PetscInt, const PetscReal[]);

@@ -59,6 +59,37 @@ static void StripPlacementHashes(char *s)
   *w = 0;
 }
 
+/* s with the model hashes of reduced bodies ("model#" and hex digits, reduced.c) left out */
+static void StripModelHashes(char *s)
+{
+  char *w = s;
+  for (const char *r = s; *r;) {
+    if (*r == '#') {
+      r++;
+      while ((*r >= '0' && *r <= '9') || (*r >= 'a' && *r <= 'f')) r++;
+    } else *w++ = *r++;
+  }
+  *w = 0;
+}
+
+/* the first space-separated entry where two fingerprints differ, and its part's name (up to its first ':') */
+static void FirstDifferentEntry(const char a[], const char b[], char name[], char ea[], char eb[], size_t len)
+{
+  const char *pa = a, *pb = b;
+  name[0] = ea[0] = eb[0] = 0;
+  while (*pa || *pb) {
+    size_t la = strcspn(pa, " "), lb = strcspn(pb, " ");
+    if (la != lb || strncmp(pa, pb, la)) {
+      snprintf(ea, len, "%.*s", (int)la, pa);
+      snprintf(eb, len, "%.*s", (int)lb, pb);
+      snprintf(name, len, "%.*s", (int)strcspn(eb, ":"), eb);
+      return;
+    }
+    pa += la + (pa[la] ? 1 : 0);
+    pb += lb + (pb[lb] ? 1 : 0);
+  }
+}
+
 /* what the state vector means: the parts and joints by name and kind, the sizes, the scales; a restart checks that
    its own run has the same */
 static PetscErrorCode Fingerprint(MonitorContext *m, char **fingerprint, PetscReal units[4])
@@ -318,6 +349,25 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
       PetscCall(PetscFree(ck_parts));
       SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);
     }
+    {
+      /* the same scene but a reduced body's model built otherwise: its elastic coordinates are in another basis */
+      PetscBool model;
+      PetscCall(PetscStrallocpy(parts, &a));
+      PetscCall(PetscStrallocpy(ck_parts, &c));
+      StripModelHashes(a);
+      StripModelHashes(c);
+      PetscCall(PetscStrcmp(a, c, &model));
+      PetscCall(PetscFree(a));
+      PetscCall(PetscFree(c));
+      if (model) {
+        char name[PHLEX_NAME_LEN + 128], ea[PHLEX_NAME_LEN + 128], eb[PHLEX_NAME_LEN + 128];
+        FirstDifferentEntry(ck_parts, parts, name, ea, eb, sizeof(ea));
+        PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written with another reduced model of body %s ('%s', this run '%s'; after '#' a hash of the model's provenance: the mesh file, the discretisation, the materials, the frame, the ports and the reduction): its elastic coordinates belong to another basis; restart with the same body (its mesh, options and -reduced_file) as the run that wrote it", file, name, ea, eb));
+        PetscCall(PetscFree(parts));
+        PetscCall(PetscFree(ck_parts));
+        SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s", msg);
+      }
+    }
     PetscCall(PetscSNPrintf(msg, sizeof(msg), "the checkpoint '%s' (option -restart) was written for another scene: its parts and joints (name:kind:field unknowns:discrete unknowns[:numbering of the unknowns, -body<k>_node_order]) are '%s', this scene's '%s'", file, ck_parts, parts));
     PetscCall(PetscFree(parts));
     PetscCall(PetscFree(ck_parts));
@@ -356,7 +406,7 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
   {
     PetscInt mine = 0;
     for (PetscInt i = 0; i < m->sys->nparts; i++)
-      if (m->sys->parts[i]->Nv) mine++;
+      if (PhlexPartIsElastic(m->sys->parts[i])) mine++; /* a field writer each: flexible and reduced bodies */
     if (!m->scene->output->fields) mine = 0;
     PetscCheck(mine == fields, comm, PETSC_ERR_USER_INPUT, "the checkpoint '%s' (option -restart) was written %s field output (-output_fields %d): restart with the same", file, fields ? "with" : "without", fields ? 1 : 0);
   }

@@ -572,21 +572,41 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
     PetscReal P[3], L[3];
     PetscCall(PhlexFrameWriteRow((PetscViewer)b->rigid_csv, t, &b->fs, u, P, L));
   }
-  if (fields && b->writer) {
-    PhlexFieldWriter w = (PhlexFieldWriter)b->writer;
-    PetscCall(PhlexFieldWriterBeginStep(w, t));
-    /* displacement first: ParaView makes the first vector the active one ("Warp By Vector") */
-    PetscCall(PhlexFieldWriterVertexField(w, "displacement", X->u, u->length, NULL, NULL, PETSC_FALSE));
-    if (b->floating) {
-      /* x_inertial = r_P + R (x - P + u_f): the XDMF geometry of the step, so ParaView shows the motion */
-      PetscReal rp[3], RP[3];
-      PhlexMatVec3(b->fs.R, b->origin, RP);
-      for (PetscInt k = 0; k < 3; k++) rp[k] = b->fs.r[k] * u->length - RP[k];
-      PetscCall(PhlexFieldWriterVertexField(w, "inertial_position", X->u, u->length, b->fs.R, rp, PETSC_TRUE));
-    }
-    PetscCall(PhlexFieldWriterVertexField(w, "velocity", X->v, u->velocity, NULL, NULL, PETSC_FALSE));
-    PetscCall(PhlexFieldWriterStress(w, X->s, u->modulus));
+  if (fields && b->writer) PetscCall(PhlexFlexibleWriteFields(b, (PhlexFieldWriter)b->writer, &b->fs, t, X->u, X->v, X->s));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleWriteFields - one output step of a flexible body's fields: displacement, a floating body's inertial
+  position (the step's geometry), velocity, stress and von Mises stress (a full body's unknowns, or a reduced body's
+  fields Phi eta, Phi zeta, Psi eta)
+
+  Collective
+
+  Input Parameters:
++ b       - the flexible body (its mesh and spaces)
+. w       - its field writer
+. fs      - the frame's state at time t (a floating body: r_P and R place the mesh)
+. t       - time [s]
+- u, v, s - displacement, velocity and stress (global vectors of its spaces, non-dimensional)
+@*/
+PetscErrorCode PhlexFlexibleWriteFields(PhlexFlexible b, PhlexFieldWriter w, const PhlexFrameState *fs, PetscReal t, Vec u, Vec v, Vec s)
+{
+  const PhlexUnits *units = b->part->units;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFieldWriterBeginStep(w, t));
+  /* displacement first: ParaView makes the first vector the active one ("Warp By Vector") */
+  PetscCall(PhlexFieldWriterVertexField(w, "displacement", u, units->length, NULL, NULL, PETSC_FALSE));
+  if (b->floating) {
+    /* x_inertial = r_P + R (x - P + u_f): the XDMF geometry of the step, so ParaView shows the motion */
+    PetscReal rp[3], RP[3];
+    PhlexMatVec3(fs->R, b->origin, RP);
+    for (PetscInt k = 0; k < 3; k++) rp[k] = fs->r[k] * units->length - RP[k];
+    PetscCall(PhlexFieldWriterVertexField(w, "inertial_position", u, units->length, fs->R, rp, PETSC_TRUE));
   }
+  PetscCall(PhlexFieldWriterVertexField(w, "velocity", v, units->velocity, NULL, NULL, PETSC_FALSE));
+  PetscCall(PhlexFieldWriterStress(w, s, units->modulus));
   PetscFunctionReturn(0);
 }
 

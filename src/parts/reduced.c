@@ -38,6 +38,9 @@ typedef struct {
   PetscReal          beta[3]; /* body force density at the evaluated time */
   PetscReal          power_ext, t_eval;
   PetscViewer        rigid_csv, ports_csv, modal_csv;
+  PhlexFieldWriter   writer;           /* the full body's field output (-output_fields), or NULL */
+  Vec                fu, fv, fsig;     /* its fields at an output step: Phi eta, Phi zeta, Psi eta */
+  PetscScalar       *fcoef;            /* m: the coordinates of a field */
   PetscReal          expect_held[64], expect_full[64], expect_rtol; /* self-checks of the basis (-reduction_expect_*) */
   PetscInt           nexpect_held, nexpect_full;
   PhlexReduction     red;   /* the kind of basis and its parameters (r->type, r->nmodes repeated in it) */
@@ -198,6 +201,13 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
     PetscCall(PhlexReducedModelRoundTrip(&r->md, part->units));
     r->built = PETSC_TRUE;
     if (r->file[0]) PetscCall(PhlexReducedWrite(part->comm, r->file, part->name, &r->md, part->units, prov, &r->red));
+  }
+  {
+    /* the checkpoint's fingerprint of the part (transient_checkpoint.c): the provenance of its model, so that a restart
+       never reads elastic coordinates of another basis (another mesh, material, frame, ports or reduction) */
+    unsigned long long h = 1469598103934665603ULL; /* FNV-1a, 64 bits */
+    for (const char *c = prov; *c; c++) h = (h ^ (unsigned char)*c) * 1099511628211ULL;
+    PetscCall(PetscSNPrintf(part->numbering, sizeof(part->numbering), "model#%016llx", h));
   }
   PetscCheck(r->md.nports == b->nports, part->comm, PETSC_ERR_PLIB, "body %s: the reduced model has %" PetscInt_FMT " ports, the body %" PetscInt_FMT, part->name, r->md.nports, b->nports);
   m = r->m      = r->md.m;
@@ -861,17 +871,40 @@ static PetscErrorCode ReducedOutputOpen(PhlexPart part, PhlexOutput out, PetscBo
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_modal.csv", part->name));
   PetscCall(PhlexOutputCSVOpen(out, name, h, &r->modal_csv));
   PetscCall(PetscFree(h));
+  if (fields) {
+    /* the full body's fields, from the basis vectors and their stress modes (read from the file only now: a run
+       without field output never needs them) */
+    char who[PHLEX_NAME_LEN + 8];
+    PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", part->name));
+    PetscCall(PhlexReducedReadBasis(r->full, r->file, who, part->units, &r->md));
+    PetscCall(PhlexFieldWriterCreate(out, b, part->name, &r->writer));
+    if (r->floating) PetscCall(PhlexFieldWriterSetGeometryField(r->writer, "inertial_position"));
+    PetscCall(VecDuplicate(r->md.Phi[0], &r->fu));
+    PetscCall(VecDuplicate(r->md.Phi[0], &r->fv));
+    PetscCall(VecDuplicate(r->md.Psi[0], &r->fsig));
+    PetscCall(PetscMalloc1(r->m, &r->fcoef));
+  }
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode ReducedOutputStep(PhlexPart part, PetscInt step, PetscReal t, const PhlexPartVec *X, PetscBool fields)
+/* x = sum_k c_k V_k with the coordinates c (m of them, stride 1) */
+static PetscErrorCode Combine(Reduced *r, const PetscReal *c, Vec *V, Vec x)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < r->m; k++) r->fcoef[k] = c[k];
+  PetscCall(VecSet(x, 0.0));
+  PetscCall(VecMAXPY(x, r->m, r->fcoef, V));
+  PetscFunctionReturn(0);
+}
+
+/* one row of the series (ports, frame, elastic coordinates) at the evaluated state X */
+static PetscErrorCode ReducedSeriesStep(PhlexPart part, PetscReal t, const PhlexPartVec *X)
 {
   Reduced          *r = (Reduced *)part->data;
   PhlexFlexible     b = r->fb;
   const PhlexUnits *u = part->units;
 
   PetscFunctionBeginUser;
-  if (step < 0) PetscFunctionReturn(0);
   if (r->ports_csv) {
     PetscViewer csv = r->ports_csv;
     PetscReal   fr  = 0.0;
@@ -907,6 +940,24 @@ static PetscErrorCode ReducedOutputStep(PhlexPart part, PetscInt step, PetscReal
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode ReducedOutputStep(PhlexPart part, PetscInt step, PetscReal t, const PhlexPartVec *X, PetscBool fields)
+{
+  Reduced      *r = (Reduced *)part->data;
+  PhlexFlexible b = r->fb;
+
+  PetscFunctionBeginUser;
+  if (step >= 0) PetscCall(ReducedSeriesStep(part, t, X));
+  if (fields && r->writer) {
+    /* u = Phi eta, v = Phi zeta, Sigma = Psi eta: the full body's fields of the reduced state */
+    const PetscReal *eta = X->q + r->ie, *zeta = X->q + r->iz;
+    PetscCall(Combine(r, eta, r->md.Phi, r->fu));
+    PetscCall(Combine(r, zeta, r->md.Phi, r->fv));
+    PetscCall(Combine(r, eta, r->md.Psi, r->fsig));
+    PetscCall(PhlexFlexibleWriteFields(b, r->writer, &r->fs, t, r->fu, r->fv, r->fsig));
+  }
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode ReducedOutputClose(PhlexPart part)
 {
   Reduced *r = (Reduced *)part->data;
@@ -915,6 +966,11 @@ static PetscErrorCode ReducedOutputClose(PhlexPart part)
   PetscCall(PetscViewerDestroy(&r->ports_csv));
   PetscCall(PetscViewerDestroy(&r->rigid_csv));
   PetscCall(PetscViewerDestroy(&r->modal_csv));
+  PetscCall(PhlexFieldWriterDestroy(&r->writer));
+  PetscCall(VecDestroy(&r->fu));
+  PetscCall(VecDestroy(&r->fv));
+  PetscCall(VecDestroy(&r->fsig));
+  PetscCall(PetscFree(r->fcoef));
   PetscFunctionReturn(0);
 }
 

@@ -828,8 +828,15 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, const PhlexReduction *red, Phle
   }
   model->nports  = b->nports;
   model->inertia = b->inertia; /* about P (a fixed body: about the inertial origin, its weight's potential) */
-  for (PetscInt j = 0; j < m; j++) PetscCall(VecDestroy(&Phi[j]));
-  PetscCall(PetscFree(Phi));
+  /* the basis kept for the field output, with the stress recovery modes: the stress each basis vector holds,
+     Psi_k = Ms^{-1} G phi_k (cell by cell, exact: the stress of the full body's displacement Phi eta is Psi eta) */
+  PetscCall(PetscMalloc1(m, &model->Psi));
+  for (PetscInt j = 0; j < m; j++) {
+    PetscCall(DMCreateGlobalVector(b->dm_s, &model->Psi[j]));
+    PetscCall(PhlexFlexibleStressOfDisplacement(b, Phi[j], model->Psi[j]));
+  }
+  model->Phi = Phi;
+  PetscCall(PetscStrncpy(model->numbering, part->numbering, sizeof(model->numbering)));
   PetscCall(VecDestroy(&work));
   PetscFunctionReturn(0);
 }
@@ -841,6 +848,12 @@ PetscErrorCode PhlexReducedModelDestroy(PhlexReducedModel *model)
   PetscCall(PetscFree3(model->N, model->Svol, model->P));
   PetscCall(PetscFree(model->lambda));
   PetscCall(PetscFree(model->lambda_full));
+  for (PetscInt k = 0; k < model->m; k++) {
+    if (model->Phi) PetscCall(VecDestroy(&model->Phi[k]));
+    if (model->Psi) PetscCall(VecDestroy(&model->Psi[k]));
+  }
+  PetscCall(PetscFree(model->Phi));
+  PetscCall(PetscFree(model->Psi));
   PetscFunctionReturn(0);
 }
 
@@ -933,6 +946,7 @@ PetscErrorCode PhlexReducedProvenance(PhlexPart part, const PhlexReduction *red,
 /* the SI factor of each stored array: value_SI = value * factor */
 typedef struct {
   PetscReal M, K, S, W, N, Svol, Pt, Pr, lambda, m, s0, E0, vol, svol;
+  PetscReal phi, psi; /* the basis vectors (m of displacement per m of eta: 1) and their stress (Pa per m of eta) */
 } ReducedScales;
 
 static void Scales(const PhlexUnits *u, ReducedScales *f)
@@ -951,6 +965,33 @@ static void Scales(const PhlexUnits *u, ReducedScales *f)
   f->E0     = u->mass * u->length * u->length;
   f->vol    = u->length * u->length * u->length;
   f->svol   = f->vol * u->length;
+  f->phi    = 1.0;
+  f->psi    = u->modulus / u->length;
+}
+
+/* the basis vectors or their stress modes (scaled to SI) as datasets <group>/<name>_<k> (k from 1), each in the
+   global numbering of the full body's field (a plain vector: a DM's vector would be written as a mesh field) */
+static PetscErrorCode WriteVectors(PetscViewer v, const char group[], const char name[], PetscInt m, const Vec *x, PetscReal scale)
+{
+  Vec      y;
+  PetscInt n, N;
+  char     dname[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(x[0], &n));
+  PetscCall(VecGetSize(x[0], &N));
+  PetscCall(VecCreateMPI(PetscObjectComm((PetscObject)x[0]), n, N, &y));
+  PetscCall(PetscViewerHDF5PushGroup(v, group));
+  for (PetscInt k = 0; k < m; k++) {
+    PetscCall(VecCopy(x[k], y));
+    PetscCall(VecScale(y, scale));
+    PetscCall(PetscSNPrintf(dname, sizeof(dname), "%s_%" PetscInt_FMT, name, k + 1));
+    PetscCall(PetscObjectSetName((PetscObject)y, dname));
+    PetscCall(VecView(y, v));
+  }
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(VecDestroy(&y));
+  PetscFunctionReturn(0);
 }
 
 static PetscErrorCode WriteScaled(PetscViewer v, const char name[], PetscInt n, const PetscReal *x, PetscReal scale)
@@ -1018,6 +1059,17 @@ PetscErrorCode PhlexReducedWrite(MPI_Comm comm, const char path[], const char bo
     a[13] = in->vol * f.vol;
     for (PetscInt k = 0; k < 3; k++) a[14 + k] = in->svol[k] * f.svol;
     PetscCall(PhlexCheckpointWriteReals(v, "/reduced", "inertia", 17, a));
+  }
+  if (md->Phi) {
+    /* the fields of the basis, in the numbering of the full body's unknowns of the run that built it */
+    PetscInt nv, ns;
+    PetscCall(VecGetSize(md->Phi[0], &nv));
+    PetscCall(VecGetSize(md->Psi[0], &ns));
+    PetscCall(PhlexCheckpointWriteString(v, "/reduced/basis", "numbering", md->numbering));
+    PetscCall(PhlexCheckpointWriteInt(v, "/reduced/basis", "velocity_dofs", nv));
+    PetscCall(PhlexCheckpointWriteInt(v, "/reduced/basis", "stress_dofs", ns));
+    PetscCall(WriteVectors(v, "/reduced/basis", "phi", m, md->Phi, f.phi));
+    PetscCall(WriteVectors(v, "/reduced/basis", "psi", m, md->Psi, f.psi));
   }
   PetscCall(PhlexCheckpointCommit(comm, tmp, path, &v));
   PetscFunctionReturn(0);
@@ -1126,6 +1178,95 @@ PetscErrorCode PhlexReducedRead(MPI_Comm comm, const char path[], const char who
   PetscFunctionReturn(0);
 }
 
+/* the vectors <group>/<name>_<k> into new global vectors of dm, divided by scale */
+static PetscErrorCode ReadVectors(PetscViewer v, DM dm, const char group[], const char name[], PetscInt m, PetscReal scale, Vec **x)
+{
+  Vec      y;
+  PetscInt n, N;
+  char     dname[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(m, x));
+  for (PetscInt k = 0; k < m; k++) PetscCall(DMCreateGlobalVector(dm, &(*x)[k]));
+  PetscCall(VecGetLocalSize((*x)[0], &n));
+  PetscCall(VecGetSize((*x)[0], &N));
+  PetscCall(VecCreateMPI(PetscObjectComm((PetscObject)dm), n, N, &y));
+  PetscCall(PetscViewerHDF5PushGroup(v, group));
+  for (PetscInt k = 0; k < m; k++) {
+    PetscCall(PetscSNPrintf(dname, sizeof(dname), "%s_%" PetscInt_FMT, name, k + 1));
+    PetscCall(PetscObjectSetName((PetscObject)y, dname));
+    PetscCall(VecLoad(y, v));
+    {
+      /* divided, as PhlexReducedModelRoundTrip does: a model read takes the bits of one built in memory */
+      const PetscScalar *ya;
+      PetscScalar       *xa;
+      PetscCall(VecGetArrayRead(y, &ya));
+      PetscCall(VecGetArray((*x)[k], &xa));
+      for (PetscInt i = 0; i < n; i++) xa[i] = PetscRealPart(ya[i]) / scale;
+      PetscCall(VecRestoreArray((*x)[k], &xa));
+      PetscCall(VecRestoreArrayRead(y, &ya));
+    }
+  }
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(VecDestroy(&y));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexReducedReadBasis - reads the basis vectors and their stress modes of a reduced body file (field output) into a
+  model read from it (PhlexReducedRead), refused unless they are in the full body's numbering of its unknowns
+
+  Collective
+
+  Input Parameters:
++ part - the full flexible body (set up: its spaces and part->numbering)
+. path - the reduced body file
+- who  - "body <name>" for messages
+
+  Notes:
+  The vectors are stored in the global numbering of the run that built the file, which depends on the mesh file's node
+  order, -node_order, the partitioner and the number of processes (PhlexFlexiblePlacement); a file built under another
+  numbering is refused with a message (its reduced operators, which the motion needs, do not depend on it).
+@*/
+PetscErrorCode PhlexReducedReadBasis(PhlexPart part, const char path[], const char who[], const PhlexUnits *u, PhlexReducedModel *md)
+{
+  PhlexFlexible b    = (PhlexFlexible)part->data;
+  MPI_Comm      comm = part->comm;
+  PetscViewer   v;
+  PetscBool     has, same;
+  char          numbering[64];
+  PetscInt      nv, ns, nv_file, ns_file;
+  ReducedScales f;
+  Vec           x;
+
+  PetscFunctionBeginUser;
+  if (md->Phi) PetscFunctionReturn(0);
+  PetscCall(PetscViewerHDF5Open(comm, path, FILE_MODE_READ, &v));
+  PetscCall(PetscViewerHDF5HasAttribute(v, "/reduced/basis", "numbering", &has));
+  if (!has) PetscCall(PetscViewerDestroy(&v));
+  PetscCheck(has, comm, PETSC_ERR_USER_INPUT, "%s: the reduced body file '%s' has no basis vectors (written by an earlier phlex), which the field output needs: delete the file to rebuild it, or run with -output_fields 0", who, path);
+  PetscCall(PhlexCheckpointReadString(v, "/reduced/basis", "numbering", numbering, sizeof(numbering)));
+  PetscCall(PetscStrcmp(numbering, part->numbering, &same));
+  if (!same) PetscCall(PetscViewerDestroy(&v));
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "%s: the reduced body file '%s' holds its basis vectors in another numbering of the body's unknowns ('%s', this run '%s'; after '@' a hash of where the unknowns are in the mesh: another number of processes, partitioner, -%snode_order or node order of the mesh file), so its fields cannot be placed on this run's mesh: delete the file to rebuild it in this run's numbering, or run with -output_fields 0 (the motion does not depend on the numbering)", who, path, numbering, part->numbering, part->prefix);
+  PetscCall(PhlexCheckpointReadInt(v, "/reduced/basis", "velocity_dofs", &nv_file));
+  PetscCall(PhlexCheckpointReadInt(v, "/reduced/basis", "stress_dofs", &ns_file));
+  PetscCall(DMGetGlobalVector(b->dm, &x));
+  PetscCall(VecGetSize(x, &nv));
+  PetscCall(DMRestoreGlobalVector(b->dm, &x));
+  PetscCall(DMGetGlobalVector(b->dm_s, &x));
+  PetscCall(VecGetSize(x, &ns));
+  PetscCall(DMRestoreGlobalVector(b->dm_s, &x));
+  if (nv != nv_file || ns != ns_file) PetscCall(PetscViewerDestroy(&v));
+  PetscCheck(nv == nv_file && ns == ns_file, comm, PETSC_ERR_FILE_UNEXPECTED, "%s: the reduced body file '%s' holds basis vectors of %" PetscInt_FMT " velocity and %" PetscInt_FMT " stress unknowns, the body has %" PetscInt_FMT " and %" PetscInt_FMT ": delete the file to rebuild it", who, path, nv_file, ns_file, nv, ns);
+  Scales(u, &f);
+  PetscCall(ReadVectors(v, b->dm, "/reduced/basis", "phi", md->m, f.phi, &md->Phi));
+  PetscCall(ReadVectors(v, b->dm_s, "/reduced/basis", "psi", md->m, f.psi, &md->Psi));
+  PetscCall(PetscStrncpy(md->numbering, numbering, sizeof(md->numbering)));
+  PetscCall(PetscViewerDestroy(&v));
+  PetscFunctionReturn(0);
+}
+
 /* x <- (x scale) / scale, array by array: a model built in this run takes the bits a file written and read again
    would give it (a run that builds the file and one that reads it give the same results) */
 static void RoundTrip(PetscInt n, PetscReal *x, PetscReal scale)
@@ -1161,6 +1302,17 @@ PetscErrorCode PhlexReducedModelRoundTrip(PhlexReducedModel *md, const PhlexUnit
   RoundTrip(9, md->inertia.E0, f.E0);
   RoundTrip(1, &md->inertia.vol, f.vol);
   RoundTrip(3, md->inertia.svol, f.svol);
+  for (PetscInt k = 0; md->Psi && k < m; k++) {
+    PetscScalar *a;
+    PetscInt     n;
+    PetscCall(VecGetLocalSize(md->Psi[k], &n));
+    PetscCall(VecGetArray(md->Psi[k], &a));
+    for (PetscInt i = 0; i < n; i++) {
+      volatile PetscReal y = PetscRealPart(a[i]) * f.psi;
+      a[i]                 = y / f.psi;
+    }
+    PetscCall(VecRestoreArray(md->Psi[k], &a));
+  }
   PetscFunctionReturn(0);
 }
 
