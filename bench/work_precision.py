@@ -11,7 +11,9 @@
              axes, slider), coupler meshes x time steps over 8 rad of crank angle; the error is the largest deviation
              of the coupler's midpoint deflection u_y/L from the converged FFRF model
              (validation/reference/crankslider_midpoint_ffrf_check.csv, tools/crankslider_midpoint.py), and the cost
-             is also given per simulated second
+             is also given per simulated second; --coupler-models full,reduced5,reduced10 adds the coupler as a
+             reduced body (issue 41; the wall time includes building the reduced model, transient_s is the
+             time-stepping stage of -log_view alone)
 
 Writes bench/results/work_precision_<case>.csv and, when matplotlib is installed, .png beside them.
 
@@ -24,6 +26,7 @@ Dimensions beyond the discretisation (each a comma-separated list; every point i
 usage: bench/work_precision.py [--cases transient,modes,mechanism] [--mesh meshes/bench/bar_h0.02.msh]
                                [--meshes meshes/bar_h0.05.msh,meshes/bench/bar_h0.02.msh,meshes/bench/bar_h0.01.msh]
                                [--coupler-cells 8,16,32] [--mechanism-dts 4e-5,2e-5,1e-5] [--np 1,2]
+                               [--coupler-models full,reduced5,reduced10,reduced20,reduced40]
                                [--presets exact,iterative] [--eps-types phlexblock,krylovschur] [--supports free,clamped]
                                [--phlex bin/phlex]
 """
@@ -165,33 +168,42 @@ def mechanism(a, out):
     outdir = tempfile.mkdtemp(prefix="phlex_wp_")
     tend = 8.0 / 150.0  # 8 rad of crank angle
 
-    def one(cells, dt, np_=1, preset=""):
+    def one(cells, dt, np_=1, preset="", model="full"):
+        extra = []
+        if model.startswith("reduced"):
+            extra = ["-body1_type", "reduced", "-body1_reduction_modes", model[len("reduced"):]]
         cmd = launcher(np_) + [a.phlex, "-options_file", "options/crankslider.yaml", "-body1_dm_plex_filename",
                                "meshes/crankslider_coupler_nx%d.msh" % cells, "-ts_dt", repr(dt), "-ts_max_time",
-                               repr(tend), "-output_fields", "0", "-output_dir", outdir, "-progress", "0"] \
-            + preset_options(preset)
+                               repr(tend), "-output_fields", "0", "-output_dir", outdir, "-progress", "0",
+                               "-log_view"] + extra + preset_options(preset)
         log, wall, rss = run(cmd)
         dofs = int(re.search(r"velocity P\d \((\d+) dofs\)", log).group(1))
+        coords = re.search(r"(\d+) coordinates\)", log)
+        stage = re.search(r"Phlex Transient: ([0-9.e+-]+)", log)
         check = subprocess.run([sys.executable, "tools/crankslider_midpoint.py", outdir], cwd=ROOT,
                                stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout
         m = re.search(r"max deviation ([0-9.e+-]+)", check)
         if not m:
             sys.exit("no deviation in the check's output:\n" + check)
-        return float(m.group(1)), wall, rss, dofs
+        return (float(m.group(1)), wall, rss, dofs, int(coords.group(1)) if coords else 0,
+                float(stage.group(1)) if stage else float("nan"))
 
     rows = []
     for np_ in a.nps:
         for preset in a.preset_list:
-            for cells in [int(x) for x in a.coupler_cells.split(",")]:
-                for dt in [float(x) for x in a.mechanism_dts.split(",")]:
-                    err, wall, rss, dofs = one(cells, dt, np_, preset)
-                    rows.append(dict(cells=cells, dt=dt, steps=round(tend / dt), error=err, wall_s=wall,
-                                     wall_per_simulated_s=wall / tend, peak_rss_gib=rss, dofs=dofs, ranks=np_,
-                                     preset=preset or "default",
-                                     variant="%d cells %s np%d" % (cells, preset or "default", np_)))
-                    print("coupler %2d cells (%5d DOFs) %-9s np %d dt %-6g deviation %.2e  %.1f s (%.0f s per "
-                          "simulated s)" % (cells, dofs, preset or "default", np_, dt, err, wall, wall / tend),
-                          flush=True)
+            for model in a.coupler_models.split(","):
+                for cells in [int(x) for x in a.coupler_cells.split(",")]:
+                    for dt in [float(x) for x in a.mechanism_dts.split(",")]:
+                        err, wall, rss, dofs, coords, transient_s = one(cells, dt, np_, preset, model)
+                        rows.append(dict(model=model, cells=cells, dt=dt, steps=round(tend / dt), error=err,
+                                         wall_s=wall, transient_s=transient_s,
+                                         wall_per_simulated_s=wall / tend, peak_rss_gib=rss, dofs=dofs,
+                                         coordinates=coords, ranks=np_, preset=preset or "default",
+                                         variant="%s %d cells %s np%d" % (model, cells, preset or "default", np_)))
+                        print("coupler %-9s %2d cells (%5d DOFs, %3d coordinates) %-9s np %d dt %-6g deviation "
+                              "%.2e  %.2f s (transient %.2f s; %.1f s per simulated s)" % (
+                                  model, cells, dofs, coords, preset or "default", np_, dt, err, wall,
+                                  transient_s, wall / tend), flush=True)
     write(out, rows)
     return rows
 
@@ -245,6 +257,8 @@ def main():
     p.add_argument("--tol", default="1e-10")
     p.add_argument("--coupler-cells", default="8,16,32")
     p.add_argument("--mechanism-dts", default="4e-5,2e-5,1e-5")
+    p.add_argument("--coupler-models", default="full",
+                   help="mechanism: the coupler, full and/or reduced<N> (a reduced body of N normal modes): full,reduced10")
     a = p.parse_args()
     a.nps = [int(x) for x in a.np.split(",")]
     a.preset_list = a.presets.split(",")

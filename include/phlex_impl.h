@@ -109,6 +109,7 @@ PETSC_INTERN PetscErrorCode PhlexOutputCreate(MPI_Comm, PhlexOutput *);
 PETSC_INTERN PetscErrorCode PhlexOutputSetFromOptions(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputFile(PhlexOutput, const char[], char[]);
 PETSC_INTERN PetscErrorCode PhlexOutputCSVOpen(PhlexOutput, const char[], const char[], PetscViewer *);
+PETSC_INTERN PetscErrorCode PhlexCSVPrintf(PetscViewer, const char[], ...) PETSC_ATTRIBUTE_FORMAT(2, 3);
 PETSC_INTERN PetscErrorCode PhlexOutputCommit(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputAbort(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputDestroy(PhlexOutput *);

@@ -3,7 +3,9 @@
 
 Runs bin/phlex on options/fourbar.yaml, options/crankslider.yaml, options/hinged_beam.yaml and
 options/rotating_cantilever.yaml (several meshes, both inertia models where the issue asks for them, the rotating
-cantilever with and without geometric stiffening), checks each metric with the tools that the regression tests use
+cantilever with and without geometric stiffening), and the reduced bodies (case "reduced": the crank-slider's coupler
+with 5-40 normal modes, the flexible pendulum's bar, the hinged beam, each against the paper's checks, the full
+body's run and the full body's frequencies; reduced_crankslider_modes.csv, reduced_convergence.png), checks each metric with the tools that the regression tests use
 (tools/compare_fourbar.py, tools/crankslider_midpoint.py, tools/check_hinged_beam.py, tools/rotating_cantilever.py),
 and writes under validation/:
   <case>_*.csv                   the computed curves beside the references
@@ -180,6 +182,131 @@ def rotating(out, S, walls, quick):
                 S.add("rotating cantilever", what, l, checked=checked)
 
 
+def full_frequencies(name, args, out, n):
+    """the lowest n elastic frequencies [Hz] of the full body of a scene (-analysis modes, the frame held as the
+    reduced body's basis holds it: clamped at a frame patch, free on mean axes), as the option list of
+    -reduction_expect_full_frequencies"""
+    d, _ = run(name, args + ["-analysis", "modes", "-modes_nev", str(n + 6)], out)
+    f = [r["frequency_hz"] for r in read_csv(os.path.join(d, "modes.csv")) if r["rigid"] == "0"]
+    return ",".join(f[:n])
+
+
+def expect_line(d):
+    """the reduced run's check of its frequencies (-reduction_expect_full_frequencies)"""
+    with open(d + ".log") as f:
+        return [l for l in f.read().splitlines() if "normal modes in the basis against the full body's" in l]
+
+
+def crank_curve_deviation(a, b):
+    """max |u_y/L| difference of two crankslider_midpoint.py --out curves (the same crank angles)"""
+    ya, yb = [float(r["uy_over_L"]) for r in a], [float(r["uy_over_L"]) for r in b]
+    return max(abs(x - y) for x, y in zip(ya, yb))
+
+
+def reduced(out, S, walls, quick):
+    """reduced bodies (issue 41) against the full ones: the crank-slider's coupler, the flexible pendulum, the hinged
+    spatial beam; each reduced run is checked against the paper's references like the full one, against the full
+    body's run, and its reduced frequencies against the full body's"""
+    print("reduced bodies (the crank-slider's coupler, the flexible pendulum, the hinged beam)")
+    full_name = "crankslider_full_nx16_dt2e-5"
+    full_csv = os.path.join(out, full_name + ".csv")
+    full_wall = dict(walls).get(full_name + " (0.0533 s simulated)")
+    if full_wall is None or not os.path.exists(full_csv):
+        d, full_wall = run(full_name, ["-options_file", "options/crankslider.yaml"], out)
+        walls.append((full_name + " (0.0533 s simulated)", full_wall))
+        check("crankslider_midpoint.py", [d, "--out", full_csv])
+    full = read_csv(full_csv)
+    table = []
+    modes = [10] if quick else [5, 10, 20, 40]
+    ffull = full_frequencies("crankslider_full_modes", ["-options_file", "options/crankslider.yaml"], out, max(modes))
+    for n in modes:
+        name = "crankslider_reduced%d_nx16_dt2e-5" % n
+        d, w = run(name, ["-options_file", "options/crankslider.yaml", "-body1_type", "reduced", "-body1_reduction_modes", str(n), "-body1_reduction_expect_full_frequencies", ffull, "-body1_reduction_expect_rtol", "1e-8"], out)
+        walls.append((name + " (0.0533 s simulated)", w))
+        csvout = os.path.join(out, name + ".csv")
+        lines, _ = check("crankslider_midpoint.py", [d, "--out", csvout])
+        what = "reduced coupler, %d normal modes + 18 attachment modes" % n
+        for l in lines:
+            S.add("crank-slider", what, l, checked="u_x" not in l)
+        curve = read_csv(csvout)
+        dev = crank_curve_deviation(curve, full)
+        tol = 1e-3
+        S.add("crank-slider", what, "u_y/L against the full coupler (16 cells, dt 2e-5) over 0-8 rad: max deviation %.2e (tolerance %g): %s" % (dev, tol, "PASS" if dev <= tol else "FAIL"))
+        for l in expect_line(d):
+            S.add("crank-slider", what, l)
+        table.append(dict(modes=n, coordinates=n + 18, deviation_from_full=dev, wall_s=w, full_wall_s=full_wall))
+    with open(os.path.join(out, "reduced_crankslider_modes.csv"), "w", newline="") as f:
+        wr = csv.DictWriter(f, fieldnames=list(table[0]))
+        wr.writeheader()
+        wr.writerows(table)
+
+    # the flexible pendulum: the period of the full body's check, and the pin angle against the full body's
+    d, w = run("flexible_pendulum_full", ["-options_file", "options/flexible_pendulum.yaml"], out)
+    walls.append(("flexible_pendulum_full (3.4 s simulated)", w))
+    full_pin = read_csv(os.path.join(d, "pin_joint.csv"))
+    ffull = full_frequencies("flexible_pendulum_full_modes", ["-options_file", "options/flexible_pendulum.yaml"], out, 10 if quick else 20)
+    for n in ([10] if quick else [5, 10, 20]):
+        name = "flexible_pendulum_reduced%d" % n
+        d, w = run(name, ["-options_file", "options/flexible_pendulum.yaml", "-body0_type", "reduced", "-body0_reduction_modes", str(n), "-body0_reduction_expect_full_frequencies", ffull, "-body0_reduction_expect_rtol", "1e-8"], out)
+        walls.append((name + " (3.4 s simulated)", w))
+        what = "reduced bar, %d normal modes (Craig-Bampton: its only interface is the pinned face)" % n
+        p = subprocess.run([sys.executable, os.path.join(ROOT, "tests", "tools", "pendulum_period.py"), os.path.join(d, "pin_joint.csv"), "--theta0", "5", "--inertia", "26.065", "--mgd", "382.59", "--sign", "-1", "--rtol", "5e-6"], cwd=ROOT, capture_output=True, text=True)
+        for l in p.stdout.splitlines():
+            if l.strip() and not l.startswith("measured"):
+                S.add("flexible pendulum", what, l)
+        red_pin = read_csv(os.path.join(d, "pin_joint.csv"))
+        key = [k for k in full_pin[0] if k.startswith("angle")][0]
+        dev = max(abs(float(a[key]) - float(b[key])) for a, b in zip(full_pin, red_pin))
+        S.add("flexible pendulum", what, "pin angle against the full bar over 3.4 s: max deviation %.2e rad (tolerance 1e-6): %s" % (dev, "PASS" if dev <= 1e-6 else "FAIL"))
+        for l in expect_line(d):
+            S.add("flexible pendulum", what, l)
+
+    # the four-bar with its three links reduced (the linearised sweep of the assembly's pulsations): against the
+    # converged beam FE as the full links are, and against the full links on the same meshes
+    nx = 8 if quick else 16
+    base = ["-options_file", "options/fourbar.yaml", "-linearized_sweep_range", "0,360,5"]
+    for k, l in enumerate(["crank", "coupler", "follower"]):
+        base += ["-body%d_dm_plex_filename" % k, "meshes/fourbar_%s_nx%d.msh" % (l, nx)]
+    full_sweep = os.path.join(out, "fourbar_sweep_nx%d.csv" % nx)
+    if not os.path.exists(full_sweep):
+        d, w = run("fourbar_nx%d" % nx, base, out)
+        walls.append(("fourbar_nx%d (73 configurations)" % nx, w))
+        shutil.copy(os.path.join(d, "linearized_sweep.csv"), full_sweep)
+    as_ref = os.path.join(out, "fourbar_sweep_nx%d_as_reference.csv" % nx)
+    with open(as_ref, "w", newline="") as f:
+        wr = csv.writer(f)
+        wr.writerow(["theta1_deg", "f1", "f2", "f3"])
+        for r in read_csv(full_sweep):
+            wr.writerow([r["position"], r["omega1_rad_s"], r["omega2_rad_s"], r["omega3_rad_s"]])
+    for n in ([8] if quick else [4, 8, 16]):
+        args = list(base)
+        for k in range(3):
+            args += ["-body%d_type" % k, "reduced", "-body%d_reduction_modes" % k, str(n)]
+        name = "fourbar_reduced%d_nx%d" % (n, nx)
+        d, w = run(name, args, out)
+        walls.append((name + " (73 configurations)", w))
+        what = "links reduced, %d normal modes + 6 attachment modes each, %d cells" % (n, nx)
+        lines, _ = check("compare_fourbar.py", [os.path.join(d, "linearized_sweep.csv"), os.path.join(REF, "fourbar_frequencies_fe_check.csv"), "--rtol", "0.01", "--label", "vs converged beam FE, nu = 0,"])
+        for l in lines:
+            S.add("four-bar", what, l)
+        lines, _ = check("compare_fourbar.py", [os.path.join(d, "linearized_sweep.csv"), as_ref, "--rtol", "1e-3", "--label", "vs the full links (%d cells)," % nx])
+        for l in lines:
+            S.add("four-bar", what, l, checked=n >= 8)
+
+    # the hinged spatial beam: the paper's checks on the reduced beam (10 normal modes + the tip's attachment modes)
+    ffull = full_frequencies("hinged_beam_full_modes", ["-options_file", "options/hinged_beam.yaml"], out, 10)
+    for n in [10]:
+        name = "hinged_beam_reduced%d_nx8" % n
+        d, w = run(name, ["-options_file", "options/hinged_beam.yaml", "-body0_type", "reduced", "-body0_reduction_modes", str(n), "-body0_reduction_expect_full_frequencies", ffull, "-body0_reduction_expect_rtol", "1e-8"], out)
+        walls.append((name + " (50 s simulated)", w))
+        lines, _ = check("check_hinged_beam.py", [d, "--out", os.path.join(out, name + ".csv")])
+        what = "reduced beam, %d normal modes + 6 attachment modes" % n
+        for l in lines:
+            S.add("hinged beam", what, l, checked="information" not in l)
+        for l in expect_line(d):
+            S.add("hinged beam", what, l)
+
+
 def plots(out):
     """the PNGs, from the CSV files of a validation run (needs matplotlib)"""
     import matplotlib
@@ -212,7 +339,7 @@ def plots(out):
         plt.close(fig)
 
     if os.path.exists(os.path.join(out, "crankslider_full_nx16_dt2e-5.csv")):
-        curves = {k: read_csv(os.path.join(out, "crankslider_%s_nx16_dt2e-5.csv" % k[0])) for k in [("full", 16, "2e-5"), ("constant", 16, "2e-5")]}
+        curves = {k: read_csv(os.path.join(out, "crankslider_%s_nx16_dt2e-5.csv" % k[0])) for k in [("full", 16, "2e-5"), ("constant", 16, "2e-5")] if os.path.exists(os.path.join(out, "crankslider_%s_nx16_dt2e-5.csv" % k[0]))}
         ffrf = read_csv(os.path.join(REF, "crankslider_midpoint_ffrf_check.csv"))
         paper = read_csv(os.path.join(REF, "crankslider_midpoint_uy_phpaper.csv"))
 
@@ -229,6 +356,28 @@ def plots(out):
         ax.grid(alpha=0.3)
         fig.tight_layout()
         fig.savefig(os.path.join(out, "crankslider.png"), dpi=120)
+        plt.close(fig)
+    table = os.path.join(out, "reduced_crankslider_modes.csv")
+    if os.path.exists(table) and os.path.exists(os.path.join(out, "crankslider_full_nx16_dt2e-5.csv")):
+        rows = read_csv(table)
+        full = read_csv(os.path.join(out, "crankslider_full_nx16_dt2e-5.csv"))
+        fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.2))
+        ax.plot([float(r["crank_angle_rad"]) for r in full], [float(r["uy_over_L"]) for r in full], "-", color="0.6", lw=3, label="full coupler (891 DOFs)")
+        for r in rows:
+            c = read_csv(os.path.join(out, "crankslider_reduced%s_nx16_dt2e-5.csv" % r["modes"]))
+            ax.plot([float(x["crank_angle_rad"]) for x in c], [float(x["uy_over_L"]) for x in c], "-", lw=1, label="reduced, %s modes (%s coordinates)" % (r["modes"], r["coordinates"]))
+        ax.set_xlabel("crank angle [rad]")
+        ax.set_ylabel("u_y / L")
+        ax.set_title("Crank-slider: reduced coupler against the full one")
+        ax.legend(fontsize=8)
+        bx.semilogy([int(r["modes"]) for r in rows], [max(float(r["deviation_from_full"]), 1e-16) for r in rows], "o-")
+        bx.axhline(1e-3, color="r", lw=0.8, ls="--", label="tolerance 1e-3")
+        bx.set_xlabel("normal modes in the basis (+ 18 attachment modes)")
+        bx.set_ylabel("max |u_y/L - full| over 8 rad")
+        bx.set_title("Error against the number of modes")
+        bx.legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(out, "reduced_convergence.png"), dpi=120)
         plt.close(fig)
 
     if os.path.exists(os.path.join(out, "hinged_beam_full_nx8.csv")):
@@ -293,7 +442,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default=os.path.join(ROOT, "validation"))
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--cases", default="fourbar,crankslider,hinged,rotating")
+    ap.add_argument("--cases", default="fourbar,crankslider,hinged,rotating,reduced")
     ap.add_argument("--plots-only", action="store_true", help="only redraw the PNGs from the CSV files in --out")
     a = ap.parse_args()
     if a.plots_only:
@@ -303,7 +452,7 @@ def main():
     S, walls = Summary(), []
     t0 = time.time()
     for c in a.cases.split(","):
-        {"fourbar": fourbar, "crankslider": crankslider, "hinged": hinged, "rotating": rotating}[c](a.out, S, walls, a.quick)
+        {"fourbar": fourbar, "crankslider": crankslider, "hinged": hinged, "rotating": rotating, "reduced": reduced}[c](a.out, S, walls, a.quick)
     S.write(a.out, walls)
     # the plots: this interpreter's matplotlib, else the system Python's (a pyenv shim may hide python3-matplotlib)
     python = next((p for p in [sys.executable, "/usr/bin/python3"] if os.path.exists(p) and have_matplotlib(p)), None)

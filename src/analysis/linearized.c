@@ -1034,7 +1034,7 @@ static PetscErrorCode WriteShapes(Pencil *p, PhlexOutput out, const Spectrum *s)
     for (PetscInt i = 0; i < s->n; i++) PetscCall(VecDestroy(&vecs[i]));
   }
   for (PetscInt i = 0; i < sys->nparts; i++)
-    if (!sys->parts[i]->fieldops && PhlexPartIsElastic(sys->parts[i])) PetscCall(PetscPrintf(sys->comm, "  mode shapes of body %s not written: its model (-%stype %s) holds no basis vectors to draw them with\n", sys->parts[i]->name, sys->parts[i]->prefix, sys->parts[i]->type));
+    if (!sys->parts[i]->fieldops && PhlexPartIsElastic(sys->parts[i])) PetscCall(PetscPrintf(sys->comm, "  mode shapes of body %s not written: the linearised analysis draws the fields of full bodies only (-%stype %s: its own modes' shapes come with -analysis modes)\n", sys->parts[i]->name, sys->parts[i]->prefix, sys->parts[i]->type));
   PetscCall(PetscFree4(qv, rigid, lambda, vecs));
   PetscCall(PetscFree(scale));
   PetscFunctionReturn(0);

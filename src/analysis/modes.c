@@ -205,7 +205,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
       PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%d,%s\n", i + 1, (double)freq[i], (double)lam, (double)resid[i], i < nrigid ? 1 : 0, part->name));
     }
     if (shapes) PetscCall((*part->analysisops->modesoutput)(part, scene->output, nconv, nrigid, lambda, vecs, rigid, NULL));
-    else if (scene->output->fields) PetscCall(PetscPrintf(scene->comm, "  mode shapes of body %s not written: its model (-%stype %s) holds no basis vectors to draw them with\n", part->name, part->prefix, part->type));
+    else if (scene->output->fields) PetscCall(PetscPrintf(scene->comm, "  mode shapes of body %s not written: its kind (-%stype %s) draws none\n", part->name, part->prefix, part->type));
     if (o.nrefine > 0) {
       if (PhlexPartAnalysisOp(part, refine)) PetscCall(ConvergenceStudy(scene, part, o.nrefine, PetscMin(nev, nconv - nrigid), lambda, nrigid, o.order_expect, o.order_tol));
       else PetscCall(PetscPrintf(scene->comm, "  no convergence study of body %s: its model (-%stype %s) has no refinement (-modes_convergence_refinements)\n", part->name, part->prefix, part->type));

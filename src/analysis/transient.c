@@ -318,7 +318,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     m->Hmax         = PetscMax(m->Hmax, H);
     m->Hprev        = H;
   }
-  PetscCall(PetscViewerASCIIPrintf(m->energy_csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e\n", step, (double)t, (double)(kin * u->energy), (double)(strain * u->energy), (double)(pot * u->energy), (double)(H * u->energy), (double)(power * u->power), (double)(m->work_total * u->energy), (double)(residual * u->energy)));
+  PetscCall(PhlexCSVPrintf(m->energy_csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e\n", step, (double)t, (double)(kin * u->energy), (double)(strain * u->energy), (double)(pot * u->energy), (double)(H * u->energy), (double)(power * u->power), (double)(m->work_total * u->energy), (double)(residual * u->energy)));
   if (m->monitor) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(residual * u->energy)));
   PetscCall(Watchdogs(m, step, t, H, residual - m->step_project_dH));
   m->step_project_dH = 0;

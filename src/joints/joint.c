@@ -1104,18 +1104,18 @@ PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *
   *gapmax = 0.0;
   for (PetscInt k = 0; k < j->nc; k++) *gapmax = PetscMax(*gapmax, PetscAbsReal(gap[k]) * (j->row[k] <= PHLEX_ROW_T3 ? u->length : 1.0));
   if (!j->csv) PetscFunctionReturn(0);
-  PetscCall(PetscViewerASCIIPrintf(j->csv, "%.12e", (double)t));
-  for (PetscInt r = 0; r < 3; r++) PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->dir + 3 * r, wJ) * u->force)));
-  for (PetscInt r = 0; r < 3; r++) PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->dir + 3 * r, wJ + 3) * u->force * u->length)));
+  PetscCall(PhlexCSVPrintf(j->csv, "%.12e", (double)t));
+  for (PetscInt r = 0; r < 3; r++) PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->dir + 3 * r, wJ) * u->force)));
+  for (PetscInt r = 0; r < 3; r++) PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->dir + 3 * r, wJ + 3) * u->force * u->length)));
   for (PetscInt k = 0; k < nm; k++) {
     const PetscBool length = (j->type == PHLEX_JOINT_PRISMATIC || (j->type == PHLEX_JOINT_CYLINDRICAL && k == 1) || (j->type == PHLEX_JOINT_PLANAR && k < 2)) ? PETSC_TRUE : PETSC_FALSE;
-    PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(length ? mo[k] * u->length : mo[k])));
+    PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(length ? mo[k] * u->length : mo[k])));
   }
   for (PetscInt k = 0; k < j->nc; k++) {
     const PetscBool length = j->row[k] <= PHLEX_ROW_T3 ? PETSC_TRUE : PETSC_FALSE;
-    PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e", (double)(length ? gap[k] * u->length : gap[k])));
+    PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(length ? gap[k] * u->length : gap[k])));
   }
-  PetscCall(PetscViewerASCIIPrintf(j->csv, ",%.12e\n", (double)(P * u->power)));
+  PetscCall(PhlexCSVPrintf(j->csv, ",%.12e\n", (double)(P * u->power)));
   PetscFunctionReturn(0);
 }
 

@@ -546,7 +546,7 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
     PetscViewer csv = (PetscViewer)b->ports_csv;
     PetscReal   fr  = 0.0;
     PetscCall(PhlexFlexiblePortOutputsAll(part, X));
-    PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
+    PetscCall(PhlexCSVPrintf(csv, "%.12e", (double)t));
     if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
     if (b->floating) {
       /* the frame: its wrench (SI), its motion (v_P, w) */
@@ -566,7 +566,7 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
         for (PetscInt c = 0; c < 3; c++) x[c] = b->fs.r[c]; /* the frame: its origin P */
       PetscCall(PhlexPortSeriesPosition(csv, u, x));
     }
-    PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
+    PetscCall(PhlexCSVPrintf(csv, "\n"));
   }
   if (b->rigid_csv && step >= 0) {
     PetscReal P[3], L[3];

@@ -835,15 +835,15 @@ PetscErrorCode PhlexFrameWriteRow(PetscViewer csv, PetscReal t, PhlexFrameState 
   PetscCall(PhlexFrameMomenta(f, P, L));
   PhlexRotationToQuaternion(f->R, qt);
   PhlexMatVec3(f->R, f->sgrav, Rs);
-  PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(f->r[k] * u->length)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)((f->r[k] + Rs[k] / f->m) * u->length)));
-  for (PetscInt k = 0; k < 9; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)f->R[k]));
-  for (PetscInt k = 0; k < 4; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)qt[k]));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(f->vP[k] * u->velocity)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(f->w[k] / u->time)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(P[k] * u->mass * u->velocity)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(L[k] * u->mass * u->velocity * u->length)));
-  PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e\n", (double)orth));
+  PetscCall(PhlexCSVPrintf(csv, "%.12e", (double)t));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(f->r[k] * u->length)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)((f->r[k] + Rs[k] / f->m) * u->length)));
+  for (PetscInt k = 0; k < 9; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)f->R[k]));
+  for (PetscInt k = 0; k < 4; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)qt[k]));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(f->vP[k] * u->velocity)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(f->w[k] / u->time)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(P[k] * u->mass * u->velocity)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(L[k] * u->mass * u->velocity * u->length)));
+  PetscCall(PhlexCSVPrintf(csv, ",%.12e\n", (double)orth));
   PetscFunctionReturn(0);
 }

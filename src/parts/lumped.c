@@ -241,13 +241,13 @@ static PetscErrorCode LumpedOutputStep(PhlexPart part, PetscInt step, PetscReal 
   PetscFunctionBeginUser;
   if (step < 0) PetscFunctionReturn(0);
   PetscCall(LumpedMomenta(part, P, L));
-  PetscCall(PetscViewerASCIIPrintf(m->csv, "%.12e", (double)t));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(m->csv, ",%.12e", (double)(m->r[k] * u->length)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(m->csv, ",%.12e", (double)(m->v[k] * u->velocity)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(m->csv, ",%.12e", (double)(m->wext[k] * u->force)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(m->csv, ",%.12e", (double)(P[k] * u->mass * u->velocity)));
-  for (PetscInt k = 0; k < 3; k++) PetscCall(PetscViewerASCIIPrintf(m->csv, ",%.12e", (double)(L[k] * u->mass * u->velocity * u->length)));
-  PetscCall(PetscViewerASCIIPrintf(m->csv, "\n"));
+  PetscCall(PhlexCSVPrintf(m->csv, "%.12e", (double)t));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(m->csv, ",%.12e", (double)(m->r[k] * u->length)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(m->csv, ",%.12e", (double)(m->v[k] * u->velocity)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(m->csv, ",%.12e", (double)(m->wext[k] * u->force)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(m->csv, ",%.12e", (double)(P[k] * u->mass * u->velocity)));
+  for (PetscInt k = 0; k < 3; k++) PetscCall(PhlexCSVPrintf(m->csv, ",%.12e", (double)(L[k] * u->mass * u->velocity * u->length)));
+  PetscCall(PhlexCSVPrintf(m->csv, "\n"));
   PetscFunctionReturn(0);
 }
 

@@ -492,10 +492,10 @@ PetscErrorCode PhlexPortSeriesOpen(PhlexOutput out, const char part[], PetscInt 
 PetscErrorCode PhlexPortSeriesEntry(PetscViewer csv, const PhlexUnits *u, const PetscReal w[6], PetscBool si, const PetscReal y[6])
 {
   PetscFunctionBeginUser;
-  for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(si ? w[c] : w[c] * u->force)));
-  for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(si ? w[c] : w[c] * u->force * u->length)));
-  for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(y[c] * u->velocity)));
-  for (PetscInt c = 3; c < 6; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(y[c] / u->time)));
+  for (PetscInt c = 0; c < 3; c++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(si ? w[c] : w[c] * u->force)));
+  for (PetscInt c = 3; c < 6; c++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(si ? w[c] : w[c] * u->force * u->length)));
+  for (PetscInt c = 0; c < 3; c++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(y[c] * u->velocity)));
+  for (PetscInt c = 3; c < 6; c++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(y[c] / u->time)));
   PetscFunctionReturn(0);
 }
 
@@ -505,6 +505,6 @@ PetscErrorCode PhlexPortSeriesEntry(PetscViewer csv, const PhlexUnits *u, const 
 PetscErrorCode PhlexPortSeriesPosition(PetscViewer csv, const PhlexUnits *u, const PetscReal x[3])
 {
   PetscFunctionBeginUser;
-  for (PetscInt c = 0; c < 3; c++) PetscCall(PetscViewerASCIIPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
+  for (PetscInt c = 0; c < 3; c++) PetscCall(PhlexCSVPrintf(csv, ",%.12e", (double)(x[c] * u->length)));
   PetscFunctionReturn(0);
 }

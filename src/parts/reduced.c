@@ -30,6 +30,7 @@ typedef struct {
   PhlexFrame         frame;
   PhlexFrameState    fs;
   PetscReal         *Mom;   /* per basis vector 3 PHLEX_FRAME_NIN: the node inputs' moments at the evaluated state */
+  PetscReal         *nmom;  /* 4 x 9 m: the moments of eta, eta', zeta, zeta' with each basis vector (FieldMoments) */
   PetscReal         *gext;  /* m: generalized force of the external inputs (ports, body force, a fixed body's weight) */
   PetscReal         *work;  /* m */
   PetscReal         *etad, *zetad; /* m each: the rates of the evaluated state (non-dimensional time) */
@@ -162,6 +163,15 @@ static PetscErrorCode ReducedExpectFrequencies(PhlexPart part, Reduced *r)
       worst = PetscMax(worst, fr[k] / r->expect_full[k] - 1);
     }
     PetscCall(PetscInfo(NULL, "body %s: the first %" PetscInt_FMT " reduced frequencies exceed the full body's by %g at most (relative)\n", part->name, n, (double)worst));
+    if (r->type != PHLEX_REDUCTION_KRYLOV && !(r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports) && nh > 0) {
+      /* the basis holds the full body's lowest nh normal modes (the frame held as in the full body's modal
+         analysis): Rayleigh-Ritz reproduces their frequencies, the lowest nh reduced ones, exactly */
+      const PetscInt ne = PetscMin(n, nh);
+      PetscReal      dev = 0.0;
+      for (PetscInt k = 0; k < ne; k++) dev = PetscMax(dev, PetscAbsReal(fr[k] / r->expect_full[k] - 1));
+      PetscCheck(dev <= tol, part->comm, PETSC_ERR_USER, "body %s: FAIL: the reduced frequencies of the %" PetscInt_FMT " normal modes in the basis differ from the full body's by %.2e relative (tolerance %.1e, -reduction_expect_full_frequencies)", part->name, ne, (double)dev, (double)tol);
+      PetscCall(PetscPrintf(part->comm, "body %s: reduced frequencies of the %" PetscInt_FMT " normal modes in the basis against the full body's: max relative deviation %.1e (tolerance %.1e): PASS\n", part->name, ne, (double)dev, (double)tol));
+    }
     if (r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports)
       for (PetscInt k = 0; k < nh; k++) {
         PetscCheck(fr[k] <= fh[k] * (1 + tol), part->comm, PETSC_ERR_USER, "body %s: FAIL: reduced frequency %" PetscInt_FMT " %.10g Hz above held frequency %" PetscInt_FMT " %.10g Hz (interlacing)", part->name, k + 1, (double)fr[k], k + 1, (double)fh[k]);
@@ -257,7 +267,7 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   r->frame.gyroscopic = b->gyroscopic;
   r->frame.inertia    = r->md.inertia;
   r->frame.gravity    = part->gravity;
-  PetscCall(PetscCalloc3(3 * PHLEX_FRAME_NIN * m, &r->Mom, m, &r->gext, m, &r->work));
+  PetscCall(PetscCalloc4(3 * PHLEX_FRAME_NIN * m, &r->Mom, m, &r->gext, m, &r->work, 36 * m, &r->nmom));
   PetscCall(PetscCalloc2(m, &r->etad, m, &r->zetad));
   if (r->floating) PetscCall(PetscCalloc3(54 * PHLEX_FRAME_NIN, &r->Lb, 54 * PHLEX_FRAME_NIN, &r->Lu, 54 * PHLEX_FRAME_NIN, &r->Lv));
   PetscFunctionReturn(0);
@@ -315,7 +325,7 @@ static PetscErrorCode ReducedDestroy(PhlexPart part)
   PetscFunctionBeginUser;
   PetscCall(PhlexPartDestroy(&r->full));
   if (r->m) PetscCall(PhlexReducedModelDestroy(&r->md));
-  PetscCall(PetscFree3(r->Mom, r->gext, r->work));
+  PetscCall(PetscFree4(r->Mom, r->gext, r->work, r->nmom));
   PetscCall(PetscFree2(r->etad, r->zetad));
   PetscCall(PetscFree3(r->Lb, r->Lu, r->Lv));
   PetscCall(PetscFree3(r->port_ext, r->port_y, r->port_ub));
@@ -353,12 +363,12 @@ static PetscErrorCode ReducedInitialState(PhlexPart part, PhlexPartVec *X)
 static inline void NMoment(const Reduced *r, const PetscReal *x, PetscInt k, PetscReal out[9])
 {
   const PetscInt m = r->m;
-  for (PetscInt i = 0; i < 9; i++) out[i] = 0.0;
+  PetscReal      acc[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}; /* accumulated locally: the compiler cannot know that out aliases no input */
   for (PetscInt j = 0; j < m; j++) {
-    const PetscReal *N = r->md.N + 9 * (j * m + k);
-    if (x[j] == 0.0) continue;
-    for (PetscInt i = 0; i < 9; i++) out[i] += x[j] * N[i];
+    const PetscReal *N = r->md.N + 9 * (j * m + k), xj = x[j];
+    for (PetscInt i = 0; i < 9; i++) acc[i] += xj * N[i];
   }
+  for (PetscInt i = 0; i < 9; i++) out[i] = acc[i];
 }
 
 /* the frame's integrals of the field (frame.c's sums) from the invariants */
@@ -384,55 +394,58 @@ static void FieldSums(const Reduced *r, const PetscReal *eta, const PetscReal *e
     }
   }
   if (!r->full_inertia) return;
-  for (PetscInt a = 0; a < m; a++)
-    for (PetscInt j = 0; j < m; j++) {
-      const PetscReal *N = r->md.N + 9 * (a * m + j);
-      const PetscReal  uu = eta[a] * eta[j], du = etad[a] * eta[j], uv = eta[a] * zeta[j], ud = eta[a] * zetad[j] + etad[a] * zeta[j];
+  {
+    /* sum_{a,j} x_a y_j N_aj = sum_j y_j (sum_a x_a N_aj): from the moments of FieldMoments, O(m) */
+    const PetscReal *nu = r->nmom, *nud = r->nmom + 9 * m;
+    for (PetscInt k = 0; k < m; k++)
       for (PetscInt i = 0; i < 9; i++) {
-        Nuu[i] += uu * N[i];
-        Nudu[i] += du * N[i];
-        Nuv[i] += uv * N[i];
-        Nuvd[i] += ud * N[i];
+        Nuu[i] += eta[k] * nu[9 * k + i];
+        Nudu[i] += eta[k] * nud[9 * k + i];
+        Nuv[i] += zeta[k] * nu[9 * k + i];
+        Nuvd[i] += zetad[k] * nu[9 * k + i] + zeta[k] * nud[9 * k + i];
       }
-    }
+  }
+}
+
+/* the moments through the mass of eta, eta' (full inertia only), zeta and zeta' with every basis vector (NMoment, 9 m
+   values each, in r->nmom): once per evaluation, shared by the frame's sums and the node inputs' moments */
+static void FieldMoments(Reduced *r, const PetscReal *eta, const PetscReal *etad, const PetscReal *zeta, const PetscReal *zetad)
+{
+  const PetscInt m  = r->m;
+  PetscReal     *nu = r->nmom, *nud = nu + 9 * m, *nv = nud + 9 * m, *nvd = nv + 9 * m;
+
+  for (PetscInt k = 0; k < m; k++) {
+    if (r->full_inertia) {
+      NMoment(r, eta, k, nu + 9 * k);
+      NMoment(r, etad, k, nud + 9 * k);
+    } else
+      for (PetscInt i = 0; i < 9; i++) nu[9 * k + i] = nud[9 * k + i] = 0.0;
+    NMoment(r, zeta, k, nv + 9 * k);
+    NMoment(r, zetad, k, nvd + 9 * k);
+  }
 }
 
 /* the node inputs' moments with each basis vector (PhlexFrameLoadCoefficients, PhlexFrameJacobian): inputs t, z = int
    rho y phi, Mv u', Mv v, Mv v', the load arm (none here: the reduced body adds its arms itself), int rho x phi */
-static void InputMoments(Reduced *r, const PetscReal *eta, const PetscReal *etad, const PetscReal *zeta, const PetscReal *zetad)
+static void InputMoments(Reduced *r)
 {
-  const PetscInt m = r->m;
+  const PetscInt   m  = r->m;
+  const PetscReal *nu = r->nmom, *nud = nu + 9 * m, *nv = nud + 9 * m, *nvd = nv + 9 * m;
   for (PetscInt k = 0; k < m; k++) {
-    PetscReal       *Mom = r->Mom + 3 * PHLEX_FRAME_NIN * k, nu[9], nud[9], nv[9], nvd[9];
+    PetscReal       *Mom = r->Mom + 3 * PHLEX_FRAME_NIN * k;
     const PetscReal *S = r->md.S + 3 * k, *W = r->md.W + 9 * k;
     for (PetscInt i = 0; i < 3 * PHLEX_FRAME_NIN; i++) Mom[i] = 0.0;
-    if (r->full_inertia) {
-      NMoment(r, eta, k, nu);
-      NMoment(r, etad, k, nud);
-    } else
-      for (PetscInt i = 0; i < 9; i++) nu[i] = nud[i] = 0.0;
-    NMoment(r, zeta, k, nv);
-    NMoment(r, zetad, k, nvd);
     for (PetscInt c = 0; c < 3; c++) {
       Mom[c + 3 * PHLEX_FRAME_IN_T] = S[c];
       for (PetscInt bb = 0; bb < 3; bb++) {
-        Mom[c + 3 * (PHLEX_FRAME_IN_Z + bb)]   = W[3 * bb + c] + nu[3 * bb + c];
-        Mom[c + 3 * (PHLEX_FRAME_IN_ZD + bb)]  = nud[3 * bb + c];
-        Mom[c + 3 * (PHLEX_FRAME_IN_MV + bb)]  = nv[3 * bb + c];
-        Mom[c + 3 * (PHLEX_FRAME_IN_MVD + bb)] = nvd[3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_Z + bb)]   = W[3 * bb + c] + nu[9 * k + 3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_ZD + bb)]  = nud[9 * k + 3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_MV + bb)]  = nv[9 * k + 3 * bb + c];
+        Mom[c + 3 * (PHLEX_FRAME_IN_MVD + bb)] = nvd[9 * k + 3 * bb + c];
         Mom[c + 3 * (PHLEX_FRAME_IN_W + bb)]   = W[3 * bb + c];
       }
     }
   }
-}
-
-/* sum_{c,i} L[(3 j + c) nin + i] Mom_k[c + 3 i] */
-static inline PetscReal Contract(const PetscReal *L, PetscInt j, const PetscReal *Mom)
-{
-  PetscReal s = 0.0;
-  for (PetscInt c = 0; c < 3; c++)
-    for (PetscInt i = 0; i < PHLEX_FRAME_NIN; i++) s += L[(3 * j + c) * PHLEX_FRAME_NIN + i] * Mom[c + 3 * i];
-  return s;
 }
 
 /* the arm of a force on port q from the frame origin P: its point, and with full inertia its mean displacement */
@@ -469,10 +482,11 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
     }
   if (r->floating) {
     for (PetscInt k = 0; k < 18; k++) qd[k] = Xdot ? T * Xdot->q[k] : 0.0;
+    FieldMoments(r, eta, etad, zeta, zetad);
     FieldSums(r, eta, etad, zeta, zetad, f->sums);
     f->sums_req = MPI_REQUEST_NULL;
     PetscCall(PhlexFrameEvaluateEnd(&r->frame, X->q, qd, f));
-    InputMoments(r, eta, etad, zeta, zetad);
+    InputMoments(r);
   }
   /* the external inputs: generalized forces on the field, resultant about P on the frame, their power */
   for (PetscInt k = 0; k < m; k++) r->gext[k] = 0.0;
@@ -620,12 +634,31 @@ static PetscErrorCode ReducedJacobian(PhlexPart part, PetscReal shift, const Phl
     PetscCall(PhlexFrameJacobian(&r->frame, &r->fs, shift, Lb, Lu, Lv, nin, Bvv, Bvu, Arr));
     for (PetscInt i = 0; i < 18; i++)
       for (PetscInt j = 0; j < 18; j++) Dq(i, j) = Arr[18 * i + j];
-    for (PetscInt k = 0; k < m; k++) {
-      const PetscReal *Mom = r->Mom + 3 * nin * k;
-      for (PetscInt j = 0; j < 18; j++) {
-        Dq(j, ie + k) = Contract(Lu, j, Mom);
-        Dq(j, iz + k) = Contract(Lv, j, Mom);
-        Dq(iz + k, j) = Contract(Lb, j, Mom);
+    {
+      /* the borders: sum_{c,i} L[(3 j + c) nin + i] Mom_k[c + 3 i], with L reordered once to Mom's layout so that each
+         entry is a contiguous dot product */
+      PetscReal Lt[3][18 * 3 * PHLEX_FRAME_NIN];
+      for (PetscInt j = 0; j < 18; j++)
+        for (PetscInt c = 0; c < 3; c++)
+          for (PetscInt i = 0; i < nin; i++) {
+            Lt[0][3 * nin * j + c + 3 * i] = Lu[(3 * j + c) * nin + i];
+            Lt[1][3 * nin * j + c + 3 * i] = Lv[(3 * j + c) * nin + i];
+            Lt[2][3 * nin * j + c + 3 * i] = Lb[(3 * j + c) * nin + i];
+          }
+      for (PetscInt k = 0; k < m; k++) {
+        const PetscReal *Mom = r->Mom + 3 * nin * k;
+        for (PetscInt j = 0; j < 18; j++) {
+          const PetscReal *lu = Lt[0] + 3 * nin * j, *lv = Lt[1] + 3 * nin * j, *lb = Lt[2] + 3 * nin * j;
+          PetscReal        su = 0.0, sv = 0.0, sb = 0.0;
+          for (PetscInt i = 0; i < 3 * nin; i++) {
+            su += lu[i] * Mom[i];
+            sv += lv[i] * Mom[i];
+            sb += lb[i] * Mom[i];
+          }
+          Dq(j, ie + k) = su;
+          Dq(j, iz + k) = sv;
+          Dq(iz + k, j) = sb;
+        }
       }
     }
     if (r->full_inertia) {
@@ -712,15 +745,23 @@ static PetscErrorCode ReducedPortLinear(PhlexPart part, PetscInt q, Vec du, Pets
   for (PetscInt k = 0; k < 6; k++) dy[k] = 0.0;
   if (!dq) PetscFunctionReturn(0);
   if (q < r->nports)
-    for (PetscInt d = 0; d < 6; d++)
-      for (PetscInt k = 0; k < m; k++) dy[d] += r->md.P[6 * m * q + m * d + k] * dq[r->iz + k];
+    for (PetscInt d = 0; d < 6; d++) {
+      const PetscReal *P = r->md.P + 6 * m * q + m * d, *dz = dq + r->iz;
+      PetscReal        s = 0.0;
+      for (PetscInt k = 0; k < m; k++) s += P[k] * dz[k];
+      dy[d] = s;
+    }
   if (r->floating) {
     PetscReal arm[3], a[3];
     if (r->full_inertia && q < r->nports) {
       /* w x d ubar */
-      PetscReal dub[3] = {0, 0, 0};
-      for (PetscInt c = 0; c < 3; c++)
-        for (PetscInt k = 0; k < m; k++) dub[c] += r->md.P[6 * m * q + m * c + k] * dq[r->ie + k];
+      PetscReal dub[3];
+      for (PetscInt c = 0; c < 3; c++) {
+        const PetscReal *P = r->md.P + 6 * m * q + m * c, *de = dq + r->ie;
+        PetscReal        s = 0.0;
+        for (PetscInt k = 0; k < m; k++) s += P[k] * de[k];
+        dub[c] = s;
+      }
       PhlexCross(r->fs.w, dub, a);
       for (PetscInt c = 0; c < 3; c++) dy[c] += a[c];
     }
@@ -741,9 +782,14 @@ static PetscErrorCode ReducedPortForce(PhlexPart part, PetscInt q, const PetscRe
 
   PetscFunctionBeginUser;
   if (!fq) PetscFunctionReturn(0);
-  if (q < r->nports)
-    for (PetscInt d = 0; d < 6; d++)
-      for (PetscInt k = 0; k < m; k++) fq[r->iz + k] += r->md.P[6 * m * q + m * d + k] * w[d];
+  if (q < r->nports) {
+    const PetscReal *P = r->md.P + 6 * m * q;
+    for (PetscInt k = 0; k < m; k++) {
+      PetscReal s = 0.0;
+      for (PetscInt d = 0; d < 6; d++) s += P[m * d + k] * w[d];
+      fq[r->iz + k] += s;
+    }
+  }
   if (r->floating) {
     PetscReal arm[3], a[3];
     PortArm(r, part, q, arm);
@@ -908,7 +954,7 @@ static PetscErrorCode ReducedSeriesStep(PhlexPart part, PetscReal t, const Phlex
   if (r->ports_csv) {
     PetscViewer csv = r->ports_csv;
     PetscReal   fr  = 0.0;
-    PetscCall(PetscViewerASCIIPrintf(csv, "%.12e", (double)t));
+    PetscCall(PhlexCSVPrintf(csv, "%.12e", (double)t));
     if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
     if (r->floating) {
       const PetscReal wf[6] = {fr * b->frame_force[0], fr * b->frame_force[1], fr * b->frame_force[2], fr * b->frame_moment[0], fr * b->frame_moment[1], fr * b->frame_moment[2]};
@@ -927,16 +973,16 @@ static PetscErrorCode ReducedSeriesStep(PhlexPart part, PetscReal t, const Phlex
         for (PetscInt c = 0; c < 3; c++) x[c] = r->fs.r[c];
       PetscCall(PhlexPortSeriesPosition(csv, u, x));
     }
-    PetscCall(PetscViewerASCIIPrintf(csv, "\n"));
+    PetscCall(PhlexCSVPrintf(csv, "\n"));
   }
   if (r->rigid_csv) {
     PetscReal P[3], L[3];
     PetscCall(PhlexFrameWriteRow(r->rigid_csv, t, &r->fs, u, P, L));
   }
-  PetscCall(PetscViewerASCIIPrintf(r->modal_csv, "%.12e", (double)t));
-  for (PetscInt k = 0; k < r->m; k++) PetscCall(PetscViewerASCIIPrintf(r->modal_csv, ",%.12e", (double)(X->q[r->ie + k] * u->length)));
-  for (PetscInt k = 0; k < r->m; k++) PetscCall(PetscViewerASCIIPrintf(r->modal_csv, ",%.12e", (double)(X->q[r->iz + k] * u->velocity)));
-  PetscCall(PetscViewerASCIIPrintf(r->modal_csv, "\n"));
+  PetscCall(PhlexCSVPrintf(r->modal_csv, "%.12e", (double)t));
+  for (PetscInt k = 0; k < r->m; k++) PetscCall(PhlexCSVPrintf(r->modal_csv, ",%.12e", (double)(X->q[r->ie + k] * u->length)));
+  for (PetscInt k = 0; k < r->m; k++) PetscCall(PhlexCSVPrintf(r->modal_csv, ",%.12e", (double)(X->q[r->iz + k] * u->velocity)));
+  PetscCall(PhlexCSVPrintf(r->modal_csv, "\n"));
   PetscFunctionReturn(0);
 }
 
@@ -1014,8 +1060,8 @@ static PetscErrorCode ReducedPencil(Reduced *r, PetscInt *n, PetscReal **K, Pets
 
   (every process holds the model and solves the same problem). Rayleigh-Ritz: every eigenvalue bounds the full body's of the same rank from above, and the full body's normal modes
   in the basis (those with the frame held: all of a fixed body's, a floating body's on mean axes) come out exactly.
-  At most the basis's m elastic modes exist; nev nearest -modes_target_frequency, else the lowest. No mode shapes
-  (vecs, rigid must be NULL): the reduced model holds no basis vectors. */
+  At most the basis's m elastic modes exist; nev nearest -modes_target_frequency, else the lowest. The shapes (vecs,
+  rigid, when asked) are the full body's fields Phi x of the eigenvectors and their frames' velocities. */
 static PetscErrorCode ReducedComputeModes(PhlexPart part, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
 {
   Reduced     *r = (Reduced *)part->data;
@@ -1025,7 +1071,6 @@ static PetscErrorCode ReducedComputeModes(PhlexPart part, PetscInt nev, PetscInt
   PetscBool    target;
 
   PetscFunctionBeginUser;
-  PetscCheck(!vecs && !rigid, part->comm, PETSC_ERR_SUP, "body %s: a reduced body's mode shapes need its basis vectors, which the reduced model does not hold", part->name);
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
   PetscCall(ReducedPencil(r, &n, &K, &M));
   PetscCall(PetscMalloc3(n * n, &A, n * n, &B, n, &w));
@@ -1084,9 +1129,42 @@ static PetscErrorCode ReducedComputeModes(PhlexPart part, PetscInt nev, PetscInt
     res = PetscSqrtReal(res), xn = PetscSqrtReal(xn);
     (*resid)[i] = i < nr ? res / ((nrmk + PetscAbsReal(lam) * nrmm) * xn) : res / (PetscAbsReal(lam) * xn);
   }
+  if (vecs || rigid) {
+    /* the shapes: the field Phi x_eta of each mode on the full body's mesh (the basis kept from the build, or read from
+       the file) and a floating body's frame velocity (v_P, w) */
+    const PetscInt o = r->floating ? 6 : 0;
+    if (vecs) {
+      char who[PHLEX_NAME_LEN + 8];
+      PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", part->name));
+      PetscCall(PhlexReducedReadBasis(r->full, r->file, who, part->units, &r->md));
+      PetscCall(PetscMalloc1(*nconv, vecs));
+    }
+    if (rigid) PetscCall(PetscMalloc1(6 * *nconv, rigid));
+    for (PetscInt i = 0; i < *nconv; i++) {
+      const PetscInt   e = i < nr ? i : first + (i - nr);
+      const PetscReal *x = A + n * e;
+      if (vecs) {
+        PetscCall(VecDuplicate(r->md.Phi[0], &(*vecs)[i]));
+        PetscCall(VecSet((*vecs)[i], 0.0));
+        PetscCall(VecMAXPY((*vecs)[i], r->m, x + o, r->md.Phi));
+      }
+      if (rigid)
+        for (PetscInt c = 0; c < 6; c++) (*rigid)[6 * i + c] = r->floating ? x[c] : 0.0;
+    }
+  }
   PetscCall(PetscFree3(A, B, w));
   PetscCall(PetscFree2(K, M));
   PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* the mode shapes on the full body's mesh (<body>_modes.h5, .xmf), written as the full body writes its own */
+static PetscErrorCode ReducedModesOutput(PhlexPart part, PhlexOutput out, PetscInt nconv, PetscInt nrigid, const PetscReal *lambda, Vec *vecs, const PetscReal *rigid, const PetscReal *placement)
+{
+  Reduced *r = (Reduced *)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFlexibleModesOutput(r->full, out, nconv, nrigid, lambda, vecs, rigid, placement));
   PetscFunctionReturn(0);
 }
 
@@ -1134,7 +1212,8 @@ PetscErrorCode PhlexPartCreate_Reduced(PhlexPart part)
   part->ops.outputopen     = ReducedOutputOpen;
   part->ops.outputstep     = ReducedOutputStep;
   part->ops.outputclose    = ReducedOutputClose;
-  part->analysisops->modes     = ReducedComputeModes;
-  part->analysisops->modeskind = ReducedModesKind;
+  part->analysisops->modes       = ReducedComputeModes;
+  part->analysisops->modeskind   = ReducedModesKind;
+  part->analysisops->modesoutput = ReducedModesOutput;
   PetscFunctionReturn(0);
 }

@@ -385,7 +385,7 @@ static PetscErrorCode RigidOutputStep(PhlexPart part, PetscInt step, PetscReal t
   if (step < 0) PetscFunctionReturn(0); /* fields only: a rigid body has none */
   PetscCall(PhlexFrameWriteRow(r->rigid_csv, t, &r->fs, u, P, L));
   if (r->ports_csv) {
-    PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "%.12e", (double)t));
+    PetscCall(PhlexCSVPrintf(r->ports_csv, "%.12e", (double)t));
     for (PetscInt p = 0; p < r->nports; p++) {
       PetscReal in[6], y[6];
       PetscCall(PhlexPortLoadEvaluate(&r->load[p], t, u, r->fs.R, in)); /* body frame */
@@ -397,7 +397,7 @@ static PetscErrorCode RigidOutputStep(PhlexPart part, PetscInt step, PetscReal t
       PetscCall((*part->ops.portplacement)(part, p, X, x, R));
       PetscCall(PhlexPortSeriesPosition(r->ports_csv, u, x));
     }
-    PetscCall(PetscViewerASCIIPrintf(r->ports_csv, "\n"));
+    PetscCall(PhlexCSVPrintf(r->ports_csv, "\n"));
   }
   PetscFunctionReturn(0);
 }

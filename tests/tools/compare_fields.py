@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
 """Checks of the field files (<body>.h5 + <body>.xmf) a body writes, read with h5dump (Debian's hdf5-tools).
 
-  compare_fields.py compare A.h5 B.h5 [--fields displacement,stress] [--step -1] [--rtol R]
+  compare_fields.py compare A.h5 B.h5 [--fields displacement,stress] [--step -1] [--rtol R] [--up-to-sign]
       the arrays of the named fields at one output step of two runs of the same mesh: vertices matched by their
       coordinates and cells by their vertices' (so two process counts, whose numberings differ, compare too);
-      PASS when max |A - B| <= R max |B| for each field, over its entities and components (R = 0: the same doubles)
+      PASS when max |A - B| <= R max |B| for each field, over its entities and components (R = 0: the same doubles);
+      --up-to-sign: A against B or -B, whichever is closer (mode shapes, whose sign is arbitrary)
 
   compare_fields.py modal FIELDS.h5 MODAL.csv REDUCED.h5 [--step -1] [--rtol R]
       a reduced body's fields are its basis times its elastic coordinates: displacement = Phi eta, velocity = Phi
@@ -82,6 +83,7 @@ FIELDS = {  # name -> (dataset, components, vertex field)
     "inertial_position": ("/vertex_fields/inertial_position_vertex", 3, True),
     "stress": ("/cell_fields/stress_cell", 6, False),
     "von_mises": ("/cell_fields/von_mises_scalar", 1, False),
+    "mode_shape": ("/vertex_fields/mode_shape_vertex", 3, True),
 }
 
 
@@ -107,13 +109,17 @@ def compare(args):
         rb = step_rows(args.b, ds, args.step, nc)
         ka, kb = (a_v, b_v) if vertex else (a_c, b_c)
         index_b = {k: i for i, k in enumerate(kb)}
-        diff = scale = 0.0
-        for i, k in enumerate(ka):
-            for c in range(nc):
-                x, y = ra[i][c], rb[index_b[k]][c]
-                diff = max(diff, abs(x - y))
-                scale = max(scale, abs(y))
-        ok = verdict(name, diff, scale, args.rtol, "B") and ok
+        best = None
+        for sign in ([1.0, -1.0] if args.up_to_sign else [1.0]):
+            diff = scale = 0.0
+            for i, k in enumerate(ka):
+                for c in range(nc):
+                    x, y = ra[i][c], sign * rb[index_b[k]][c]
+                    diff = max(diff, abs(x - y))
+                    scale = max(scale, abs(y))
+            if best is None or diff < best[0]:
+                best = (diff, scale)
+        ok = verdict(name, best[0], best[1], args.rtol, "B") and ok
     return ok
 
 
@@ -189,6 +195,7 @@ def main():
     c.add_argument("--fields", default="displacement,stress")
     c.add_argument("--step", type=int, default=-1)
     c.add_argument("--rtol", type=float, default=0.0)
+    c.add_argument("--up-to-sign", action="store_true", help="A against B or -B, the closer (mode shapes)")
     md = sub.add_parser("modal")
     md.add_argument("fields")
     md.add_argument("modal")
