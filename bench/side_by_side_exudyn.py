@@ -21,6 +21,7 @@ import datetime
 import json
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -49,6 +50,7 @@ def phlex(a, mesh, model):
     steps = int(re.search(r"Transient: (\d+) steps", log).group(1))
     with open(os.path.join(out, "bar_ports.csv")) as f:
         rows = list(csv.DictReader(f))
+    shutil.rmtree(out)
     tip = [[float(r["tip_%s" % c]) for c in "xyz"] for r in rows]
     return dict(ms_per_step=1e3 * stage / steps, tip_final=tip[-1], tip_min_z=min(t[2] for t in tip), steps=steps)
 

@@ -171,7 +171,11 @@ def mechanism(a, out):
     def one(cells, dt, np_=1, preset="", model="full"):
         extra = []
         if model.startswith("reduced"):
+            if not model[len("reduced"):].isdigit():
+                sys.exit("coupler model %s: reduced<N>, N the number of normal modes (reduced10)" % model)
             extra = ["-body1_type", "reduced", "-body1_reduction_modes", model[len("reduced"):]]
+        elif model != "full":
+            sys.exit("unknown coupler model %s (full, reduced<N>)" % model)
         cmd = launcher(np_) + [a.phlex, "-options_file", "options/crankslider.yaml", "-body1_dm_plex_filename",
                                "meshes/crankslider_coupler_nx%d.msh" % cells, "-ts_dt", repr(dt), "-ts_max_time",
                                repr(tend), "-output_fields", "0", "-output_dir", outdir, "-progress", "0",

@@ -16,7 +16,8 @@ typedef struct _p_PhlexOutput  *PhlexOutput;
 typedef enum {
   PHLEX_ANALYSIS_TRANSIENT,
   PHLEX_ANALYSIS_MODES,
-  PHLEX_ANALYSIS_LINEARIZED
+  PHLEX_ANALYSIS_LINEARIZED,
+  PHLEX_ANALYSIS_REDUCE
 } PhlexAnalysisType;
 PETSC_EXTERN const char *const PhlexAnalysisTypes[];
 
@@ -120,6 +121,7 @@ PETSC_EXTERN PetscErrorCode PhlexJointDestroy(PhlexJoint *);
 /* modes.c and transient.c: the analyses */
 PETSC_EXTERN PetscErrorCode PhlexSceneSolveModes(PhlexScene);
 PETSC_EXTERN PetscErrorCode PhlexSceneSolveLinearized(PhlexScene);
+PETSC_EXTERN PetscErrorCode PhlexSceneReduce(PhlexScene);
 PETSC_EXTERN PetscErrorCode PhlexSceneSolveTransient(PhlexScene);
 
 #endif

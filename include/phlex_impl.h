@@ -44,6 +44,7 @@ struct _p_PhlexOutput {
   void       **writer_ctx;
   PetscErrorCode (**writer_save)(void *, PetscViewer); /* records writer k's state in a checkpoint */
   PetscBool    keep_tmp;                  /* a checkpoint refers to the temporary files: an error keeps them */
+  PetscLogDouble series_flushed;          /* wall time of the series' last flush (PhlexOutputFlushSeries) */
   PetscViewer  restart;                   /* the checkpoint a restarted run continues (HDF5, read), or NULL */
   char         restart_dir[PETSC_MAX_PATH_LEN]; /* where the interrupted run's series and field segments are */
   PetscInt     nrestart_csv;
@@ -110,6 +111,7 @@ PETSC_INTERN PetscErrorCode PhlexOutputSetFromOptions(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputFile(PhlexOutput, const char[], char[]);
 PETSC_INTERN PetscErrorCode PhlexOutputCSVOpen(PhlexOutput, const char[], const char[], PetscViewer *);
 PETSC_INTERN PetscErrorCode PhlexCSVPrintf(PetscViewer, const char[], ...) PETSC_ATTRIBUTE_FORMAT(2, 3);
+PETSC_INTERN PetscErrorCode PhlexOutputFlushSeries(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputCommit(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputAbort(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputDestroy(PhlexOutput *);

@@ -70,6 +70,7 @@ static PetscErrorCode Run(PhlexScene *scene)
   if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_MODES) PetscCall(PhlexSceneSolveModes(*scene));
   if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_TRANSIENT) PetscCall(PhlexSceneSolveTransient(*scene));
   if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_LINEARIZED) PetscCall(PhlexSceneSolveLinearized(*scene));
+  if (help_mode == PHLEX_HELP_NONE && analysis == PHLEX_ANALYSIS_REDUCE) PetscCall(PhlexSceneReduce(*scene));
   if (help_mode != PHLEX_HELP_NONE) PetscCall(PhlexHelpEnd(PETSC_COMM_WORLD, catalogue));
   else PetscCall(PhlexOptionsWarnUnused(PETSC_COMM_WORLD));
   PetscFunctionReturn(0);

@@ -13,7 +13,7 @@ and writes under validation/:
   summary.csv, summary.md        case, metric, tolerance, value, pass/fail, and the wall time of each run
   runs/<run>/                    each run's own output directory (energy.csv, ports, joints, ...)
 Exit status 1 if a checked metric fails. Usage: python3 tools/validate.py [--out validation] [--quick]
-(--quick: the coarse meshes only, about a minute).
+(--quick: the coarse meshes and one basis size per reduced case, about 4 minutes).
 """
 import argparse
 import csv
@@ -183,12 +183,20 @@ def rotating(out, S, walls, quick):
 
 
 def full_frequencies(name, args, out, n):
-    """the lowest n elastic frequencies [Hz] of the full body of a scene (-analysis modes, the frame held as the
-    reduced body's basis holds it: clamped at a frame patch, free on mean axes), as the option list of
+    """the lowest n elastic frequencies [Hz] of a full body (-analysis modes; args hold it as the reduced body's basis
+    does: clamped at its frame patch, clamped_bar, or free on mean axes), as the option list of
     -reduction_expect_full_frequencies"""
     d, _ = run(name, args + ["-analysis", "modes", "-modes_nev", str(n + 6)], out)
     f = [r["frequency_hz"] for r in read_csv(os.path.join(d, "modes.csv")) if r["rigid"] == "0"]
     return ",".join(f[:n])
+
+
+def clamped_bar(mesh, degree, patch, E, nu):
+    """a scene's body alone, clamped at its frame patch (the modal analysis of a floating body on a frame patch has
+    the patch move rigidly: free-free modes; the reduced body's basis holds the clamped ones)"""
+    return ["-num_bodies", "1", "-body0_name", "bar", "-body0_dm_plex_filename", mesh, "-body0_petscspace_degree", str(degree),
+            "-body0_motion", "fixed", "-body0_frame_patch", patch, "-body0_youngs_modulus", E, "-body0_poissons_ratio", nu,
+            "-body0_density", "7800"]
 
 
 def expect_line(d):
@@ -199,6 +207,9 @@ def expect_line(d):
 
 def crank_curve_deviation(a, b):
     """max |u_y/L| difference of two crankslider_midpoint.py --out curves (the same crank angles)"""
+    xa, xb = [r["crank_angle_rad"] for r in a], [r["crank_angle_rad"] for r in b]
+    if xa != xb:
+        sys.exit("validate: the two crank-slider curves are not sampled at the same crank angles (%d and %d rows)" % (len(xa), len(xb)))
     ya, yb = [float(r["uy_over_L"]) for r in a], [float(r["uy_over_L"]) for r in b]
     return max(abs(x - y) for x, y in zip(ya, yb))
 
@@ -210,7 +221,7 @@ def reduced(out, S, walls, quick):
     print("reduced bodies (the crank-slider's coupler, the flexible pendulum, the hinged beam)")
     full_name = "crankslider_full_nx16_dt2e-5"
     full_csv = os.path.join(out, full_name + ".csv")
-    full_wall = dict(walls).get(full_name + " (0.0533 s simulated)")
+    full_wall = dict(walls).get(full_name + " (0.0533 s simulated)")  # this validation's own run only
     if full_wall is None or not os.path.exists(full_csv):
         d, full_wall = run(full_name, ["-options_file", "options/crankslider.yaml"], out)
         walls.append((full_name + " (0.0533 s simulated)", full_wall))
@@ -244,17 +255,20 @@ def reduced(out, S, walls, quick):
     d, w = run("flexible_pendulum_full", ["-options_file", "options/flexible_pendulum.yaml"], out)
     walls.append(("flexible_pendulum_full (3.4 s simulated)", w))
     full_pin = read_csv(os.path.join(d, "pin_joint.csv"))
-    ffull = full_frequencies("flexible_pendulum_full_modes", ["-options_file", "options/flexible_pendulum.yaml"], out, 10 if quick else 20)
+    # (Krylov-Schur: the default block solver breaks down on this 120-DOF bar, its Krylov space exhausted; issue 43)
+    ffull = full_frequencies("flexible_pendulum_full_modes", clamped_bar("meshes/bar_struct_n1.msh", 1, "clamp", "2.1e11", "0.3") + ["-modes_eps_type", "krylovschur"], out, 10 if quick else 20)
     for n in ([10] if quick else [5, 10, 20]):
         name = "flexible_pendulum_reduced%d" % n
         d, w = run(name, ["-options_file", "options/flexible_pendulum.yaml", "-body0_type", "reduced", "-body0_reduction_modes", str(n), "-body0_reduction_expect_full_frequencies", ffull, "-body0_reduction_expect_rtol", "1e-8"], out)
         walls.append((name + " (3.4 s simulated)", w))
-        what = "reduced bar, %d normal modes (Craig-Bampton: its only interface is the pinned face)" % n
+        what = "reduced bar, %d normal modes clamped at the pin (free_interface: with no listed port, Craig-Bampton's basis)" % n
         p = subprocess.run([sys.executable, os.path.join(ROOT, "tests", "tools", "pendulum_period.py"), os.path.join(d, "pin_joint.csv"), "--theta0", "5", "--inertia", "26.065", "--mgd", "382.59", "--sign", "-1", "--rtol", "5e-6"], cwd=ROOT, capture_output=True, text=True)
         for l in p.stdout.splitlines():
             if l.strip() and not l.startswith("measured"):
                 S.add("flexible pendulum", what, l)
         red_pin = read_csv(os.path.join(d, "pin_joint.csv"))
+        if [r["time"] for r in red_pin] != [r["time"] for r in full_pin]:
+            sys.exit("validate: the reduced and full pendulums' pin series have different times (%d and %d rows)" % (len(red_pin), len(full_pin)))
         key = [k for k in full_pin[0] if k.startswith("angle")][0]
         dev = max(abs(float(a[key]) - float(b[key])) for a, b in zip(full_pin, red_pin))
         S.add("flexible pendulum", what, "pin angle against the full bar over 3.4 s: max deviation %.2e rad (tolerance 1e-6): %s" % (dev, "PASS" if dev <= 1e-6 else "FAIL"))
@@ -268,7 +282,7 @@ def reduced(out, S, walls, quick):
     for k, l in enumerate(["crank", "coupler", "follower"]):
         base += ["-body%d_dm_plex_filename" % k, "meshes/fourbar_%s_nx%d.msh" % (l, nx)]
     full_sweep = os.path.join(out, "fourbar_sweep_nx%d.csv" % nx)
-    if not os.path.exists(full_sweep):
+    if ("fourbar_nx%d (73 configurations)" % nx) not in dict(walls):  # not from an earlier validation's binary
         d, w = run("fourbar_nx%d" % nx, base, out)
         walls.append(("fourbar_nx%d (73 configurations)" % nx, w))
         shutil.copy(os.path.join(d, "linearized_sweep.csv"), full_sweep)
@@ -291,10 +305,10 @@ def reduced(out, S, walls, quick):
             S.add("four-bar", what, l)
         lines, _ = check("compare_fourbar.py", [os.path.join(d, "linearized_sweep.csv"), as_ref, "--rtol", "1e-3", "--label", "vs the full links (%d cells)," % nx])
         for l in lines:
-            S.add("four-bar", what, l, checked=n >= 8)
+            S.add("four-bar", what, l)
 
     # the hinged spatial beam: the paper's checks on the reduced beam (10 normal modes + the tip's attachment modes)
-    ffull = full_frequencies("hinged_beam_full_modes", ["-options_file", "options/hinged_beam.yaml"], out, 10)
+    ffull = full_frequencies("hinged_beam_full_modes", clamped_bar("meshes/hinged_beam_nx8.msh", 2, "P", "2.1e6", "0"), out, 10)
     for n in [10]:
         name = "hinged_beam_reduced%d_nx8" % n
         d, w = run(name, ["-options_file", "options/hinged_beam.yaml", "-body0_type", "reduced", "-body0_reduction_modes", str(n), "-body0_reduction_expect_full_frequencies", ffull, "-body0_reduction_expect_rtol", "1e-8"], out)
@@ -347,6 +361,8 @@ def plots(out):
         ax.plot([float(r["crank_angle_rad"]) for r in ffrf], [float(r["uy_over_L"]) for r in ffrf], "-", color="0.6", lw=3, label="FFRF check (converged, full inertia)")
         ax.plot([float(r["crank_angle_rad"]) for r in paper], [float(r["uy_over_L"]) for r in paper], "--", color="k", lw=1, label="pH paper")
         for key, c in [(("full", 16, "2e-5"), "C0"), (("constant", 16, "2e-5"), "C3")]:
+            if key not in curves:
+                continue
             s = curves[key]
             ax.plot([float(r["crank_angle_rad"]) for r in s], [float(r["uy_over_L"]) for r in s], "-", color=c, lw=1, label="phlex, %s inertia" % key[0])
         ax.set_xlabel("crank angle [rad]")

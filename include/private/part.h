@@ -170,6 +170,7 @@ typedef struct {
   PetscErrorCode (*modeskind)(PhlexPart, char[], size_t, PetscInt *); /* "free", "clamped", ...; how many rigid-body modes it has (-1: none counted) */
   PetscErrorCode (*steadystate)(PhlexPart, PhlexPartVec *); /* its fields in the steady state of a prescribed uniform spin (NULL: at rest) */
   PetscErrorCode (*spinrate)(PhlexPart, PetscBool, PetscReal *); /* get (PETSC_FALSE) or set (PETSC_TRUE) the rate of its prescribed spin [rad/s]; -1 on get: it has none */
+  PetscErrorCode (*reduce)(PhlexPart, PetscViewer);               /* -analysis reduce: its reduced model's file (built or checked at set-up), reported */
 } PhlexPartAnalysisOps;
 
 /* an entry of a part's analysis table, NULL when it has no such table or entry */

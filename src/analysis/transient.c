@@ -71,6 +71,7 @@ static PetscErrorCode EnergyAndOutputs(MonitorContext *m, PetscInt step, PetscRe
     PetscCall(PhlexSystemJointSidesRestore(sys, j, X, pv));
     m->max_gap = PetscMax(m->max_gap, gmax);
   }
+  PetscCall(PhlexOutputFlushSeries(sys->scene->output));
   if (m->free_system) {
     PetscReal P[3] = {0, 0, 0}, L[3] = {0, 0, 0};
     for (PetscInt i = 0; i < sys->nparts; i++) {

@@ -429,8 +429,8 @@ PetscErrorCode PhlexOutputRestartCheckUsed(PhlexOutput out)
 /*@C
   PhlexCSVPrintf - writes a piece of a series row to a CSV file of PhlexOutputCSVOpen() (rank 0 of its communicator
   writes): like PetscViewerASCIIPrintf(), through the file's stdio buffer instead of a flush after every piece (which
-  cost a system call per number: 13 % of a reduced crank-slider's run); the file is flushed at each checkpoint
-  (PhlexOutputSaveState) and when it is closed
+  cost a system call per number: 13 % of a reduced crank-slider's run); the files are flushed at most a second after a
+  row (PhlexOutputFlushSeries, once per output step), at each checkpoint (PhlexOutputSaveState) and when closed
 
   Not collective
 @*/
@@ -449,6 +449,33 @@ PetscErrorCode PhlexCSVPrintf(PetscViewer csv, const char format[], ...)
   n = vfprintf(fp, format, ap);
   va_end(ap);
   PetscCheck(n >= 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write a series row: %s", strerror(errno));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputFlushSeries - writes the series' buffered rows to their files if the last flush is a second old or more
+  (called after each step's rows: the files, which one may follow during a run, are at most a second behind, and a
+  run that fails loses no more than that of the rows it buffered)
+
+  Collective
+@*/
+PetscErrorCode PhlexOutputFlushSeries(PhlexOutput out)
+{
+  PetscLogDouble now;
+  PetscMPIInt    rank;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&now));
+  PetscCallMPI(MPI_Comm_rank(out->comm, &rank));
+  if (!rank && now - out->series_flushed >= 1.0) {
+    for (PetscInt k = 0; k < out->nfiles; k++) {
+      FILE *fp;
+      if (!out->csv[k]) continue;
+      PetscCall(PetscViewerASCIIGetPointer(out->csv[k], &fp));
+      PetscCheck(!fflush(fp), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot write the series '%s': %s", out->tmp[k], strerror(errno));
+    }
+    out->series_flushed = now;
+  }
   PetscFunctionReturn(0);
 }
 

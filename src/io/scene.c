@@ -1,7 +1,7 @@
 /* The scene: its parts (bodies), joints, the analysis, the reference scales, gravity and the output directory. */
 #include <phlex_impl.h>
 
-const char *const PhlexAnalysisTypes[]     = {"transient", "modes", "linearized", "PhlexAnalysisType", "PHLEX_ANALYSIS_", NULL};
+const char *const PhlexAnalysisTypes[]     = {"transient", "modes", "linearized", "reduce", "PhlexAnalysisType", "PHLEX_ANALYSIS_", NULL};
 const char *const PhlexRedundantPolicies[] = {"error", "drop", "keep", "PhlexRedundantPolicy", "PHLEX_REDUNDANT_", NULL};
 
 /*@C
@@ -61,7 +61,7 @@ PetscErrorCode PhlexSceneSetFromOptions(PhlexScene s)
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(s->comm, NULL, "phlex scene options", NULL);
-  PetscCall(PetscOptionsEnum("-analysis", "Analysis to run: transient, modes (each flexible body alone), linearized (the whole assembly about rest)", "PhlexSceneSetFromOptions", PhlexAnalysisTypes, (PetscEnum)s->analysis, (PetscEnum *)&s->analysis, NULL));
+  PetscCall(PetscOptionsEnum("-analysis", "Analysis to run: transient, modes (each flexible body alone), linearized (the whole assembly about rest), reduce (build the reduced bodies' files and stop)", "PhlexSceneSetFromOptions", PhlexAnalysisTypes, (PetscEnum)s->analysis, (PetscEnum *)&s->analysis, NULL));
   PetscCall(PetscOptionsInt("-num_bodies", "Number of bodies (options prefixed body0_, body1_, ...)", "PhlexSceneSetFromOptions", s->nparts, &s->nparts, NULL));
   PetscCall(PetscOptionsInt("-num_joints", "Number of joints (options prefixed joint0_, joint1_, ...)", "PhlexSceneSetFromOptions", s->njoints, &s->njoints, NULL));
   PetscCall(PetscOptionsReal("-scale_length", "Reference length of the non-dimensionalisation [m] (0: automatic)", "PhlexSceneSetFromOptions", s->scale_length, &s->scale_length, NULL));

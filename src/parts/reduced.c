@@ -85,7 +85,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscCall(PetscOptionsRealArray("-reduction_view_transfer", "Self-check: prints the relative error of the reduced ports' transfer function against the full body's at these frequencies [Hz]", "ReducedSetFromOptions", r->view_transfer, &r->nview_transfer, &set_view));
   PetscCall(PetscOptionsReal("-reduction_expect_moments_rtol", "Self-check (krylov): the first 2 r moments of the ports' transfer function at each expansion frequency equal the full body's within this relative tolerance (0: no check)", "ReducedSetFromOptions", r->expect_moments_rtol, &r->expect_moments_rtol, NULL));
   PetscCall(PetscOptionsRealArray("-reduction_expect_held_frequencies", "Self-check: the full body's frequencies with its frame and ports held [Hz] (craig_bampton: those of its fixed-interface modes, compared within -reduction_expect_rtol)", "ReducedSetFromOptions", r->expect_held, &r->nexpect_held, &set_held));
-  PetscCall(PetscOptionsRealArray("-reduction_expect_full_frequencies", "Self-check: the full body's lowest frequencies with its frame held [Hz]: the reduced ones must bound them from above (Rayleigh-Ritz), and with craig_bampton lie below the held ones, which lie below the reduced ones 6 per port further (interlacing)", "ReducedSetFromOptions", r->expect_full, &r->nexpect_full, &set_full));
+  PetscCall(PetscOptionsRealArray("-reduction_expect_full_frequencies", "Self-check: the full body's lowest frequencies with its frame held as the basis holds it (clamped at the frame patch, free on mean axes) [Hz]: the reduced ones must bound them from above (Rayleigh-Ritz) and, with free_interface, equal them for the normal modes in the basis; with craig_bampton lie below the held ones, which lie below the reduced ones 6 per port further (interlacing)", "ReducedSetFromOptions", r->expect_full, &r->nexpect_full, &set_full));
   PetscCall(PetscOptionsReal("-reduction_expect_rtol", "Relative tolerance of -reduction_expect_held_frequencies, and the slack of the bounds of -reduction_expect_full_frequencies", "ReducedSetFromOptions", r->expect_rtol, &r->expect_rtol, NULL));
   PetscOptionsEnd();
   if (!set_held) r->nexpect_held = 0;
@@ -305,7 +305,12 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
       PetscCall(PetscSNPrintf(at + n, sizeof(at) - n, "%s%.6g", i ? ", " : "", (double)r->red.frequencies[i]));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (krylov basis: %" PetscInt_FMT " block steps at %s Hz from the load vectors of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, r->red.krylov_order, at, r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
-  } else PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " %s modes and the %s modes of %" PetscInt_FMT " ports, %" PetscInt_FMT " coordinates), %s %s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "fixed-interface" : "normal", r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports ? "constraint" : "attachment", r->nports, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? r->file : ""));
+  } else {
+    const PetscBool cb = (PetscBool)(r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports);
+    char            statics[96] = "";
+    if (r->nports) PetscCall(PetscSNPrintf(statics, sizeof(statics), " and the %s modes of %" PetscInt_FMT " port%s", cb ? "constraint" : "attachment", r->nports, r->nports > 1 ? "s" : ""));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "body %s: reduced flexible body (%s basis: %" PetscInt_FMT " %s modes%s, %" PetscInt_FMT " coordinates), %s%s%s\n", part->name, PhlexReductionTypes[r->type], r->md.nnormal, cb ? "fixed-interface" : "normal", statics, r->m, r->built ? (r->file[0] ? "built and written to" : "built in memory") : "read from", r->file[0] ? " " : "", r->file[0] ? r->file : ""));
+  }
   PetscCall(PetscViewerASCIIPushTab(viewer));
   PetscCall(PetscViewerASCIIPrintf(viewer, "the full body it reduces:\n"));
   PetscCall(PetscViewerASCIIPushTab(viewer));
@@ -1158,6 +1163,17 @@ static PetscErrorCode ReducedComputeModes(PhlexPart part, PetscInt nev, PetscInt
   PetscFunctionReturn(0);
 }
 
+/* -analysis reduce: its file, built and written at set-up or read there with its provenance checked */
+static PetscErrorCode ReducedReduce(PhlexPart part, PetscViewer viewer)
+{
+  Reduced *r = (Reduced *)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCheck(r->file[0], part->comm, PETSC_ERR_USER_INPUT, "body %s: -analysis reduce writes the reduced body file: give -%sreduced_file <file>", part->name, part->prefix);
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  body %s: %s %s (%" PetscInt_FMT " coordinates)\n", part->name, r->built ? "built and written to" : "up to date (its provenance matches the scene):", r->file, r->m));
+  PetscFunctionReturn(0);
+}
+
 /* the mode shapes on the full body's mesh (<body>_modes.h5, .xmf), written as the full body writes its own */
 static PetscErrorCode ReducedModesOutput(PhlexPart part, PhlexOutput out, PetscInt nconv, PetscInt nrigid, const PetscReal *lambda, Vec *vecs, const PetscReal *rigid, const PetscReal *placement)
 {
@@ -1215,5 +1231,6 @@ PetscErrorCode PhlexPartCreate_Reduced(PhlexPart part)
   part->analysisops->modes       = ReducedComputeModes;
   part->analysisops->modeskind   = ReducedModesKind;
   part->analysisops->modesoutput = ReducedModesOutput;
+  part->analysisops->reduce      = ReducedReduce;
   PetscFunctionReturn(0);
 }
