@@ -230,6 +230,7 @@ PETSC_INTERN PetscErrorCode PhlexPartRestoreVec(PhlexPart, Vec, PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexPartCreateGround(MPI_Comm, PhlexPart *);
 PETSC_INTERN PetscBool      PhlexPartIsGround(PhlexPart);
 PETSC_INTERN PetscBool      PhlexPartIsElastic(PhlexPart);
+PETSC_INTERN void           PhlexPortPlacementFromMean(const PetscReal *, const PetscReal[3], const PetscReal[6], PetscReal[3], PetscReal[9]);
 PETSC_INTERN PetscErrorCode PhlexPortSeriesOpen(PhlexOutput, const char[], PetscInt, const char *const[], PetscViewer *);
 PETSC_INTERN PetscErrorCode PhlexPortSeriesEntry(PetscViewer, const PhlexUnits *, const PetscReal[6], PetscBool, const PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexPortSeriesPosition(PetscViewer, const PhlexUnits *, const PetscReal[3]);

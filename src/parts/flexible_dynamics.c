@@ -347,8 +347,8 @@ static PetscErrorCode FlexPortBasisColumn(PhlexPart part, PetscInt q, PetscInt *
 /* inertial position and orientation of port q at the state X: r + R (c - P + u_avg), R exp([theta_avg]x) */
 static PetscErrorCode FlexPortPlacement(PhlexPart part, PetscInt q, const PhlexPartVec *X, PetscReal x[3], PetscReal Rp[9])
 {
-  PhlexFlexible b = (PhlexFlexible)part->data;
-  PetscReal     R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, r[3] = {0, 0, 0}, ub[6] = {0, 0, 0, 0, 0, 0}, c[3], E[9], n;
+  PhlexFlexible b     = (PhlexFlexible)part->data;
+  PetscReal     ub[6] = {0, 0, 0, 0, 0, 0};
 
   PetscFunctionBeginUser;
   if (q < b->nports) {
@@ -356,17 +356,7 @@ static PetscErrorCode FlexPortPlacement(PhlexPart part, PetscInt q, const PhlexP
     PetscCall(VecMDot(X->u, 6, b->ports[q].dist, d));
     for (PetscInt k = 0; k < 6; k++) ub[k] = PetscRealPart(d[k]);
   }
-  if (b->floating)
-    for (PetscInt k = 0; k < 3; k++) {
-      r[k] = X->q[k];
-      for (PetscInt j = 0; j < 3; j++) R[3 * k + j] = X->q[3 + 3 * k + j];
-    }
-  for (PetscInt k = 0; k < 3; k++) c[k] = part->ports[q].point[k] + ub[k];
-  PhlexMatVec3(R, c, x);
-  for (PetscInt k = 0; k < 3; k++) x[k] += r[k];
-  n = PhlexNorm3(ub + 3);
-  PhlexAxisAngleToRotation(n > 0 ? ub + 3 : (PetscReal[3]){1, 0, 0}, n, E);
-  PhlexMatMat3(R, E, Rp);
+  PhlexPortPlacementFromMean(b->floating ? X->q : NULL, part->ports[q].point, ub, x, Rp);
   PetscFunctionReturn(0);
 }
 

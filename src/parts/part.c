@@ -201,6 +201,32 @@ PetscBool PhlexPartIsElastic(PhlexPart p)
 }
 
 /*@C
+  PhlexPortPlacementFromMean - the inertial position and orientation of a port of a deforming body from its frame and
+  the port's mean displacement and rotation: r + R (c + ubar), R exp([theta]x)
+
+  Input Parameters:
++ frame - the frame's r (3) and R (9, row-wise) as in the part's unknowns, or NULL for a fixed body (identity)
+. point - the port point c relative to the frame origin, body frame
+- ub    - the port's mean displacement (3) and rotation vector (3), body frame
+
+  Not collective
+@*/
+void PhlexPortPlacementFromMean(const PetscReal *frame, const PetscReal point[3], const PetscReal ub[6], PetscReal x[3], PetscReal Rp[9])
+{
+  PetscReal R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, c[3], E[9], n;
+
+  if (frame)
+    for (PetscInt k = 0; k < 9; k++) R[k] = frame[3 + k];
+  for (PetscInt k = 0; k < 3; k++) c[k] = point[k] + ub[k];
+  PhlexMatVec3(R, c, x);
+  if (frame)
+    for (PetscInt k = 0; k < 3; k++) x[k] += frame[k];
+  n = PhlexNorm3(ub + 3);
+  PhlexAxisAngleToRotation(n > 0 ? ub + 3 : (PetscReal[3]){1, 0, 0}, n, E);
+  PhlexMatMat3(R, E, Rp);
+}
+
+/*@C
   PhlexPartSetPorts - allocates the port table of a part (names and points filled by the kind)
 @*/
 PetscErrorCode PhlexPartSetPorts(PhlexPart p, PetscInt n)

@@ -810,25 +810,15 @@ static PetscErrorCode ReducedPortForce(PhlexPart part, PetscInt q, const PetscRe
 /* inertial position and orientation of port q at the state X: r + R (c - P + ubar), R exp([theta]x) */
 static PetscErrorCode ReducedPortPlacement(PhlexPart part, PetscInt q, const PhlexPartVec *X, PetscReal x[3], PetscReal Rp[9])
 {
-  Reduced       *r = (Reduced *)part->data;
-  const PetscInt m = r->m;
-  PetscReal      R[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, o[3] = {0, 0, 0}, ub[6] = {0, 0, 0, 0, 0, 0}, c[3], E[9], n;
+  Reduced       *r     = (Reduced *)part->data;
+  const PetscInt m     = r->m;
+  PetscReal      ub[6] = {0, 0, 0, 0, 0, 0};
 
   PetscFunctionBeginUser;
   if (q < r->nports)
     for (PetscInt d = 0; d < 6; d++)
       for (PetscInt k = 0; k < m; k++) ub[d] += r->md.P[6 * m * q + m * d + k] * X->q[r->ie + k];
-  if (r->floating)
-    for (PetscInt k = 0; k < 3; k++) {
-      o[k] = X->q[k];
-      for (PetscInt j = 0; j < 3; j++) R[3 * k + j] = X->q[3 + 3 * k + j];
-    }
-  for (PetscInt k = 0; k < 3; k++) c[k] = part->ports[q].point[k] + ub[k];
-  PhlexMatVec3(R, c, x);
-  for (PetscInt k = 0; k < 3; k++) x[k] += o[k];
-  n = PhlexNorm3(ub + 3);
-  PhlexAxisAngleToRotation(n > 0 ? ub + 3 : (PetscReal[3]){1, 0, 0}, n, E);
-  PhlexMatMat3(R, E, Rp);
+  PhlexPortPlacementFromMean(r->floating ? X->q : NULL, part->ports[q].point, ub, x, Rp);
   PetscFunctionReturn(0);
 }
 

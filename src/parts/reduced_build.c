@@ -88,94 +88,131 @@ static PetscErrorCode RemoveRigid(PhlexFlexible b, Vec R[6], Vec x, Vec work)
   PetscFunctionReturn(0);
 }
 
-/* the static attachment modes of the listed ports: K psi = B_q e_d (six per port) */
+/* A solver of (K - omega^2 Mv) x = f on the field space with the frame held: MUMPS (LDL^T for an indefinite
+   matrix, above the first frequency), options prefix <body>reduction_. On mean axes the load loses its rigid
+   resultant (f - Mv R R^T f) and the solution its rigid content; at omega = 0 K is singular there and the solve takes
+   K + lambda1 Mv with refinements on K (the inertia-relief static solve of the attachment modes). */
+typedef struct {
+  PhlexFlexible b;
+  PetscBool     mean_axes, relief;
+  Mat           A;
+  KSP           ksp;
+  Vec           R[6], f, r, dx, work;
+} ShiftedSolver;
+
+static PetscErrorCode ShiftedSolverCreate(PhlexPart part, PetscReal omega2, PetscReal lambda1, ShiftedSolver *s)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PC            pc;
+  PetscReal     shift;
+  char          prefix[64];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(s, sizeof(*s)));
+  s->b         = b;
+  s->mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
+  s->relief    = (s->mean_axes && omega2 == 0.0) ? PETSC_TRUE : PETSC_FALSE;
+  shift        = s->relief ? lambda1 : -omega2;
+  PetscCall(MatDuplicate(b->K, MAT_COPY_VALUES, &s->A));
+  if (shift != 0.0) PetscCall(MatAXPY(s->A, shift, b->Mv, DIFFERENT_NONZERO_PATTERN));
+  PetscCall(MatSetOption(s->A, MAT_SYMMETRIC, PETSC_TRUE));
+  if (shift < 0.0) PetscCall(MatSetOption(s->A, MAT_SPD, PETSC_FALSE));
+  if (s->mean_axes) PetscCall(RigidFields(b, s->R));
+  PetscCall(KSPCreate(b->comm, &s->ksp));
+  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sreduction_", part->prefix));
+  PetscCall(KSPSetOptionsPrefix(s->ksp, prefix));
+  PetscCall(KSPSetOperators(s->ksp, s->A, s->A));
+  PetscCall(KSPSetType(s->ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(s->ksp, &pc));
+  PetscCall(PCSetType(pc, PCCHOLESKY));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(KSPSetFromOptions(s->ksp));
+  PetscCall(MatCreateVecs(b->Mv, &s->f, NULL));
+  PetscCall(VecDuplicate(s->f, &s->r));
+  PetscCall(VecDuplicate(s->f, &s->dx));
+  PetscCall(VecDuplicate(s->f, &s->work));
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode ShiftedSolverDestroy(ShiftedSolver *s)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 6; k++) PetscCall(VecDestroy(&s->R[k]));
+  PetscCall(VecDestroy(&s->f));
+  PetscCall(VecDestroy(&s->r));
+  PetscCall(VecDestroy(&s->dx));
+  PetscCall(VecDestroy(&s->work));
+  PetscCall(KSPDestroy(&s->ksp));
+  PetscCall(MatDestroy(&s->A));
+  PetscFunctionReturn(0);
+}
+
+/* x = (K - omega^2 Mv)^{-1} rhs (x created), one refinement step. On mean axes at omega = 0: refinements on K (each
+   divides the error in mode i by 1 + lambda_i / lambda1 >= 2) until the residual is 1e-12 of the load, or it stops
+   falling at round-off (three refinements in a row without falling below 3/4 of the
+   smallest so far, 2-norm): the later Krylov blocks' loads Mv x are smooth, their solutions large, and their
+   residuals stall above 1e-12 ||f|| (observed on the crank-slider's coupler: the residual halving at each refinement
+   down to a normwise backward error ||f - K x|| / (||K|| ||x|| + ||f||) of 5e-17 after 28). Not earlier: a backward
+   error of 1e-14 still leaves the lowest mode's error up to ||K|| / lambda1 times larger in the solution (the
+   moments were off by 1e-6 so). Refused if the backward error (infinity norms) is then above 1e-13. */
+static PetscErrorCode ShiftedSolverSolve(ShiftedSolver *s, Vec rhs, Vec *x)
+{
+  PhlexFlexible b = s->b;
+  Mat           op = s->relief ? b->K : s->A;
+  PetscReal     fn, rn = 0.0, kn = 0.0, xn = 0.0, rmin = PETSC_MAX_REAL;
+  PetscInt      it, stall = 0;
+
+  PetscFunctionBeginUser;
+  if (s->relief) PetscCall(MatNorm(b->K, NORM_INFINITY, &kn));
+  PetscCall(VecCopy(rhs, s->f));
+  if (s->mean_axes) {
+    PetscScalar c[6];
+    PetscCall(VecMDot(s->f, 6, s->R, c));
+    PetscCall(VecSet(s->work, 0.0));
+    PetscCall(VecMAXPY(s->work, 6, c, s->R));
+    PetscCall(MatMult(b->Mv, s->work, s->r));
+    PetscCall(VecAXPY(s->f, -1.0, s->r)); /* f - Mv R R^T f: no resultant */
+  }
+  PetscCall(VecDuplicate(s->f, x));
+  PetscCall(KSPSolve(s->ksp, s->f, *x));
+  PetscCall(VecNorm(s->f, NORM_INFINITY, &fn));
+  for (it = 0; it < (s->relief ? 200 : 1); it++) {
+    if (s->mean_axes) PetscCall(RemoveRigid(b, s->R, *x, s->work));
+    PetscCall(MatMult(op, *x, s->r));
+    PetscCall(VecAYPX(s->r, -1.0, s->f));
+    PetscCall(VecNorm(s->r, NORM_INFINITY, &rn));
+    PetscCall(VecNorm(*x, NORM_INFINITY, &xn));
+    if (s->relief) {
+      PetscReal r2;
+      PetscCall(VecNorm(s->r, NORM_2, &r2));
+      stall = r2 > 0.75 * rmin ? stall + 1 : 0;
+      rmin  = PetscMin(rmin, r2);
+      if (rn <= 1e-12 * fn || stall >= 3) break;
+    }
+    PetscCall(KSPSolve(s->ksp, s->r, s->dx));
+    PetscCall(VecAXPY(*x, 1.0, s->dx));
+  }
+  PetscCheck(!s->relief || rn <= 1e-12 * fn || rn <= 1e-13 * (kn * xn + fn), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: a static solve of the Krylov reduction did not converge on mean axes (backward error %g after %" PetscInt_FMT " refinements)", b->name, (double)(rn / (kn * xn + fn)), it);
+  if (s->mean_axes) PetscCall(RemoveRigid(b, s->R, *x, s->work));
+  PetscFunctionReturn(0);
+}
+
+/* the static attachment modes of the listed ports: K psi = B_q e_d (six per port); on mean axes with inertia relief
+   (ShiftedSolver at omega = 0: loads without resultant, solutions without rigid content) */
 static PetscErrorCode AttachmentModes(PhlexPart part, PetscReal lambda1, Vec **psi, PetscInt *npsi)
 {
-  PhlexFlexible   b         = (PhlexFlexible)part->data;
-  const PetscBool mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
-  KSP             ksp;
-  PC              pc;
-  Mat             A;
-  Vec             R[6] = {NULL}, f, r, dx, work;
-  PetscReal       Knorm = 0.0;
-  char            prefix[64];
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  ShiftedSolver solver;
 
   PetscFunctionBeginUser;
   *npsi = 6 * b->nports;
   *psi  = NULL;
   if (!*npsi) PetscFunctionReturn(0);
   PetscCall(PetscMalloc1(*npsi, psi));
-  /* a floating body on mean axes has a singular K: solve with K + lambda1 Mv (its rigid fields then have a well
-     separated eigenvalue) and refine on K, the loads and the solutions kept off the rigid fields */
-  PetscCall(MatDuplicate(b->K, MAT_COPY_VALUES, &A));
-  if (mean_axes) {
-    PetscCall(MatNorm(b->K, NORM_INFINITY, &Knorm)); /* >= the 2-norm of a symmetric matrix, and close to it for a sparse one */
-    PetscCall(MatAXPY(A, lambda1, b->Mv, DIFFERENT_NONZERO_PATTERN));
-    PetscCall(RigidFields(b, R));
-  }
-  PetscCall(KSPCreate(b->comm, &ksp));
-  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sreduction_", part->prefix));
-  PetscCall(KSPSetOptionsPrefix(ksp, prefix));
-  PetscCall(KSPSetOperators(ksp, A, A));
-  PetscCall(KSPSetType(ksp, KSPPREONLY));
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCCHOLESKY));
-  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  PetscCall(KSPSetFromOptions(ksp));
-  PetscCall(VecDuplicate(b->ports[0].dist[0], &f));
-  PetscCall(VecDuplicate(f, &r));
-  PetscCall(VecDuplicate(f, &dx));
-  PetscCall(VecDuplicate(f, &work));
+  PetscCall(ShiftedSolverCreate(part, 0.0, lambda1, &solver));
   for (PetscInt q = 0; q < b->nports; q++)
-    for (PetscInt d = 0; d < 6; d++) {
-      Vec x;
-      PetscCall(VecDuplicate(f, &x));
-      PetscCall(VecCopy(b->ports[q].dist[d], f));
-      if (mean_axes) {
-        PetscScalar c[6];
-        PetscCall(VecMDot(f, 6, R, c));
-        PetscCall(VecSet(work, 0.0));
-        PetscCall(VecMAXPY(work, 6, c, R));
-        PetscCall(MatMult(b->Mv, work, r));
-        PetscCall(VecAXPY(f, -1.0, r)); /* f - Mv R R^T f: no resultant */
-      }
-      PetscCall(KSPSolve(ksp, f, x));
-      if (mean_axes) {
-        /* K x = f on the complement of the rigid fields: refine the shifted solve until the residual is at round-off
-           (each refinement divides the error in mode i by 1 + lambda_i / lambda1): |K x - f| <= 1e-12 |f|, or a
-           normwise backward error |K x - f| / (|K| |x| + |f|) of a few machine epsilons, or the residual no longer
-           falling (by 10 % a refinement) at a backward error below 1e-12: on a fine or slender body (|K| |x| >> |f|)
-           the residual stalls at the round-off of K x, far above 1e-12 |f| */
-        PetscReal fn, rn = 0.0, rprev = PETSC_MAX_REAL, xn, berr = 1.0;
-        PetscBool done = PETSC_FALSE;
-        PetscInt  it;
-        PetscCall(VecNorm(f, NORM_2, &fn));
-        for (it = 0; it < 200; it++) {
-          PetscCall(RemoveRigid(b, R, x, work));
-          PetscCall(MatMult(b->K, x, r));
-          PetscCall(VecAYPX(r, -1.0, f));
-          PetscCall(VecNorm(r, NORM_2, &rn));
-          PetscCall(VecNorm(x, NORM_2, &xn));
-          berr = rn / (Knorm * xn + fn);
-          done = (PetscBool)(rn <= 1e-12 * fn || berr <= 64 * PETSC_MACHINE_EPSILON || (rn > 0.9 * rprev && berr <= 1e-12));
-          if (done) break;
-          rprev = rn;
-          PetscCall(KSPSolve(ksp, r, dx));
-          PetscCall(VecAXPY(x, 1.0, dx));
-        }
-        PetscCheck(done, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the attachment mode of port %s, component %" PetscInt_FMT ", did not converge on mean axes (relative residual %g, backward error %g after %" PetscInt_FMT " refinements)", b->name, b->ports[q].name, d, (double)(rn / fn), (double)berr, it);
-        PetscCall(PetscInfo(NULL, "body %s: attachment mode of port %s, component %" PetscInt_FMT ": relative residual %g, backward error %g after %" PetscInt_FMT " refinements\n", b->name, b->ports[q].name, d, (double)(rn / fn), (double)berr, it));
-      }
-      if (mean_axes) PetscCall(RemoveRigid(b, R, x, work));
-      (*psi)[6 * q + d] = x;
-    }
-  PetscCall(VecDestroy(&f));
-  PetscCall(VecDestroy(&r));
-  PetscCall(VecDestroy(&dx));
-  PetscCall(VecDestroy(&work));
-  for (PetscInt k = 0; k < 6; k++) PetscCall(VecDestroy(&R[k]));
-  PetscCall(KSPDestroy(&ksp));
-  PetscCall(MatDestroy(&A));
+    for (PetscInt d = 0; d < 6; d++) PetscCall(ShiftedSolverSolve(&solver, b->ports[q].dist[d], &(*psi)[6 * q + d]));
+  PetscCall(ShiftedSolverDestroy(&solver));
   PetscFunctionReturn(0);
 }
 
@@ -328,115 +365,6 @@ static PetscErrorCode FixedInterfaceModes(PhlexPart part, PetscInt nmodes, Petsc
   PetscCall(PetscFree2(Sinv, ipiv));
   PetscCall(EPSDestroy(&eps));
   PetscCall(MatDestroy(&A));
-  PetscFunctionReturn(0);
-}
-
-/* A solver of (K - omega^2 Mv) x = f on the field space with the frame held: MUMPS (LDL^T for an indefinite
-   matrix, above the first frequency), options prefix <body>reduction_. On mean axes the load loses its rigid
-   resultant (f - Mv R R^T f) and the solution its rigid content; at omega = 0 K is singular there and the solve takes
-   K + lambda1 Mv with refinements on K, as AttachmentModes (the inertia-relief static solve). */
-typedef struct {
-  PhlexFlexible b;
-  PetscBool     mean_axes, relief;
-  Mat           A;
-  KSP           ksp;
-  Vec           R[6], f, r, dx, work;
-} ShiftedSolver;
-
-static PetscErrorCode ShiftedSolverCreate(PhlexPart part, PetscReal omega2, PetscReal lambda1, ShiftedSolver *s)
-{
-  PhlexFlexible b = (PhlexFlexible)part->data;
-  PC            pc;
-  PetscReal     shift;
-  char          prefix[64];
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMemzero(s, sizeof(*s)));
-  s->b         = b;
-  s->mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
-  s->relief    = (s->mean_axes && omega2 == 0.0) ? PETSC_TRUE : PETSC_FALSE;
-  shift        = s->relief ? lambda1 : -omega2;
-  PetscCall(MatDuplicate(b->K, MAT_COPY_VALUES, &s->A));
-  if (shift != 0.0) PetscCall(MatAXPY(s->A, shift, b->Mv, DIFFERENT_NONZERO_PATTERN));
-  PetscCall(MatSetOption(s->A, MAT_SYMMETRIC, PETSC_TRUE));
-  if (shift < 0.0) PetscCall(MatSetOption(s->A, MAT_SPD, PETSC_FALSE));
-  if (s->mean_axes) PetscCall(RigidFields(b, s->R));
-  PetscCall(KSPCreate(b->comm, &s->ksp));
-  PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sreduction_", part->prefix));
-  PetscCall(KSPSetOptionsPrefix(s->ksp, prefix));
-  PetscCall(KSPSetOperators(s->ksp, s->A, s->A));
-  PetscCall(KSPSetType(s->ksp, KSPPREONLY));
-  PetscCall(KSPGetPC(s->ksp, &pc));
-  PetscCall(PCSetType(pc, PCCHOLESKY));
-  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
-  PetscCall(KSPSetFromOptions(s->ksp));
-  PetscCall(MatCreateVecs(b->Mv, &s->f, NULL));
-  PetscCall(VecDuplicate(s->f, &s->r));
-  PetscCall(VecDuplicate(s->f, &s->dx));
-  PetscCall(VecDuplicate(s->f, &s->work));
-  PetscFunctionReturn(0);
-}
-
-static PetscErrorCode ShiftedSolverDestroy(ShiftedSolver *s)
-{
-  PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < 6; k++) PetscCall(VecDestroy(&s->R[k]));
-  PetscCall(VecDestroy(&s->f));
-  PetscCall(VecDestroy(&s->r));
-  PetscCall(VecDestroy(&s->dx));
-  PetscCall(VecDestroy(&s->work));
-  PetscCall(KSPDestroy(&s->ksp));
-  PetscCall(MatDestroy(&s->A));
-  PetscFunctionReturn(0);
-}
-
-/* x = (K - omega^2 Mv)^{-1} rhs (x created), one refinement step. On mean axes at omega = 0: refinements on K (each
-   divides the error in mode i by 1 + lambda_i / lambda1 >= 2) until the residual is 1e-12 of the load, as
-   AttachmentModes, or it stops falling at round-off (three refinements in a row without falling below 3/4 of the
-   smallest so far, 2-norm): the later Krylov blocks' loads Mv x are smooth, their solutions large, and their
-   residuals stall above 1e-12 ||f|| (observed on the crank-slider's coupler: the residual halving at each refinement
-   down to a normwise backward error ||f - K x|| / (||K|| ||x|| + ||f||) of 5e-17 after 28). Not earlier: a backward
-   error of 1e-14 still leaves the lowest mode's error up to ||K|| / lambda1 times larger in the solution (the
-   moments were off by 1e-6 so). Refused if the backward error (infinity norms) is then above 1e-13. */
-static PetscErrorCode ShiftedSolverSolve(ShiftedSolver *s, Vec rhs, Vec *x)
-{
-  PhlexFlexible b = s->b;
-  Mat           op = s->relief ? b->K : s->A;
-  PetscReal     fn, rn = 0.0, kn = 0.0, xn = 0.0, rmin = PETSC_MAX_REAL;
-  PetscInt      it, stall = 0;
-
-  PetscFunctionBeginUser;
-  if (s->relief) PetscCall(MatNorm(b->K, NORM_INFINITY, &kn));
-  PetscCall(VecCopy(rhs, s->f));
-  if (s->mean_axes) {
-    PetscScalar c[6];
-    PetscCall(VecMDot(s->f, 6, s->R, c));
-    PetscCall(VecSet(s->work, 0.0));
-    PetscCall(VecMAXPY(s->work, 6, c, s->R));
-    PetscCall(MatMult(b->Mv, s->work, s->r));
-    PetscCall(VecAXPY(s->f, -1.0, s->r)); /* f - Mv R R^T f: no resultant */
-  }
-  PetscCall(VecDuplicate(s->f, x));
-  PetscCall(KSPSolve(s->ksp, s->f, *x));
-  PetscCall(VecNorm(s->f, NORM_INFINITY, &fn));
-  for (it = 0; it < (s->relief ? 200 : 1); it++) {
-    if (s->mean_axes) PetscCall(RemoveRigid(b, s->R, *x, s->work));
-    PetscCall(MatMult(op, *x, s->r));
-    PetscCall(VecAYPX(s->r, -1.0, s->f));
-    PetscCall(VecNorm(s->r, NORM_INFINITY, &rn));
-    PetscCall(VecNorm(*x, NORM_INFINITY, &xn));
-    if (s->relief) {
-      PetscReal r2;
-      PetscCall(VecNorm(s->r, NORM_2, &r2));
-      stall = r2 > 0.75 * rmin ? stall + 1 : 0;
-      rmin  = PetscMin(rmin, r2);
-      if (rn <= 1e-12 * fn || stall >= 3) break;
-    }
-    PetscCall(KSPSolve(s->ksp, s->r, s->dx));
-    PetscCall(VecAXPY(*x, 1.0, s->dx));
-  }
-  PetscCheck(!s->relief || rn <= 1e-12 * fn || rn <= 1e-13 * (kn * xn + fn), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: a static solve of the Krylov reduction did not converge on mean axes (backward error %g after %" PetscInt_FMT " refinements)", b->name, (double)(rn / (kn * xn + fn)), it);
-  if (s->mean_axes) PetscCall(RemoveRigid(b, s->R, *x, s->work));
   PetscFunctionReturn(0);
 }
 
