@@ -31,6 +31,7 @@ typedef struct {
   PhlexFrameState    fs;
   PetscReal         *Mom;   /* per basis vector 3 PHLEX_FRAME_NIN: the node inputs' moments at the evaluated state */
   PetscReal         *nmom;  /* 4 x 9 m: the moments of eta, eta', zeta, zeta' with each basis vector (FieldMoments) */
+  PetscReal         *xcols; /* 4 m: eta, eta', zeta, zeta' as the columns of FieldMoments' product */
   PetscReal         *gext;  /* m: generalized force of the external inputs (ports, body force, a fixed body's weight) */
   PetscReal         *work;  /* m */
   PetscReal         *etad, *zetad; /* m each: the rates of the evaluated state (non-dimensional time) */
@@ -267,7 +268,7 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   r->frame.gyroscopic = b->gyroscopic;
   r->frame.inertia    = r->md.inertia;
   r->frame.gravity    = part->gravity;
-  PetscCall(PetscCalloc4(3 * PHLEX_FRAME_NIN * m, &r->Mom, m, &r->gext, m, &r->work, 36 * m, &r->nmom));
+  PetscCall(PetscCalloc5(3 * PHLEX_FRAME_NIN * m, &r->Mom, m, &r->gext, m, &r->work, 36 * m, &r->nmom, 4 * m, &r->xcols));
   PetscCall(PetscCalloc2(m, &r->etad, m, &r->zetad));
   if (r->floating) PetscCall(PetscCalloc3(54 * PHLEX_FRAME_NIN, &r->Lb, 54 * PHLEX_FRAME_NIN, &r->Lu, 54 * PHLEX_FRAME_NIN, &r->Lv));
   PetscFunctionReturn(0);
@@ -330,7 +331,7 @@ static PetscErrorCode ReducedDestroy(PhlexPart part)
   PetscFunctionBeginUser;
   PetscCall(PhlexPartDestroy(&r->full));
   if (r->m) PetscCall(PhlexReducedModelDestroy(&r->md));
-  PetscCall(PetscFree4(r->Mom, r->gext, r->work, r->nmom));
+  PetscCall(PetscFree5(r->Mom, r->gext, r->work, r->nmom, r->xcols));
   PetscCall(PetscFree2(r->etad, r->zetad));
   PetscCall(PetscFree3(r->Lb, r->Lu, r->Lv));
   PetscCall(PetscFree3(r->port_ext, r->port_y, r->port_ub));
@@ -363,18 +364,6 @@ static PetscErrorCode ReducedInitialState(PhlexPart part, PhlexPartVec *X)
 
 /* ------------------------------------------------------------------------------------------------------------ */
 /* Evaluation, residual, Jacobian                                                                                 */
-
-/* sum_j x_j N_jk[b][c] (9 values): the moment of a field x = Phi x with basis vector k through the mass */
-static inline void NMoment(const Reduced *r, const PetscReal *x, PetscInt k, PetscReal out[9])
-{
-  const PetscInt m = r->m;
-  PetscReal      acc[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}; /* accumulated locally: the compiler cannot know that out aliases no input */
-  for (PetscInt j = 0; j < m; j++) {
-    const PetscReal *N = r->md.N + 9 * (j * m + k), xj = x[j];
-    for (PetscInt i = 0; i < 9; i++) acc[i] += xj * N[i];
-  }
-  for (PetscInt i = 0; i < 9; i++) out[i] = acc[i];
-}
 
 /* the frame's integrals of the field (frame.c's sums) from the invariants */
 static void FieldSums(const Reduced *r, const PetscReal *eta, const PetscReal *etad, const PetscReal *zeta, const PetscReal *zetad, PetscReal sums[84])
@@ -412,22 +401,27 @@ static void FieldSums(const Reduced *r, const PetscReal *eta, const PetscReal *e
   }
 }
 
-/* the moments through the mass of eta, eta' (full inertia only), zeta and zeta' with every basis vector (NMoment, 9 m
-   values each, in r->nmom): once per evaluation, shared by the frame's sums and the node inputs' moments */
-static void FieldMoments(Reduced *r, const PetscReal *eta, const PetscReal *etad, const PetscReal *zeta, const PetscReal *zetad)
+/* the moments through the mass of eta, eta' (full inertia only), zeta and zeta' with every basis vector k,
+   sum_j x_j N_jk[b][c] (9 m values each, in r->nmom): once per evaluation, shared by the frame's sums and the node
+   inputs' moments */
+static PetscErrorCode FieldMoments(Reduced *r, const PetscReal *eta, const PetscReal *etad, const PetscReal *zeta, const PetscReal *zetad)
 {
-  const PetscInt m  = r->m;
-  PetscReal     *nu = r->nmom, *nud = nu + 9 * m, *nv = nud + 9 * m, *nvd = nv + 9 * m;
+  const PetscInt m = r->m;
+  PetscReal     *X = r->xcols, one = 1.0, zero = 0.0;
+  PetscBLASInt   n9, nm, four = 4;
 
+  PetscFunctionBeginUser;
+  /* N as a 9m x m column-major matrix (entry (9k + i, j) = N_jk[i]): all moments in one product with [eta eta' zeta zeta'] */
   for (PetscInt k = 0; k < m; k++) {
-    if (r->full_inertia) {
-      NMoment(r, eta, k, nu + 9 * k);
-      NMoment(r, etad, k, nud + 9 * k);
-    } else
-      for (PetscInt i = 0; i < 9; i++) nu[9 * k + i] = nud[9 * k + i] = 0.0;
-    NMoment(r, zeta, k, nv + 9 * k);
-    NMoment(r, zetad, k, nvd + 9 * k);
+    X[k]         = r->full_inertia ? eta[k] : 0.0;
+    X[m + k]     = r->full_inertia ? etad[k] : 0.0;
+    X[2 * m + k] = zeta[k];
+    X[3 * m + k] = zetad[k];
   }
+  PetscCall(PetscBLASIntCast(9 * m, &n9));
+  PetscCall(PetscBLASIntCast(m, &nm));
+  PetscCallBLAS("BLASgemm", BLASgemm_("N", "N", &n9, &four, &nm, &one, r->md.N, &n9, X, &nm, &zero, r->nmom, &n9));
+  PetscFunctionReturn(0);
 }
 
 /* the node inputs' moments with each basis vector (PhlexFrameLoadCoefficients, PhlexFrameJacobian): inputs t, z = int
@@ -487,7 +481,7 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
     }
   if (r->floating) {
     for (PetscInt k = 0; k < 18; k++) qd[k] = Xdot ? T * Xdot->q[k] : 0.0;
-    FieldMoments(r, eta, etad, zeta, zetad);
+    PetscCall(FieldMoments(r, eta, etad, zeta, zetad));
     FieldSums(r, eta, etad, zeta, zetad, f->sums);
     f->sums_req = MPI_REQUEST_NULL;
     PetscCall(PhlexFrameEvaluateEnd(&r->frame, X->q, qd, f));
