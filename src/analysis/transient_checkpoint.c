@@ -46,25 +46,13 @@ static void UnpackMonitor(MonitorContext *m, const PetscReal a[CHECKPOINT_NMONIT
   m->last_written = (PetscInt)a[k++], m->nretries = (PetscInt)a[k++];
 }
 
-/* removes the placement hashes ("@" and 16 hex digits, PhlexFlexiblePlacement) from a fingerprint */
-static void StripPlacementHashes(char *s)
+/* removes the hashes after marker from a fingerprint: '@' and 16 hex digits, the placement hashes of
+   PhlexFlexiblePlacement; '#' and hex digits, the model hashes of reduced bodies ("model#...", reduced.c) */
+static void StripHashes(char *s, char marker)
 {
   char *w = s;
   for (const char *r = s; *r;) {
-    if (*r == '@') {
-      r++;
-      while ((*r >= '0' && *r <= '9') || (*r >= 'a' && *r <= 'f')) r++;
-    } else *w++ = *r++;
-  }
-  *w = 0;
-}
-
-/* s with the model hashes of reduced bodies ("model#" and hex digits, reduced.c) left out */
-static void StripModelHashes(char *s)
-{
-  char *w = s;
-  for (const char *r = s; *r;) {
-    if (*r == '#') {
+    if (*r == marker) {
       r++;
       while ((*r >= '0' && *r <= '9') || (*r >= 'a' && *r <= 'f')) r++;
     } else *w++ = *r++;
@@ -332,8 +320,8 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
     /* the same scene but its field unknowns placed otherwise (the hashes after '@' differ) */
     PetscCall(PetscStrallocpy(parts, &a));
     PetscCall(PetscStrallocpy(ck_parts, &c));
-    StripPlacementHashes(a);
-    StripPlacementHashes(c);
+    StripHashes(a, '@');
+    StripHashes(c, '@');
     PetscCall(PetscStrcmp(a, c, &numbering));
     PetscCall(PetscFree(a));
     PetscCall(PetscFree(c));
@@ -354,8 +342,8 @@ PetscErrorCode PhlexTransientRestartCheck(TS ts, MonitorContext *m, PetscViewer 
       PetscBool model;
       PetscCall(PetscStrallocpy(parts, &a));
       PetscCall(PetscStrallocpy(ck_parts, &c));
-      StripModelHashes(a);
-      StripModelHashes(c);
+      StripHashes(a, '#');
+      StripHashes(c, '#');
       PetscCall(PetscStrcmp(a, c, &model));
       PetscCall(PetscFree(a));
       PetscCall(PetscFree(c));

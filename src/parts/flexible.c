@@ -535,6 +535,43 @@ static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool 
 
 PETSC_INTERN PetscErrorCode PhlexFlexiblePortOutputsAll(PhlexPart, const PhlexPartVec *);
 
+/*@C
+  PhlexFlexiblePortSeriesRow - one row of <body>_ports.csv of a flexible body or of the reduced body wrapping it (part
+  is the body's own part, which places its ports): time; a floating frame's wrench and motion; each port's input
+  wrench (body frame) and output port_y; the frame origin's and each port's inertial position
+
+  Not collective
+@*/
+PetscErrorCode PhlexFlexiblePortSeriesRow(PhlexPart part, PhlexFlexible b, PetscBool floating, const PhlexFrameState *fs, PetscReal (*port_y)[6], PetscReal t, const PhlexPartVec *X, PetscViewer csv)
+{
+  const PhlexUnits *u  = part->units;
+  PetscReal         fr = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexCSVPrintf(csv, "%.12e", (double)t));
+  if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+  if (floating) {
+    /* the frame: its wrench (SI), its motion (v_P, w) */
+    const PetscReal wf[6] = {fr * b->frame_force[0], fr * b->frame_force[1], fr * b->frame_force[2], fr * b->frame_moment[0], fr * b->frame_moment[1], fr * b->frame_moment[2]};
+    const PetscReal yf[6] = {fs->vP[0], fs->vP[1], fs->vP[2], fs->w[0], fs->w[1], fs->w[2]};
+    PetscCall(PhlexPortSeriesEntry(csv, u, wf, PETSC_TRUE, yf));
+  }
+  for (PetscInt p = 0; p < b->nports; p++) {
+    PetscReal in[6];
+    PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, floating ? fs->R : NULL, in)); /* body frame */
+    PetscCall(PhlexPortSeriesEntry(csv, u, in, PETSC_FALSE, port_y[p]));
+  }
+  for (PetscInt p = floating ? -1 : 0; p < b->nports; p++) {
+    PetscReal x[3], R[9];
+    if (p >= 0) PetscCall((*part->ops.portplacement)(part, p, X, x, R));
+    else
+      for (PetscInt c = 0; c < 3; c++) x[c] = fs->r[c]; /* the frame: its origin P */
+    PetscCall(PhlexPortSeriesPosition(csv, u, x));
+  }
+  PetscCall(PhlexCSVPrintf(csv, "\n"));
+  PetscFunctionReturn(0);
+}
+
 /* one output step at the evaluated state X: port series, rigid series, fields */
 static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t, const PhlexPartVec *X, PetscBool fields)
 {
@@ -543,30 +580,8 @@ static PetscErrorCode FlexOutputStep(PhlexPart part, PetscInt step, PetscReal t,
 
   PetscFunctionBeginUser;
   if (b->ports_csv && step >= 0) {
-    PetscViewer csv = (PetscViewer)b->ports_csv;
-    PetscReal   fr  = 0.0;
     PetscCall(PhlexFlexiblePortOutputsAll(part, X));
-    PetscCall(PhlexCSVPrintf(csv, "%.12e", (double)t));
-    if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
-    if (b->floating) {
-      /* the frame: its wrench (SI), its motion (v_P, w) */
-      const PetscReal wf[6] = {fr * b->frame_force[0], fr * b->frame_force[1], fr * b->frame_force[2], fr * b->frame_moment[0], fr * b->frame_moment[1], fr * b->frame_moment[2]};
-      const PetscReal yf[6] = {b->fs.vP[0], b->fs.vP[1], b->fs.vP[2], b->fs.w[0], b->fs.w[1], b->fs.w[2]};
-      PetscCall(PhlexPortSeriesEntry(csv, u, wf, PETSC_TRUE, yf));
-    }
-    for (PetscInt p = 0; p < b->nports; p++) {
-      PetscReal in[6];
-      PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, b->floating ? b->fs.R : NULL, in)); /* body frame */
-      PetscCall(PhlexPortSeriesEntry(csv, u, in, PETSC_FALSE, b->port_y[p]));
-    }
-    for (PetscInt p = b->floating ? -1 : 0; p < b->nports; p++) {
-      PetscReal x[3], R[9];
-      if (p >= 0) PetscCall((*part->ops.portplacement)(part, p, X, x, R));
-      else
-        for (PetscInt c = 0; c < 3; c++) x[c] = b->fs.r[c]; /* the frame: its origin P */
-      PetscCall(PhlexPortSeriesPosition(csv, u, x));
-    }
-    PetscCall(PhlexCSVPrintf(csv, "\n"));
+    PetscCall(PhlexFlexiblePortSeriesRow(part, b, b->floating, &b->fs, b->port_y, t, X, (PetscViewer)b->ports_csv));
   }
   if (b->rigid_csv && step >= 0) {
     PetscReal P[3], L[3];

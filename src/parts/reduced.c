@@ -940,30 +940,7 @@ static PetscErrorCode ReducedSeriesStep(PhlexPart part, PetscReal t, const Phlex
   const PhlexUnits *u = part->units;
 
   PetscFunctionBeginUser;
-  if (r->ports_csv) {
-    PetscViewer csv = r->ports_csv;
-    PetscReal   fr  = 0.0;
-    PetscCall(PhlexCSVPrintf(csv, "%.12e", (double)t));
-    if (b->frame_loaded) PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
-    if (r->floating) {
-      const PetscReal wf[6] = {fr * b->frame_force[0], fr * b->frame_force[1], fr * b->frame_force[2], fr * b->frame_moment[0], fr * b->frame_moment[1], fr * b->frame_moment[2]};
-      const PetscReal yf[6] = {r->fs.vP[0], r->fs.vP[1], r->fs.vP[2], r->fs.w[0], r->fs.w[1], r->fs.w[2]};
-      PetscCall(PhlexPortSeriesEntry(csv, u, wf, PETSC_TRUE, yf));
-    }
-    for (PetscInt p = 0; p < r->nports; p++) {
-      PetscReal in[6];
-      PetscCall(PhlexPortLoadEvaluate(&b->ports[p].load, t, u, r->floating ? r->fs.R : NULL, in));
-      PetscCall(PhlexPortSeriesEntry(csv, u, in, PETSC_FALSE, r->port_y[p]));
-    }
-    for (PetscInt p = r->floating ? -1 : 0; p < r->nports; p++) {
-      PetscReal x[3], R[9];
-      if (p >= 0) PetscCall(ReducedPortPlacement(part, p, X, x, R));
-      else
-        for (PetscInt c = 0; c < 3; c++) x[c] = r->fs.r[c];
-      PetscCall(PhlexPortSeriesPosition(csv, u, x));
-    }
-    PetscCall(PhlexCSVPrintf(csv, "\n"));
-  }
+  if (r->ports_csv) PetscCall(PhlexFlexiblePortSeriesRow(part, b, r->floating, &r->fs, r->port_y, t, X, r->ports_csv));
   if (r->rigid_csv) {
     PetscReal P[3], L[3];
     PetscCall(PhlexFrameWriteRow(r->rigid_csv, t, &r->fs, u, P, L));
