@@ -70,6 +70,7 @@ struct _p_PhlexSystem {
   Vec       *xu, *xv; /* work: per field part */
   Vec        Xwork;    /* work: a whole state (the joints' mid-step geometry) */
   PetscReal  fprev;    /* Newton: the previous residual norm (round-off floor test) */
+  PetscReal  jreuse;   /* Newton: the Jacobian is kept for the next iteration after a reduction of the residual below this (0: never) */
   PetscReal  vrtol;    /* Newton on the whole state of a scene with discrete unknowns: the velocity rows' tolerance */
   PetscReal  fv0, fvprev; /* ... their residual at the stage's initial guess and at the previous iterate */
   /* the state the parts and joints were last evaluated at (a Jacobian right after a residual at the same state

@@ -449,6 +449,18 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
 
 /* every option of a transient run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
    the analysis', the solver preset's, and those of TS, SNES, KSP and PC */
+/* Newton's Jacobian reuse within a step (PhlexSystemSNESConverged): read after the solver preset, which sets it */
+static PetscErrorCode JacobianReuseOption(MPI_Comm comm, PetscReal *rate, PetscBool *set)
+{
+  PetscFunctionBeginUser;
+  *rate = 0.0;
+  PetscOptionsBegin(comm, NULL, "Transient analysis: Newton", NULL);
+  PetscCall(PetscOptionsReal("-snes_reuse_jacobian_below", "Newton (SNES newtonls) keeps the Jacobian and its factorization for the next iteration of a step when the last iteration reduced the residual norm by at least this factor (a stale Jacobian then contracts about as fast, at the cost of a residual); 0: a new Jacobian every iteration (options/solver/rigid.opts: 1e-3)", "PhlexSystemSNESConverged", *rate, rate, set));
+  PetscOptionsEnd();
+  PetscCheck(*rate >= 0 && *rate < 1, comm, PETSC_ERR_USER_INPUT, "-snes_reuse_jacobian_below must be in [0, 1) (0: off), got %g", (double)*rate);
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode TransientRereadOptions(void *ctx)
 {
   MPI_Comm         comm = *(MPI_Comm *)ctx;
@@ -461,6 +473,11 @@ static PetscErrorCode TransientRereadOptions(void *ctx)
   PetscCall(TransientSetFromOptions(comm, &o));
   PetscCall(PetscViewerDestroy(&o.monitor));
   PetscCall(SolverPresetOption(comm, file));
+  {
+    PetscReal rate;
+    PetscBool set;
+    PetscCall(JacobianReuseOption(comm, &rate, &set));
+  }
   {
     MonitorContext m;
     char           restart[PETSC_MAX_PATH_LEN];
@@ -793,6 +810,21 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
        a fully converged solve with 1.5 x the Newton iterations (floating_stiffening_lossless) */
     sys->vrtol = o.velocity_rtol_set ? o.velocity_rtol : (sys->njoints ? o.velocity_rtol : 0.0);
     PetscCall(SNESSetConvergenceTest(snes, m.reduced ? PhlexSystemSNESConverged : PhlexSystemSNESConvergedStage, sys, NULL));
+  }
+  {
+    /* the Jacobian kept for the next Newton iteration of a step after a fast one (a preset's choice: rigid.opts) */
+    SNES              snes;
+    PetscBool         set, newtonls, lag, typed;
+    PetscReal         rate;
+    const char *const reuse[] = {"snes_reuse_jacobian_below", NULL};
+    PetscCall(JacobianReuseOption(scene->comm, &rate, &set));
+    PetscCall(TSGetSNES(ts, &snes));
+    PetscCall(PetscObjectTypeCompare((PetscObject)snes, SNESNEWTONLS, &newtonls));
+    PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_lag_jacobian", &lag));
+    PetscCheck(!(rate > 0 && lag), scene->comm, PETSC_ERR_USER_INPUT, "-snes_reuse_jacobian_below %g and -snes_lag_jacobian both decide when Newton rebuilds its Jacobian: give one (-snes_reuse_jacobian_below 0 turns the first off)", (double)rate);
+    PetscCall(PhlexOptionsCommandLineHasPrefix(reuse, &typed));
+    PetscCheck(!(typed && rate > 0) || (newtonls && (sys->nonlinear || sys->inexact_schur)), scene->comm, PETSC_ERR_USER_INPUT, "-snes_reuse_jacobian_below has no effect on this run: it applies to Newton on the whole state (SNES newtonls) of a nonlinear scene%s", m.reduced ? "; its steps are solved by SNES phlexreduced" : (m.condensed ? "; its steps are solved by SNES phlexcondensed" : ""));
+    sys->jreuse = (newtonls && (sys->nonlinear || sys->inexact_schur)) ? rate : 0.0;
   }
   PetscCheck(!o.velocity_rtol_set || (!m.reduced && !m.condensed && sys->nq && (sys->nonlinear || sys->inexact_schur)), scene->comm, PETSC_ERR_USER_INPUT, "-snes_velocity_rtol has no effect on this run: it applies to Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns; %s", m.reduced ? "its steps are solved by SNES phlexreduced, whose test is -snes_phlexreduced_velocity_rtol" : (m.condensed ? "its steps are solved by SNES phlexcondensed (no Newton)" : (sys->nq ? "the scene is linear (no Newton)" : "the scene has none")));
   PetscCall(TSGetTimeStep(ts, &dt));

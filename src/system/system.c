@@ -1122,6 +1122,14 @@ PetscErrorCode PhlexSystemSNESConverged(SNES snes, PetscInt it, PetscReal xnorm,
     const PetscReal floor = 100.0 * PETSC_MACHINE_EPSILON * PetscMax(1.0, sys->shift) * xnorm;
     if (fnorm <= floor && fnorm >= 0.5 * sys->fprev) *reason = SNES_CONVERGED_FNORM_ABS;
   }
+  if (sys->jreuse > 0) {
+    /* after an iteration that reduced the residual by jreuse or more the next one keeps the Jacobian and its
+       factorization (lag -1: SNESComputeJacobian returns at once): the stale Jacobian's contraction is then about
+       as strong (modified Newton), at the cost of a residual and a back-substitution. Each step starts with a new
+       one, so a run repeats itself across a restart; a slow iteration (a hard step) rebuilds it */
+    const PetscBool keep = (*reason == SNES_CONVERGED_ITERATING && it > 0 && fnorm <= sys->jreuse * sys->fprev) ? PETSC_TRUE : PETSC_FALSE;
+    PetscCall(SNESSetLagJacobian(snes, keep ? -1 : 1));
+  }
   sys->fprev = fnorm;
   PetscFunctionReturn(0);
 }
