@@ -326,18 +326,23 @@ def plot_energy(np, plt, tbl, dpi):
             lines.append(Line(label + (" (identically 0)" if not np.any(y) else ""), y, {"color": color, "lw": 1.8}))
     total, work = tbl.num("total"), tbl.num("supplied_work")
     power, residual = tbl.num("input_power"), tbl.num("balance_residual")
+    # the dampers' share (files of earlier versions have no such columns: nothing dissipated)
+    dpower = tbl.num("dissipated_power") if tbl.has("dissipated_power") else np.zeros(t.shape)
+    dwork = tbl.num("dissipated_work") if tbl.has("dissipated_work") else np.zeros(t.shape)
     lines.append(Line("total H", total, {"color": "k", "ls": "--", "lw": 1.1, "zorder": 3}))
     change = total - total[0]
-    drift = np.nancumsum(residual)  # H - H0 - W, free of the rounding of the total in the CSV
+    drift = np.nancumsum(residual)  # H - H0 - W + D, free of the rounding of the total in the CSV
     scale = _size(np, [line.y for line in lines])
     error = float(np.nanmax(np.abs(drift)))
     relative = f" = {error / scale:.3g} of the largest energy" if scale > 0 else ""
     change_lines = [Line("H − H0", change, {"color": "k", "ls": "--", "zorder": 3})]
     if np.any(work):
         change_lines.insert(0, Line("supplied work W", work, {"color": "tab:red", "lw": 2.5, "alpha": 0.6}))
+    if np.any(dwork):
+        change_lines.insert(0, Line("W − dissipated D", work - dwork, {"color": "tab:purple", "lw": 2.5, "alpha": 0.6}))
     panels = [
         panel("energy components, total H dashed on top", "energy [J]", lines),
-        panel(f"change of the total energy; max |H − H0 − W| = {error:.3g} J{relative}", "[J]", change_lines,
+        panel(f"change of the total energy; max |H − H0 − W{' + D' if np.any(dwork) else ''}| = {error:.3g} J{relative}", "[J]", change_lines,
               flat=False),
     ]
     run = _run(os.path.dirname(tbl.path))
@@ -345,10 +350,10 @@ def plot_energy(np, plt, tbl, dpi):
                 ncols=1)
     panels = [
         panel("input power of the port and frame wrenches, body forces, drives and prescribed motions",
-              "P [W]", [Line("P", power)]),
-        panel("per-step balance residual |H(n+1) − H(n) − Δt P| (log scale)", "|residual| [J]",
+              "P [W]", [Line("P", power)] + ([Line("dissipated D", dpower, {"color": "tab:purple"})] if np.any(dpower) else [])),
+        panel(f"per-step balance residual |H(n+1) − H(n) − Δt {'(P − D)' if np.any(dpower) else 'P'}| (log scale)", "|residual| [J]",
               [Line("|residual|", residual, {"color": "tab:red"})], log=True),
-        panel("cumulative balance error H − H0 − W, summed from the residuals (the CSV rounds H to 13 digits)",
+        panel(f"cumulative balance error H − H0 − W{' + D' if np.any(dwork) else ''}, summed from the residuals (the CSV rounds H to 13 digits)",
               "Σ residual [J]", [Line("Σ residual", drift)], flat=False),
     ]
     draw_figure(np, plt, t, T_LABEL, panels, f"Power balance ({run}, {tbl.name})", _png(tbl, "power_balance.png"),

@@ -114,6 +114,7 @@ PETSC_INTERN PetscErrorCode PhlexJointOutputOpen(PhlexJoint, PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointPower(PhlexJoint, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointSourcePower(PhlexJoint, PetscReal, const PetscReal *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointDissipation(PhlexJoint, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointOutputClose(PhlexJoint);
 PETSC_INTERN PetscBool      PhlexJointTouches(PhlexJoint, PhlexPart);
 

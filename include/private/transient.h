@@ -12,6 +12,8 @@ typedef struct {
   PetscReal   tstage;
   PetscBool   have_stage;
   PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax, Emax; /* Emax: largest kinetic + strain energy */
+  PetscReal   dissipated_total; /* the energy the dampers dissipated (>= 0); max_work: the largest of it and |work_total| */
+  PetscBool   dissipative;      /* a part or joint has dampers (the summary and the monitor show the dissipation) */
   PetscViewer energy_csv, monitor;
   PetscInt    interval, last_written;
   PetscBool   theta, endpoint;

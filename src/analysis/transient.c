@@ -15,7 +15,7 @@
 
 static PetscErrorCode TransientProgress(TS, MonitorContext *, PetscInt, PetscReal);
 static PetscErrorCode ReportRetry(TS, MonitorContext *, const char[]);
-static PetscErrorCode InputPower(MonitorContext *, PetscReal, Vec, PetscReal, PetscBool, PetscReal *);
+static PetscErrorCode InputPower(MonitorContext *, PetscReal, Vec, PetscReal, PetscBool, PetscReal *, PetscReal *);
 static PetscErrorCode Watchdogs(MonitorContext *, PetscInt, PetscReal, PetscReal, PetscReal);
 
 /* ---------------------------------------------------------------------------------------------------------- */
@@ -24,24 +24,29 @@ static PetscErrorCode Watchdogs(MonitorContext *, PetscInt, PetscReal, PetscReal
 /* the power of the inputs at (t, X): external inputs of every part and the drives of the joints (multipliers
    m->lambda); the joints' share, times weight, is added to m->jpower. At the stage of a theta method (X: the state
    where the constraints hold) a joint's power is measured from its ports, lambda . (c + g), zero to solver
-   tolerance for a workless joint; for the other schemes it is lambda . g(t), the scheme holding c = g. */
-static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscReal weight, PetscBool stage, PetscReal *P)
+   tolerance for a workless joint; for the other schemes it is lambda . g(t), the scheme holding c = g. D: the power
+   the parts' and joints' dampers dissipate at (t, X), >= 0; the balance is dH/dt = P - D. */
+static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscReal weight, PetscBool stage, PetscReal *P, PetscReal *D)
 {
   PhlexSystem sys = m->sys;
 
   PetscFunctionBeginUser;
   PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
-  *P = 0.0;
+  *P = *D = 0.0;
   for (PetscInt i = 0; i < sys->nparts; i++) {
-    PetscReal p = 0.0;
+    PetscReal p = 0.0, d = 0.0;
     if (sys->parts[i]->ops.inputpower) PetscCall((*sys->parts[i]->ops.inputpower)(sys->parts[i], &p));
+    if (sys->parts[i]->ops.dissipation) PetscCall((*sys->parts[i]->ops.dissipation)(sys->parts[i], &d));
     *P += p;
+    *D += d;
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
-    PetscReal p;
+    PetscReal p, d;
     if (stage) PetscCall(PhlexJointPower(sys->joints[k], m->lambda + sys->joints[k]->qoff, &p));
     else PetscCall(PhlexJointSourcePower(sys->joints[k], t, m->lambda + sys->joints[k]->qoff, &p));
+    PetscCall(PhlexJointDissipation(sys->joints[k], m->lambda + sys->joints[k]->qoff, &d));
     *P += p;
+    *D += d;
     m->jpower[k] += weight * p;
   }
   PetscFunctionReturn(0);
@@ -178,15 +183,15 @@ static PetscErrorCode CheckStage(TSAdapt adapt, TS ts, PetscReal t, Vec Y, Petsc
   else if (m->lossless_scheme && m->watch_balance > 0) {
     /* the implicit midpoint rule: the step's power balance at its end state, cleaned as PostStep will */
     const PetscReal dtn = dt / u->time;
-    PetscReal       P, kin, strain, pot, residual, scale, defect;
+    PetscReal       P, D, kin, strain, pot, residual, scale, defect;
     Xe = m->Xmid; /* scratch: the monitor sets it before using it */
     PetscCall(VecAXPBYPCZ(Xe, 1.0 / m->theta_value, 1.0 - 1.0 / m->theta_value, 0.0, Y, m->Xprev));
     PetscCall(PhlexSystemPostStep(sys, Xe, &defect));
     PetscCall(PhlexSystemGather(sys, Xe, sys->q));
     for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dtn : 0.0;
-    PetscCall(InputPower(m, t, Y, 1.0, PETSC_TRUE, &P));
+    PetscCall(InputPower(m, t, Y, 1.0, PETSC_TRUE, &P, &D));
     PetscCall(PhlexSystemEnergy(sys, m->tprev + dt, Xe, &kin, &strain, &pot));
-    residual = kin + strain + pot - m->Hprev - dtn * P;
+    residual = kin + strain + pot - m->Hprev - dtn * (P - D);
     scale    = PetscMax(PetscMax(m->Emax, kin + strain), PetscAbsReal(m->H0));
     if (PetscIsInfOrNanReal(residual)) PetscCall(PetscSNPrintf(why, sizeof(why), "the power balance of the step is not a number"));
     else if (PetscAbsReal(residual) > m->watch_balance * scale) PetscCall(PetscSNPrintf(why, sizeof(why), "watchdog: the power balance of the step is off by %.3e J, %.2e of the energy (bound -watchdog_balance_rtol %g)", (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)m->watch_balance));
@@ -258,7 +263,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   MonitorContext   *m   = (MonitorContext *)ctx;
   PhlexSystem       sys = m->sys;
   const PhlexUnits *u   = &m->scene->units;
-  PetscReal         kin = 0, strain = 0, pot = 0, H, dt = 0, power = 0, residual = 0;
+  PetscReal         kin = 0, strain = 0, pot = 0, H, dt = 0, power = 0, dissipated = 0, residual = 0;
   PetscBool         fields;
 
   PetscFunctionBeginUser;
@@ -276,8 +281,8 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   for (PetscInt k = 0; k < sys->njoints; k++) m->jpower[k] = 0.0;
   if (step == 0 && sys->njoints) {
     /* the joints' power at the consistent start */
-    PetscReal P0;
-    PetscCall(InputPower(m, t, X, 1.0, PETSC_TRUE, &P0));
+    PetscReal P0, D0;
+    PetscCall(InputPower(m, t, X, 1.0, PETSC_TRUE, &P0, &D0));
   }
   if (step > 0) {
     dt = (t - m->tprev) / u->time;
@@ -289,18 +294,20 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
       PetscCheck(m->have_stage, m->scene->comm, PETSC_ERR_PLIB, "step %" PetscInt_FMT ": the theta method's step has no stage", step);
       PetscCall(PetscObjectStateGet((PetscObject)m->Xstage, &state));
       PetscCheck(state == m->stage_state, m->scene->comm, PETSC_ERR_PLIB, "step %" PetscInt_FMT ": TS changed the theta method's stage vector after the stage", step);
-      PetscCall(InputPower(m, m->tstage, m->Xstage, 1.0, PETSC_TRUE, &power));
+      PetscCall(InputPower(m, m->tstage, m->Xstage, 1.0, PETSC_TRUE, &power, &dissipated));
     } else if (m->theta && m->endpoint) {
-      PetscReal P1, P0;
+      PetscReal P1, P0, D1, D0;
       PetscCall(VecAXPBYPCZ(m->Xmid, 0.5, 0.5, 0.0, X, m->Xprev));
-      PetscCall(InputPower(m, t, m->Xmid, m->theta_value, PETSC_FALSE, &P1));
-      PetscCall(InputPower(m, m->tprev, m->Xmid, 1.0 - m->theta_value, PETSC_FALSE, &P0));
-      power = m->theta_value * P1 + (1.0 - m->theta_value) * P0;
+      PetscCall(InputPower(m, t, m->Xmid, m->theta_value, PETSC_FALSE, &P1, &D1));
+      PetscCall(InputPower(m, m->tprev, m->Xmid, 1.0 - m->theta_value, PETSC_FALSE, &P0, &D0));
+      power      = m->theta_value * P1 + (1.0 - m->theta_value) * P0;
+      dissipated = m->theta_value * D1 + (1.0 - m->theta_value) * D0;
     } else {
-      PetscReal P1, P0;
-      PetscCall(InputPower(m, t, X, 0.5, PETSC_FALSE, &P1));
-      PetscCall(InputPower(m, m->tprev, m->Xprev, 0.5, PETSC_FALSE, &P0));
-      power = 0.5 * (P0 + P1);
+      PetscReal P1, P0, D1, D0;
+      PetscCall(InputPower(m, t, X, 0.5, PETSC_FALSE, &P1, &D1));
+      PetscCall(InputPower(m, m->tprev, m->Xprev, 0.5, PETSC_FALSE, &P0, &D0));
+      power      = 0.5 * (P0 + P1);
+      dissipated = 0.5 * (D0 + D1);
     }
   }
   fields = (step == 0 || (m->interval > 0 && step % m->interval == 0)) ? PETSC_TRUE : PETSC_FALSE;
@@ -312,15 +319,17 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     m->H0 = m->Hprev = m->Hmax = H;
   } else {
     m->work_total += dt * power;
-    residual        = H - m->Hprev - dt * power;
+    m->dissipated_total += dt * dissipated;
+    residual        = H - m->Hprev - dt * (power - dissipated);
     m->max_residual = PetscMax(m->max_residual, PetscAbsReal(residual));
-    m->max_work     = PetscMax(m->max_work, PetscAbsReal(m->work_total));
+    m->max_work     = PetscMax(m->max_work, PetscMax(PetscAbsReal(m->work_total), m->dissipated_total));
     m->max_drift    = PetscMax(m->max_drift, PetscAbsReal(H - m->H0));
     m->Hmax         = PetscMax(m->Hmax, H);
     m->Hprev        = H;
   }
-  PetscCall(PhlexCSVPrintf(m->energy_csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e\n", step, (double)t, (double)(kin * u->energy), (double)(strain * u->energy), (double)(pot * u->energy), (double)(H * u->energy), (double)(power * u->power), (double)(m->work_total * u->energy), (double)(residual * u->energy)));
-  if (m->monitor) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(residual * u->energy)));
+  PetscCall(PhlexCSVPrintf(m->energy_csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e\n", step, (double)t, (double)(kin * u->energy), (double)(strain * u->energy), (double)(pot * u->energy), (double)(H * u->energy), (double)(power * u->power), (double)(m->work_total * u->energy), (double)(residual * u->energy), (double)(dissipated * u->power), (double)(m->dissipated_total * u->energy)));
+  if (m->monitor && m->dissipative) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  dissipated %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(dissipated * u->power), (double)(residual * u->energy)));
+  else if (m->monitor) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(residual * u->energy)));
   PetscCall(Watchdogs(m, step, t, H, residual - m->step_project_dH));
   m->step_project_dH = 0;
   if (m->Xprev) PetscCall(VecCopy(X, m->Xprev));
@@ -881,6 +890,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   }
   /* the implicit midpoint rule keeps the power balance to solver tolerance for a quadratic Hamiltonian */
   m.lossless_scheme = (m.theta && !m.endpoint && m.theta_value == 0.5) ? PETSC_TRUE : PETSC_FALSE;
+  /* a part with dampers: the summary and the monitor say what was dissipated */
+  for (PetscInt i = 0; i < sys->nparts; i++)
+    if (sys->parts[i]->ops.dissipation) m.dissipative = PETSC_TRUE;
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
   m.watch_balance   = o.watch_balance;
@@ -899,7 +911,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PhlexTransientRestartCheck(ts, &m, checkpoint, restart, X));
     PetscCall(PhlexOutputSetRestart(scene->output, checkpoint, restart));
   }
-  PetscCall(PhlexOutputCSVOpen(scene->output, "energy.csv", "step,time,kinetic,strain,potential,total,input_power,supplied_work,balance_residual", &m.energy_csv));
+  PetscCall(PhlexOutputCSVOpen(scene->output, "energy.csv", "step,time,kinetic,strain,potential,total,input_power,supplied_work,balance_residual,dissipated_power,dissipated_work", &m.energy_csv));
   for (PetscInt i = 0; i < sys->nparts; i++) PetscCall((*sys->parts[i]->ops.outputopen)(sys->parts[i], scene->output, scene->output->fields));
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputOpen(sys->joints[k], scene->output));
   PetscCall(TSMonitorSet(ts, MonitorEnergy, &m, NULL));
@@ -964,7 +976,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PetscPrintf(scene->comm, ", max |H - H0| %.3e J", (double)(m.max_drift * u->energy)));
     if (m.H0 > 1e-6 * m.Emax) PetscCall(PetscPrintf(scene->comm, " (%.3e of H0)", (double)(m.max_drift / m.H0)));
     PetscCall(PetscPrintf(scene->comm, "\n"));
-    PetscCall(PetscPrintf(scene->comm, "  supplied work: %.8e J, max power-balance residual %.3e J\n", (double)(m.work_total * u->energy), (double)(m.max_residual * u->energy)));
+    if (m.dissipative) PetscCall(PetscPrintf(scene->comm, "  supplied work: %.8e J, dissipated %.8e J, max power-balance residual %.3e J (H_{n+1} - H_n - supplied + dissipated)\n", (double)(m.work_total * u->energy), (double)(m.dissipated_total * u->energy), (double)(m.max_residual * u->energy)));
+    else PetscCall(PetscPrintf(scene->comm, "  supplied work: %.8e J, max power-balance residual %.3e J\n", (double)(m.work_total * u->energy), (double)(m.max_residual * u->energy)));
     for (PetscInt i = 0; i < sys->nparts; i++)
       if (sys->parts[i]->frame.R >= 0) {
         if (!m.history) PetscCall(PetscPrintf(scene->comm, "  rotations: max ||R^T R - I||_F = %.3e (largest per-step defect removed %.3e, same norm)\n", (double)m.max_orth, (double)m.max_defect));

@@ -571,6 +571,18 @@ PetscErrorCode PhlexJointPower(PhlexJoint j, const PetscReal *lambda, PetscReal 
 }
 
 /*@C
+  PhlexJointDissipation - the power the joint dissipates at the evaluated state (>= 0), with the given multipliers:
+  zero for the constraint rows, which are workless (a drive's power is supplied, PhlexJointPower)
+@*/
+PetscErrorCode PhlexJointDissipation(PhlexJoint j, const PetscReal *lambda, PetscReal *D)
+{
+  PetscFunctionBeginUser;
+  (void)lambda;
+  *D = 0.0;
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexJointSourcePower - the power the joint supplies, lambda . g(t): its drive's or prescribed motion's (zero for a
   workless joint), given that the scheme holds c = g at its stage (for the schemes whose stage state the monitor does
   not see)
