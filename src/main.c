@@ -84,8 +84,9 @@ int main(int argc, char **argv)
   int            code;
 
   if (argc == 1) {
+    /* nothing to run: the usage, and the input-error code (a script that forgot its arguments must not pass) */
     fputs(PhlexUsage, stdout);
-    return 0;
+    return PHLEX_EXIT_INPUT;
   }
   (void)PhlexHelpParseArgs(&argc, argv);
   code = PhlexSceneFilesCheck(argc, argv);

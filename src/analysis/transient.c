@@ -688,6 +688,15 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   }
   PetscCall(TSSetFromOptions(ts));
   {
+    /* the scene's equations are implicit (an index-2 DAE with constraints, a mass matrix, algebraic rows): an
+       explicit integrator cannot take them (PETSc refuses it at the first step with a traceback) */
+    PetscBool explicit_ts;
+    TSType    type;
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)ts, &explicit_ts, TSEULER, TSRK, TSSSP, TSMPRK, TSGLEE, TSBASICSYMPLECTIC, ""));
+    PetscCall(TSGetType(ts, &type));
+    PetscCheck(!explicit_ts, scene->comm, PETSC_ERR_USER_INPUT, "-ts_type %s: an explicit integrator cannot take phlex's implicit equations (mass matrices, constraints, algebraic rows); use theta (the implicit midpoint rule, the default), cn, beuler, bdf or alpha", type);
+  }
+  {
     /* SNES phlexcondensed (the presets exact and iterative ask for it): the theta-method stage of fixed linear bodies by
        exact elimination (snes_condensed.c). Where it does not apply the preset's field split takes over (SNES ksponly, or
        Newton for a nonlinear scene), unless -snes_type phlexcondensed was typed on the command line: then an error

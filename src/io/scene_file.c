@@ -27,7 +27,7 @@ static int CheckYAML(const char *option, const char *file)
   FILE         *fp = fopen(file, "rb");
   yaml_parser_t parser;
   yaml_document_t document;
-  int           done = 0, code = 0;
+  int           done = 0, code = 0, first = 1;
 
   if (!fp) {
     if (IsRankZero()) fprintf(stderr, "phlex: error: cannot read the scene file '%s' (option %s): %s\n", file, option, strerror(errno));
@@ -48,7 +48,20 @@ static int CheckYAML(const char *option, const char *file)
       code = PHLEX_EXIT_INPUT;
       break;
     }
-    done = !yaml_document_get_root_node(&document);
+    {
+      /* PETSc reads a scene as one mapping of options (key: value, nested mappings for prefixes): an empty file or
+         another top level (a list, a bare value) is refused here with the file named, not by PETSc's parser */
+      const yaml_node_t *root = yaml_document_get_root_node(&document);
+      if (first && !root) {
+        if (IsRankZero()) fprintf(stderr, "phlex: error: scene file '%s' (option %s) is empty: a scene is a mapping of options (key: value; see options/*.yaml)\n", file, option);
+        code = PHLEX_EXIT_INPUT;
+      } else if (root && root->type != YAML_MAPPING_NODE) {
+        if (IsRankZero()) fprintf(stderr, "phlex: error: scene file '%s' (option %s): its top level (line %lu) is a %s, not a mapping of options (key: value; see options/*.yaml)\n", file, option, (unsigned long)root->start_mark.line + 1, root->type == YAML_SEQUENCE_NODE ? "list" : "single value");
+        code = PHLEX_EXIT_INPUT;
+      }
+      first = 0;
+      done  = !root || code;
+    }
     yaml_document_delete(&document);
   }
   yaml_parser_delete(&parser);

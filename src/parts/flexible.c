@@ -13,6 +13,8 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart);
 static PetscErrorCode MaterialCheck(PhlexFlexible b, const PhlexMaterial *m, const char prefix[])
 {
   PetscFunctionBeginUser;
+  /* a value beyond the double range (1e400) is read as inf: refused here, not by the factorization */
+  PetscCheck(!PetscIsInfOrNanReal(m->youngs_modulus) && !PetscIsInfOrNanReal(m->poissons_ratio) && !PetscIsInfOrNanReal(m->density), b->comm, PETSC_ERR_USER_INPUT, "body %s: a material value is not a finite number (beyond the range of doubles, about 1.8e308): -%syoungs_modulus %g, -%spoissons_ratio %g, -%sdensity %g", b->name, prefix, (double)m->youngs_modulus, prefix, (double)m->poissons_ratio, prefix, (double)m->density);
   PetscCheck(m->youngs_modulus > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: Young's modulus must be positive: -%syoungs_modulus %g", b->name, prefix, (double)m->youngs_modulus);
   PetscCheck(m->poissons_ratio > -1.0 && m->poissons_ratio < 0.5, b->comm, PETSC_ERR_USER_INPUT, "body %s: Poisson's ratio must lie in (-1, 0.5): -%spoissons_ratio %g", b->name, prefix, (double)m->poissons_ratio);
   PetscCheck(m->density > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: density must be positive: -%sdensity %g", b->name, prefix, (double)m->density);

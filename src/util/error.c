@@ -152,7 +152,9 @@ static PetscErrorCode PhlexErrorHandler(MPI_Comm comm, int line, const char *fun
     if (comm != MPI_COMM_NULL) MPI_Comm_rank(comm, &rank);
     /* PETSc's own option parsing (an unknown value of a list option, a malformed number) is input too */
     const PetscBool options = (file && (strstr(file, "sys/objects/options.c") || strstr(file, "sys/objects/aoptions.c"))) ? PETSC_TRUE : PETSC_FALSE;
-    if (!phlex_exit) phlex_exit = ExitCodeOf(n, (ours || options) ? PETSC_TRUE : PETSC_FALSE);
+    /* an unknown value of a list option (PetscOptionsEnum, PetscOptionsList: "Unknown option x for -y") is bad input,
+       not a failed self-check */
+    if (!phlex_exit) phlex_exit = (options && n == PETSC_ERR_USER) ? PHLEX_EXIT_INPUT : ExitCodeOf(n, (ours || options) ? PETSC_TRUE : PETSC_FALSE);
     if (n == PETSC_ERR_MISSING_FACTOR && !phlex_traceback) {
       char named[2048];
       NameFactorPackage(mess, named, sizeof(named));
