@@ -37,7 +37,11 @@ static void ReadHeaderRank0(const char file[], PhlexMeshHeader *h, PhlexPhysical
     return;
   }
   if (strncmp(line, "$MeshFormat", 11)) {
-    h->status = MESH_NOT_GMSH;
+    /* gmsh's format 1 has no $MeshFormat section: it starts with $NOD (or $PhysicalNames) */
+    if (!strncmp(line, "$NOD", 4) || !strncmp(line, "$PhysicalNames", 14)) {
+      h->status = MESH_BAD_VERSION;
+      snprintf(h->detail, sizeof(h->detail), "1 (it starts with $NOD)");
+    } else h->status = MESH_NOT_GMSH;
     fclose(fp);
     return;
   }

@@ -676,7 +676,7 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   part->ops.outputstep          = FlexOutputStep;
   part->ops.outputclose         = FlexOutputClose;
   part->fieldops->energybegin = FlexEnergyBegin;
-  part->analysisops->modes       = PhlexFlexibleComputeModes;
+  part->analysisops->modes       = PhlexFlexibleModesAnalysis;
   part->analysisops->modesoutput = PhlexFlexibleModesOutput;
   part->analysisops->refine      = PhlexFlexibleRefine;
   part->analysisops->modesorder  = PhlexFlexibleModesOrder;

@@ -87,6 +87,11 @@ static PetscErrorCode ModeField(PhlexPart part, const PhlexIC *ic, const char fi
   Vec          *vecs;
 
   PetscFunctionBeginUser;
+  {
+    char option[96];
+    PetscCall(PetscSNPrintf(option, sizeof(option), "-%sic_%s_mode", b->prefix, field));
+    PetscCall(PhlexFlexibleModesRequestCheck(part, ic->mode, option, ic->mode));
+  }
   PetscCall(PhlexFlexibleComputeModes(part, ic->mode, &nconv, &nrigid, &lambda, &vecs, &q, NULL));
   PetscCheck(nconv >= nrigid + ic->mode, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: elastic mode %" PetscInt_FMT " for -%sic_%s_mode was not found (%" PetscInt_FMT " converged)", b->name, ic->mode, b->prefix, field, nconv - nrigid);
   PetscCall(VecDuplicate(vecs[nrigid + ic->mode - 1], mode));

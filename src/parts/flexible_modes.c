@@ -275,6 +275,35 @@ static PetscErrorCode EigenpairResiduals(EPS eps, PetscInt n, PetscReal rigid_be
 }
 
 /*@C
+  PhlexFlexibleModesRequestCheck - refuses, before any work, a request of more eigenpairs than the body's eigensolver
+  can give: nev elastic modes (plus a free body's six rigid ones) and the subspace of about twice as many vectors the
+  solver builds must fit in the body's velocity unknowns. option and value name what asked (-modes_nev 100000,
+  -body0_ic_velocity_mode 1000, -body0_reduction_modes 5000)
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleModesRequestCheck(PhlexPart part, PetscInt nev, const char option[], PetscInt value)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscInt      N, want;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetSize(b->Mv, &N, NULL));
+  want = nev + ((!b->frame_patch[0] || b->floating) ? 6 : 0);
+  PetscCheck(2 * want <= N, b->comm, PETSC_ERR_USER_INPUT, "body %s: %s %" PetscInt_FMT ": more modes than the body's %" PetscInt_FMT " velocity unknowns allow, at most %" PetscInt_FMT " on this mesh (the eigensolver's subspace holds about twice the pairs asked%s); ask for fewer, or refine the mesh", part->name, option, value, N, PetscMax(N / 2 - (want - nev), 0), want > nev ? ", the six rigid-body modes of a free body among them" : "");
+  PetscFunctionReturn(0);
+}
+
+/* the modal analysis's request (-modes_nev), checked, then solved */
+PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart part, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFlexibleModesRequestCheck(part, nev, "-modes_nev", nev));
+  PetscCall(PhlexFlexibleComputeModes(part, nev, nconv, nrigid, lambda, vecs, rigid, resid));
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexFlexibleComputeModes - lowest eigenpairs of K x = lambda Mv x of a flexible body (non-dimensional lambda = omega^2)
 
   Collective

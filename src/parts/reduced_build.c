@@ -582,6 +582,14 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, const PhlexReduction *red, Phle
   PetscBool       floating = b->floating;
 
   PetscFunctionBeginUser;
+  if (type != PHLEX_REDUCTION_KRYLOV) {
+    char option[96];
+    PetscCall(PetscSNPrintf(option, sizeof(option), "-%sreduction_modes", b->prefix));
+    /* the basis's modes are the field's, clamped at the frame patch (or at the ports), free only on mean axes */
+    if (!mean_axes) b->floating = PETSC_FALSE;
+    PetscCall(PhlexFlexibleModesRequestCheck(part, nmodes, option, nmodes));
+    b->floating = floating;
+  }
   if (type == PHLEX_REDUCTION_KRYLOV) {
     model->nnormal = 0;
     PetscCall(PetscMalloc1(1, &model->lambda_full));

@@ -66,7 +66,7 @@ static int ExitCodeOf(PetscErrorCode n, PetscBool ours)
 static void NameMalformedOption(const char *mess, char *out, size_t len)
 {
   const char *value = NULL, *kind = NULL, *end;
-  char        v[256], *all = NULL, *tok, *next, names[512] = "";
+  char        v[256], *all = NULL, *tok, names[512] = "", kindbuf[128], given[512] = "", *name = NULL;
   size_t      nv;
 
   out[0] = 0;
@@ -79,18 +79,36 @@ static void NameMalformedOption(const char *mess, char *out, size_t len)
     value = mess + 23;
     end   = value + strlen(value);
     kind  = "not a boolean (true/false, yes/no, 1/0)";
+  } else if (!strncmp(mess, "Newly set value ", 16)) {
+    /* a bounded integer option (PetscOptionsBoundedInt, PetscOptionsRangeInt) */
+    const char *bound = strstr(mess, " than allowed bound ");
+    value = mess + 16;
+    end   = strchr(value, ' ');
+    if (bound) {
+      snprintf(kindbuf, sizeof(kindbuf), "%s %s", strstr(mess, " less than ") ? "below the smallest allowed value," : "above the largest allowed value,", bound + 20);
+      kind = kindbuf;
+    }
   }
   if (!value || !end) return;
   nv = PetscMin((size_t)(end - value), sizeof(v) - 1);
   memcpy(v, value, nv);
   v[nv] = 0;
   if (PetscOptionsGetAll(NULL, &all)) return;
-  /* "-name value -name value ...": a name is a '-' and a letter, its value the next token unless that is a name */
-  for (tok = strtok(all, " "); tok; tok = next) {
-    next = strtok(NULL, " ");
-    if (tok[0] == '-' && isalpha((unsigned char)tok[1]) && next && !(next[0] == '-' && isalpha((unsigned char)next[1])) && !strcmp(next, v)) {
-      size_t n = strlen(names);
-      snprintf(names + n, sizeof(names) - n, "%s%s", n ? ", " : "", tok);
+  /* "-name value -name value ...": a name is a '-' and a letter, its value the tokens up to the next name (a value
+     may hold spaces: "7800 kg/m^3") */
+  for (tok = strtok(all, " "); ; tok = strtok(NULL, " ")) {
+    const PetscBool is_name = (!tok || (tok[0] == '-' && isalpha((unsigned char)tok[1]))) ? PETSC_TRUE : PETSC_FALSE;
+    if (is_name) {
+      if (name && !strcmp(given, v)) {
+        size_t n = strlen(names);
+        snprintf(names + n, sizeof(names) - n, "%s%s", n ? ", " : "", name);
+      }
+      if (!tok) break;
+      name     = tok;
+      given[0] = 0;
+    } else if (name) {
+      size_t n = strlen(given);
+      snprintf(given + n, sizeof(given) - n, "%s%s", n ? " " : "", tok);
     }
   }
   (void)PetscFree(all);

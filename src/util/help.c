@@ -18,6 +18,7 @@ static PetscBool     bool_line; /* the line being printed is PETSc 3.18's bool o
 static char         *pending; /* the current line of stdout, built from several printf calls */
 static size_t        npending, maxpending;
 static char        **lines; /* help: the option lines printed so far (a repeated one is skipped); capture: names */
+static char          boundary_head[512]; /* a -dm_plex_boundary_label line whose garbage value held a newline: its start, up to '<' */
 static PetscInt      nlines, maxlines;
 static PetscErrorCode (*vfprintf_default)(FILE *, const char[], va_list);
 
@@ -150,6 +151,23 @@ static PetscErrorCode EmitLine(const char *line)
   PetscBool   option;
 
   PetscFunctionBeginUser;
+  if (!capturing) {
+    /* -dm_plex_boundary_label's garbage value (below) may hold newlines: the line is cut, and its pieces come as lines
+       of their own. They are dropped up to the one that ends the option's line, which is printed with an empty value */
+    const char *tail = strstr(line, ">: Label to mark the mesh boundary"), *head = strstr(line, "dm_plex_boundary_label <");
+    char        rebuilt[1024];
+    if (boundary_head[0]) {
+      if (!tail) PetscFunctionReturn(0);
+      PetscCall(PetscSNPrintf(rebuilt, sizeof(rebuilt), "%s%s", boundary_head, tail));
+      boundary_head[0] = 0;
+      PetscCall(EmitLine(rebuilt));
+      PetscFunctionReturn(0);
+    }
+    if (head && !tail) {
+      PetscCall(PetscSNPrintf(boundary_head, sizeof(boundary_head), "%.*s", (int)(head - line) + 24, line));
+      PetscFunctionReturn(0);
+    }
+  }
   while (*c == ' ') c++;
   option = (c > line && c[0] == '-' && isalpha((unsigned char)c[1])) ? PETSC_TRUE : PETSC_FALSE;
   if (capturing) {
