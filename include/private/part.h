@@ -203,6 +203,8 @@ struct _p_PhlexPart {
   char          (*qname)[16];
   PhlexFrameIndex frame;
   PetscBool       nonlinear; /* its residual is not linear in its unknowns (a moving frame) */
+  PetscBool       material_warned;     /* a warning said its material is suspicious (units, near incompressibility): the
+                                          watchdogs' advice points at it */
   PetscBool       nonquadratic_energy; /* its Hamiltonian is not quadratic in its energy variables (a floating body's
                                           full inertia): the implicit midpoint rule conserves it to O(dt^2) only */
 

@@ -368,8 +368,12 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
   PetscCheck(!PetscIsInfOrNanReal(residual), m->scene->comm, PETSC_ERR_NOT_CONVERGED, "at step %" PetscInt_FMT " (t = %g s) the power balance of the step is not a number: the state (a multiplier, an input) holds NaN or Inf; reduce -ts_dt, or check the inputs' magnitudes; no result was written", step, (double)t);
   if (step > 0 && m->lossless_scheme && m->watch_balance > 0) {
     const PetscReal scale = PetscMax(m->Emax, PetscAbsReal(m->H0));
-    PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently; tighten %s or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
-               step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance, m->condensed ? "-condensed_ksp_rtol" : (m->reduced ? "-snes_rtol/-reduced_ksp_rtol" : "-snes_rtol/-ksp_rtol"));
+    char            material[PHLEX_NAME_LEN + 160] = "";
+    /* a material warned about at the start (units, near incompressibility) conditions the solves badly: say so first */
+    for (PetscInt i = 0; i < m->sys->nparts && !material[0]; i++)
+      if (m->sys->parts[i]->material_warned) PetscCall(PetscSNPrintf(material, sizeof(material), "; first check body %s's material, warned about at the start (its units, or near incompressibility): it conditions the solves badly", m->sys->parts[i]->name));
+    PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently%s; tighten %s or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
+               step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance, material, m->condensed ? "-condensed_ksp_rtol" : (m->reduced ? "-snes_rtol/-reduced_ksp_rtol" : "-snes_rtol/-ksp_rtol"));
   }
   /* a scheme whose rotations are not re-orthonormalised (BDF, alpha): R^T R - I drifts with the scheme's error */
   if (m->history && !m->orth_warned && m->max_orth > 1e-2 && (m->watch_orth <= 0 || m->max_orth <= m->watch_orth)) {

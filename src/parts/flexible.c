@@ -210,10 +210,12 @@ static PetscErrorCode WarnSuspicious(PhlexFlexible b)
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < 3; d++) extent = PetscMax(extent, b->bbox_max[d] - b->bbox_min[d]);
-  if (extent > 1e3 || extent < 1e-4) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s: the mesh %s is %g m across; mesh coordinates are metres (a mesh drawn in millimetres is 1000 times too large)\n", b->name, b->mesh_file, (double)extent));
+  /* a 0.1 to 1 m part drawn in millimetres is 100 to 1000 units across */
+  if (extent >= 100 || extent < 1e-4) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s: the mesh %s is %g m across; mesh coordinates are metres: a mesh drawn in millimetres is 1000 times too large (gmsh: Mesh.ScalingFactor = 0.001)\n", b->name, b->mesh_file, (double)extent));
   for (PetscInt m = 0; m < b->nmaterials; m++) {
     const PhlexMaterial *mat   = &b->materials[m];
     const char          *where = mat->region[0] ? mat->region : "whole body";
+    if (mat->poissons_ratio > 0.49 || mat->youngs_modulus < 1e3 || mat->youngs_modulus > 1e15 || mat->density < 10 || mat->density > 1e5) b->part->material_warned = PETSC_TRUE;
     if (mat->poissons_ratio > 0.49) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s (%s): Poisson's ratio %s is nearly incompressible: the condition of the stress block grows like 1/(1 - 2 nu) = %.3g and P1 velocities lock (too stiff); prefer P2 and watch the solver's residuals\n", b->name, where, PhlexFormatReal(mat->poissons_ratio, (char[32]){0}, 32), (double)(1.0 / (1.0 - 2.0 * mat->poissons_ratio))));
     if (mat->youngs_modulus < 1e3 || mat->youngs_modulus > 1e15) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s (%s): Young's modulus %g Pa is outside the range of solids (1e3 to 1e15 Pa, the rigid limit included): is it in Pa?\n", b->name, where, (double)mat->youngs_modulus));
     if (mat->density < 10 || mat->density > 1e5) PetscCall(PetscFPrintf(b->comm, PETSC_STDERR, "phlex: warning: body %s (%s): density %g kg/m^3 is outside the range of solids (10 to 1e5 kg/m^3): is it in kg/m^3 (7.8 g/cm^3 = 7800 kg/m^3)?\n", b->name, where, (double)mat->density));
@@ -273,6 +275,8 @@ static PetscErrorCode SetUpPorts(PhlexPart part)
   const PetscInt    n = b->nports + (frame_port ? 1 : 0);
 
   PetscFunctionBeginUser;
+  /* a load on the clamped patch of a fixed body goes into the support: it would do nothing, without a word */
+  for (PetscInt p = 0; p < b->nports; p++) PetscCheck(b->floating || !b->frame_patch[0] || !b->ports[p].load.loaded || strcmp(b->ports[p].name, b->frame_patch), b->comm, PETSC_ERR_USER_INPUT, "body %s: port %s carries a load (-%sport_%s_force/_moment), but it is the clamped patch of the fixed body (-%sframe_patch %s): the support takes it and nothing moves; load another surface", b->name, b->ports[p].name, b->prefix, b->ports[p].name, b->prefix, b->frame_patch);
   for (PetscInt p = 0; p < b->nports; p++) PetscCall(PhlexFlexPortSetUp(b, &b->ports[p], u));
   PetscCall(PhlexPartSetPorts(part, n));
   for (PetscInt p = 0; p < b->nports; p++) {
