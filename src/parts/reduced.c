@@ -110,6 +110,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscCheck(r->nmodes >= 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_modes must be >= 0, got %" PetscInt_FMT, part->name, part->prefix, r->nmodes);
   PetscCheck(b->floating || b->frame_patch[0], part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced fixed body needs the clamp of its frame (-%sframe_patch <surface>): a free fixed body has no reduced model", part->name, part->prefix);
   PetscCheck(!b->stiffening && !b->spinning, part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced body has no %s (its basis is that of the linear body at rest, and the stiffening would need the stress of every basis pair): use the full body (-%stype flexible)", part->name, b->stiffening ? "geometric stiffening (-geometric_stiffening)" : "prescribed spin (-spin)", part->prefix);
+  PetscCheck(!b->damped, part->comm, PETSC_ERR_SUP, "body %s: a reduced body has no structural damping yet (-%srayleigh_alpha, -%srayleigh_beta, -%sviscosity): use the full body (-%stype flexible)", part->name, part->prefix, part->prefix, part->prefix, part->prefix);
   {
     /* the elastic initial state is the basis's: a reduced body starts undeformed, its frame placed and moving as given */
     const PhlexIC *iv = &b->ic_velocity, *iu = &b->ic_displacement, *is = &b->ic_stress;
