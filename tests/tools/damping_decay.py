@@ -7,7 +7,7 @@ velocity of a port is then y_n = Re(c z^n), and it obeys the two-term recurrence
 a = 2 Re z, b = -|z|^2 exactly. A least-squares fit of (a, b) over the series gives z; the implicit midpoint rule maps
 the semi-discrete eigenvalue lambda to z = (1 + h lambda/2) / (1 - h lambda/2) (Cayley), so
 lambda = (2/h) (z - 1) / (z + 1) is recovered exactly, and with it the mode's undamped pulsation w = |lambda| and its
-damping ratio zeta = -Re(lambda) / |lambda|: compared with alpha/(2 w) + (beta + eta/E) w/2 (the continuous model's
+damping ratio zeta = -Re(lambda) / |lambda|: compared with [zeta_i +] alpha/(2 w) + (beta + eta/E) w/2 (the continuous model's
 per-mode ratio, which the spatial discretisation keeps exactly for proportional damping). The time-discrete series'
 own logarithmic decrement per period, delta_h = -2 pi ln|z| / arg z, differs from the continuous
 delta = 2 pi zeta / sqrt(1 - zeta^2) by the midpoint rule's O((w h)^2) error: checked within --raw-rtol.
@@ -36,9 +36,10 @@ def main():
     p.add_argument("outdir")
     p.add_argument("--series", default=None, help="the CSV with the port velocities (relative to outdir); none: energy.csv only")
     p.add_argument("--columns", default="tip_vx,tip_vy,tip_vz", help="candidate columns: the one of largest amplitude is fitted")
+    p.add_argument("--after", type=float, default=None, help="fit only the rows after this time [s] (the end of a load)")
     p.add_argument("--alpha", type=float, default=0.0, help="Rayleigh alpha [1/s]")
     p.add_argument("--beta", type=float, default=0.0, help="Rayleigh beta plus eta/E [s]")
-    p.add_argument("--zeta", type=float, default=None, help="expected damping ratio (instead of alpha, beta)")
+    p.add_argument("--zeta", type=float, default=0.0, help="the mode's own damping ratio (a reduced body's -modal_damping_ratios), added to alpha's and beta's")
     p.add_argument("--zeta-rtol", type=float, default=1e-6)
     p.add_argument("--frequency", type=float, default=None, help="expected undamped frequency [Hz]")
     p.add_argument("--frequency-rtol", type=float, default=1e-6)
@@ -58,6 +59,8 @@ def main():
 
 def decay(a, failed):
     rows = read(os.path.join(a.outdir, a.series))
+    if a.after is not None:
+        rows = [r for r in rows if float(r["time"]) > a.after]
     t = [float(r["time"]) for r in rows]
     h = t[1] - t[0]
     for k in range(2, len(t)):
@@ -90,7 +93,7 @@ def decay(a, failed):
     w = abs(lam)
     zeta = -lam.real / w
     f = w / (2.0 * math.pi)
-    expected = a.zeta if a.zeta is not None else a.alpha / (2.0 * w) + a.beta * w / 2.0
+    expected = a.zeta + a.alpha / (2.0 * w) + a.beta * w / 2.0
     print("damped mode (%s): f = %.6g Hz, zeta = %.6g" % (col, f, zeta))
     if a.frequency is not None:
         dev = abs(f - a.frequency) / a.frequency
