@@ -292,10 +292,13 @@ struct _p_PhlexFlexible {
      velocity rows (symmetric positive semi-definite), assembled once */
   PetscReal rayleigh_alpha, rayleigh_beta; /* SI: 1/s, s */
   PetscBool damped;                        /* alpha, beta or a viscosity > 0 */
-  Mat       Rd;                            /* R (AIJ, non-dimensional: velocity rows in time T), NULL until needed */
-  Vec       rv;                            /* R v at the evaluated state */
-  PetscReal diss_loc;                      /* this process's part of v^T R v at the evaluated state */
-  PetscBool diss_valid;                    /* rv and diss_loc belong to the evaluated state */
+  Mat       Rd;                            /* R (AIJ, non-dimensional: velocity rows in time T), NULL until needed: the
+                                              sums into the condensed operator and the fixed body's Jvv */
+  Mat       Rsb;                           /* R as assembled (SBAIJ, 3x3 blocks, upper triangle): the products R v, about
+                                              half the time of the AIJ copy's */
+  Vec       veval, rv;                     /* the evaluated state's velocity (a copy), R veval (formed when asked for) */
+  PetscReal diss_loc;                      /* this process's part of veval^T R veval */
+  PetscBool evaluated, rv_valid;           /* veval holds the evaluated state's v; rv and diss_loc are its */
 
   /* output */
   void *writer, *rigid_csv, *ports_csv;
@@ -344,7 +347,8 @@ PETSC_INTERN PetscErrorCode PhlexFlexPortDestroy(PhlexFlexPort *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleAssembleDamping(PhlexFlexible, const PhlexUnits *, Mat *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDampingSetFromOptions(PhlexPart);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDampingSetUp(PhlexPart);
-PETSC_INTERN PetscErrorCode PhlexFlexibleDampingForce(PhlexPart, Vec);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingEvaluate(PhlexPart, Vec);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingForce(PhlexPart);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDampingView(PhlexFlexible, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDampingDestroy(PhlexFlexible);
 

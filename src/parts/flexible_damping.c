@@ -13,8 +13,9 @@
        body keeps its momenta and loses only elastic energy).
    A mode of pulsation w of the undamped body decays with the damping ratio zeta = alpha / (2 w) + (beta + eta/E) w / 2.
 
-   R is assembled once (flexible_fe.c, PhlexFlexibleAssembleDamping) and costs one sparse product per evaluation of
-   the body (R v for the residual, the condensed stage's right-hand side and the dissipated power). It enters every
+   R is assembled once (flexible_fe.c, PhlexFlexibleAssembleDamping) and costs one sparse product per residual (R v)
+   and one for the dissipated power at the monitor's evaluation point; SNES phlexcondensed forms R v0 for its
+   right-hand side itself (PhlexFieldOperators' R). The evaluations for the energy and the outputs form none. It enters every
    velocity block: the fixed body's Jvv = shift Mv + R, the floating body's shells (shift + Bvv) Mv + R, and the
    preconditioners' condensed operator Sv = shift Mv + K / shift + R (flexible_dynamics.c). With the implicit
    midpoint rule the power balance H_{n+1} - H_n = dt (P - v_m^T R v_m) holds to solver tolerance. */
@@ -26,7 +27,7 @@ static PetscErrorCode FlexDissipation(PhlexPart part, PetscReal *D)
   PhlexFlexible b = (PhlexFlexible)part->data;
 
   PetscFunctionBeginUser;
-  PetscCheck(b->diss_valid, b->comm, PETSC_ERR_ORDER, "body %s: the dissipated power was asked for before an evaluation", b->name);
+  PetscCall(PhlexFlexibleDampingForce(part));
   PetscCall(MPIU_Allreduce(&b->diss_loc, D, 1, MPIU_REAL, MPI_SUM, b->comm));
   PetscFunctionReturn(0);
 }
@@ -76,29 +77,48 @@ PetscErrorCode PhlexFlexibleDampingSetUp(PhlexPart part)
   if (!b->damped || b->Rd) PetscFunctionReturn(0);
   PetscCall(PhlexFlexibleAssembleDamping(b, part->units, &Rs));
   PetscCall(MatConvert(Rs, MATAIJ, MAT_INITIAL_MATRIX, &b->Rd));
-  PetscCall(MatDestroy(&Rs));
+  b->Rsb = Rs;
   PetscCall(MatSetOption(b->Rd, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(PetscObjectSetName((PetscObject)b->Rd, "structural damping"));
-  PetscCall(MatCreateVecs(b->Rd, &b->rv, NULL));
+  PetscCall(MatCreateVecs(b->Rd, &b->rv, &b->veval));
   PetscFunctionReturn(0);
 }
 
 /*@C
-  PhlexFlexibleDampingForce - R v at the evaluated state (kept in b->rv) and this process's part of v^T R v
+  PhlexFlexibleDampingEvaluate - keeps the evaluated state's velocity (a copy: the product R v is formed only when a
+  residual or the dissipated power asks for it, not for the evaluations of the energy and the outputs)
 
   Collective
 @*/
-PetscErrorCode PhlexFlexibleDampingForce(PhlexPart part, Vec v)
+PetscErrorCode PhlexFlexibleDampingEvaluate(PhlexPart part, Vec v)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
 
   PetscFunctionBeginUser;
-  b->diss_valid = PETSC_FALSE;
   if (!b->damped) PetscFunctionReturn(0);
   PetscCall(PhlexFlexibleDampingSetUp(part));
-  PetscCall(MatMult(b->Rd, v, b->rv));
-  PetscCall(PhlexLocalDot(b->rv, v, &b->diss_loc));
-  b->diss_valid = PETSC_TRUE;
+  PetscCall(VecCopy(v, b->veval));
+  b->evaluated = PETSC_TRUE;
+  b->rv_valid  = PETSC_FALSE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleDampingForce - R v at the evaluated state (b->rv) and this process's part of v^T R v, formed once per
+  evaluation
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleDampingForce(PhlexPart part)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCheck(b->evaluated, b->comm, PETSC_ERR_ORDER, "body %s: its damping force was asked for before an evaluation", b->name);
+  if (b->rv_valid) PetscFunctionReturn(0);
+  PetscCall(MatMult(b->Rsb, b->veval, b->rv));
+  PetscCall(PhlexLocalDot(b->rv, b->veval, &b->diss_loc));
+  b->rv_valid = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
 
@@ -124,6 +144,8 @@ PetscErrorCode PhlexFlexibleDampingDestroy(PhlexFlexible b)
 {
   PetscFunctionBeginUser;
   PetscCall(MatDestroy(&b->Rd));
+  PetscCall(MatDestroy(&b->Rsb));
   PetscCall(VecDestroy(&b->rv));
+  PetscCall(VecDestroy(&b->veval));
   PetscFunctionReturn(0);
 }

@@ -397,12 +397,7 @@ static PetscErrorCode FlexEvaluate(PhlexPart part, PetscReal t, const PhlexPartV
     PetscCall(PhlexFrameEvaluateEnd(&b->frame, X->q, qd, &b->fs));
   }
   PetscCall(ExternalLoads(part, t, X));
-  if (b->damped) {
-    /* structural damping R v (flexible_damping.c): a fixed body's load b - R v, so that the residual and the condensed
-       stage's right-hand side (SNES phlexcondensed: ops.load) both take it; a floating body's residual adds it */
-    PetscCall(PhlexFlexibleDampingForce(part, X->v));
-    if (!b->floating) PetscCall(VecAXPY(b->load, -1.0, b->rv));
-  }
+  if (b->damped) PetscCall(PhlexFlexibleDampingEvaluate(part, X->v)); /* R v formed when asked for (flexible_damping.c) */
   PetscCall(PortOutputs(part, X, PETSC_FALSE));
   PetscFunctionReturn(0);
 }
@@ -442,6 +437,11 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
   }
   if (!b->floating) {
     PetscCall(VecAXPY(F->v, -1.0, b->load));
+    if (b->damped) {
+      /* + R v (flexible_damping.c) */
+      PetscCall(PhlexFlexibleDampingForce(part));
+      PetscCall(VecAXPY(F->v, 1.0, b->rv));
+    }
     if (b->spinning) {
       /* the hub's uniform spin: + Cor v + Cen (x - c + u) (flexible_spin.c) */
       PetscCall(MatMultAdd(b->Cor, X->v, F->v, F->v));
@@ -452,7 +452,11 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
   }
   PetscCall(PetscLogEventBegin(PHLEX_FloatResidual, 0, 0, 0, 0));
   PetscCall(VecAXPY(F->v, -1.0, b->fs.bext));
-  if (b->damped) PetscCall(VecAXPY(F->v, 1.0, b->rv)); /* + R v_f: the elastic rows only, the frame's rows undamped */
+  if (b->damped) {
+    /* + R v_f: the elastic rows only, the frame's rows undamped */
+    PetscCall(PhlexFlexibleDampingForce(part));
+    PetscCall(VecAXPY(F->v, 1.0, b->rv));
+  }
   PetscCall(PhlexFrameResidual(&b->frame, &b->fs, X->u, X->v, b->ud, F->v, F->q));
   if (b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
     /* the multipliers of int rho v = 0, int rho (x - P) x v = 0 enter through the transposed map (paper Section 5:
@@ -548,7 +552,7 @@ static PetscErrorCode MatMult_Avv(Mat A, Vec x, Vec y)
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &b));
   PetscCall(NodeMassMult(b, b->shift, b->Bvv, x, y));
-  if (b->Rd) PetscCall(MatMultAdd(b->Rd, x, y, y)); /* structural damping */
+  if (b->Rsb) PetscCall(MatMultAdd(b->Rsb, x, y, y)); /* structural damping */
   PetscFunctionReturn(0);
 }
 
@@ -562,7 +566,7 @@ static PetscErrorCode MatMult_Avc(Mat A, Vec x, Vec y)
   PetscCall(MatShellGetContext(A, &b));
   for (PetscInt k = 0; k < 9; k++) B[k] = b->Bvv[k] + b->Bvu[k] / b->shift;
   PetscCall(NodeMassMult(b, b->shift, B, x, y));
-  if (b->Rd) PetscCall(MatMultAdd(b->Rd, x, y, y)); /* structural damping */
+  if (b->Rsb) PetscCall(MatMultAdd(b->Rsb, x, y, y)); /* structural damping */
   PetscFunctionReturn(0);
 }
 
@@ -698,6 +702,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->M         = b->Mvaij;
   ops->K         = b->Kaij;
   ops->load      = b->floating ? NULL : b->load;
+  ops->R         = b->Rsb;
   PetscFunctionReturn(0);
 }
 
