@@ -21,6 +21,8 @@ typedef struct {
   char      region[PHLEX_NAME_LEN]; /* physical volume name, empty for the whole body */
   PetscInt  tag;                    /* "Cell Sets" value, -1 for the whole body */
   PetscReal youngs_modulus, poissons_ratio, density;
+  PetscReal viscosity; /* Kelvin-Voigt viscous modulus eta [Pa s]: viscous stress (eta / E) D eps(v), D the elastic
+                          moduli (the viscous tensor has the elastic Poisson's ratio); 0: none */
 } PhlexMaterial;
 
 /* A port of a flexible body: a named boundary surface. Its wrench (force F, moment T about the patch centroid c) is
@@ -286,6 +288,18 @@ struct _p_PhlexFlexible {
   Vec       fcen, fcen1; /* Cen (x - c): the centrifugal load at the drawn geometry; at 1 rad/s */
   KSP       steady_ksp; /* the steady spin's Newton (linearised analysis) */
 
+  /* structural damping (flexible_damping.c): R = alpha Mv + sum over regions of (beta E + eta) / E K_region on the
+     velocity rows (symmetric positive semi-definite), assembled once */
+  PetscReal rayleigh_alpha, rayleigh_beta; /* SI: 1/s, s */
+  PetscBool damped;                        /* alpha, beta or a viscosity > 0 */
+  Mat       Rd;                            /* R (AIJ, non-dimensional: velocity rows in time T), NULL until needed: the
+                                              sums into the condensed operator and the fixed body's Jvv */
+  Mat       Rsb;                           /* R as assembled (SBAIJ, 3x3 blocks, upper triangle): the products R v, about
+                                              half the time of the AIJ copy's */
+  Vec       veval, rv;                     /* the evaluated state's velocity (a copy), R veval (formed when asked for) */
+  PetscReal diss_loc;                      /* this process's part of veval^T R veval */
+  PetscBool evaluated, rv_valid;           /* veval holds the evaluated state's v; rv and diss_loc are its */
+
   /* output */
   void *writer, *rigid_csv, *ports_csv;
 
@@ -328,6 +342,15 @@ PETSC_INTERN PetscErrorCode PhlexSurfaceIntegrate(PhlexFlexible, PetscInt, Petsc
 PETSC_INTERN PetscErrorCode PhlexSurfaceMoments(PhlexFlexible, PetscInt, PetscReal *, PetscReal[3], PetscReal[9]);
 PETSC_INTERN PetscErrorCode PhlexFlexPortSetUp(PhlexFlexible, PhlexFlexPort *, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexFlexPortDestroy(PhlexFlexPort *);
+
+/* flexible_damping.c */
+PETSC_INTERN PetscErrorCode PhlexFlexibleAssembleDamping(PhlexFlexible, const PhlexUnits *, Mat *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingSetFromOptions(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingSetUp(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingEvaluate(PhlexPart, Vec);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingForce(PhlexPart);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingView(PhlexFlexible, PetscViewer);
+PETSC_INTERN PetscErrorCode PhlexFlexibleDampingDestroy(PhlexFlexible);
 
 /* flexible_ic.c */
 PETSC_INTERN PetscErrorCode PhlexFlexibleICSetFromOptions(PhlexFlexible, PhlexIC *, const char[], PetscInt);

@@ -77,6 +77,8 @@ typedef struct {
   Mat      Gyro;     /* velocity rows' velocity terms besides shift Mv: the Coriolis matrix of a spin (AIJ, skew), or NULL */
   PetscBool inexact_schur; /* Sv is not the exact Schur complement of u and Sigma (spin, stiffening): a Krylov method is needed */
   Vec      load;     /* a fixed body's applied load b of the velocity rows at the last evaluation (T Mv v' + G^T Sigma = b), or NULL */
+  Mat      R;        /* structural damping R of the velocity rows (T Mv v' + G^T Sigma + R v = b; symmetric positive
+                        semi-definite, constant), or NULL: undamped */
 } PhlexFieldOperators;
 
 /* Reference scales a part suggests before set-up (the scene takes the largest of each). */

@@ -5,6 +5,8 @@
 #ifndef PHLEX_PRIVATE_REDUCED_H
 #define PHLEX_PRIVATE_REDUCED_H
 
+#define PHLEX_MAX_MODAL_RATIOS 256 /* -modal_damping_ratios values */
+
 typedef enum {
   PHLEX_REDUCTION_FREE_INTERFACE, /* the body's own normal modes (clamped at its frame patch, or free on mean axes)
                                      plus the static attachment modes of its ports */

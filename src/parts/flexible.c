@@ -18,6 +18,7 @@ static PetscErrorCode MaterialCheck(PhlexFlexible b, const PhlexMaterial *m, con
   PetscCheck(m->youngs_modulus > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: Young's modulus must be positive: -%syoungs_modulus %g", b->name, prefix, (double)m->youngs_modulus);
   PetscCheck(m->poissons_ratio > -1.0 && m->poissons_ratio < 0.5, b->comm, PETSC_ERR_USER_INPUT, "body %s: Poisson's ratio must lie in (-1, 0.5): -%spoissons_ratio %g", b->name, prefix, (double)m->poissons_ratio);
   PetscCheck(m->density > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: density must be positive: -%sdensity %g", b->name, prefix, (double)m->density);
+  PetscCheck(m->viscosity >= 0 && !PetscIsInfOrNanReal(m->viscosity), b->comm, PETSC_ERR_USER_INPUT, "body %s: the Kelvin-Voigt viscosity must be >= 0 [Pa s] (a negative one feeds energy in): -%sviscosity %g", b->name, prefix, (double)m->viscosity);
   PetscFunctionReturn(0);
 }
 
@@ -30,6 +31,7 @@ static PetscErrorCode MaterialSetFromOptions(PhlexFlexible b, PhlexMaterial *m, 
   PetscCall(PetscOptionsReal("-youngs_modulus", "Young's modulus E [Pa]", "PhlexFlexibleSetFromOptions", m->youngs_modulus, &m->youngs_modulus, &fE));
   PetscCall(PetscOptionsReal("-poissons_ratio", "Poisson's ratio nu [-]", "PhlexFlexibleSetFromOptions", m->poissons_ratio, &m->poissons_ratio, &fn));
   PetscCall(PetscOptionsReal("-density", "Mass density rho [kg/m^3]", "PhlexFlexibleSetFromOptions", m->density, &m->density, &fr));
+  PetscCall(PetscOptionsReal("-viscosity", "Kelvin-Voigt viscous modulus eta: a viscous stress (eta/E) D eps(v), the viscous moduli proportional to the elastic ones (damping ratio eta w/(2 E) of a mode of pulsation w); 0: none [Pa s]", "PhlexFlexibleSetFromOptions", m->viscosity, &m->viscosity, NULL));
   PetscOptionsEnd();
   PetscCheck(fE, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%syoungs_modulus [Pa]", b->name, prefix);
   PetscCheck(fn, b->comm, PETSC_ERR_USER_INPUT, "body %s: missing material option -%spoissons_ratio [-]", b->name, prefix);
@@ -188,6 +190,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
     PetscCall(PhlexProfileCreate(b->comm, prefix, what, &b->body_force_profile));
     PetscCall(PhlexProfileSetFromOptions(b->body_force_profile));
   }
+  PetscCall(PhlexFlexibleDampingSetFromOptions(part));
   PetscCall(PhlexFlexibleICSetFromOptions(b, &b->ic_velocity, "velocity", 3));
   PetscCall(PhlexFlexibleICSetFromOptions(b, &b->ic_displacement, "displacement", 3));
   PetscCall(PhlexFlexibleICSetFromOptions(b, &b->ic_stress, "stress", 6));
@@ -389,6 +392,7 @@ static PetscErrorCode FlexView(PhlexPart part, PetscViewer viewer)
     char                 E[32], nu[32], rho[32];
     PetscCall(PetscViewerASCIIPrintf(viewer, "material %s: E = %s Pa, nu = %s, rho = %s kg/m^3\n", mat->region[0] ? mat->region : "(whole body)", PhlexFormatReal(mat->youngs_modulus, E, sizeof(E)), PhlexFormatReal(mat->poissons_ratio, nu, sizeof(nu)), PhlexFormatReal(mat->density, rho, sizeof(rho))));
   }
+  PetscCall(PhlexFlexibleDampingView(b, viewer));
   for (PetscInt p = 0; p < b->nports; p++) {
     const PhlexFlexPort *port = &b->ports[p];
     char                 load[512];
@@ -433,6 +437,7 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(PhlexFlexibleStressMapsDestroy(b));
   PetscCall(PhlexFlexibleStiffeningDestroy(b));
   PetscCall(PhlexFlexibleSpinDestroy(b));
+  PetscCall(PhlexFlexibleDampingDestroy(b));
   PetscCall(PhlexFlexibleDestroyFE(b));
   PetscCall(PetscFree(part->data));
   PetscFunctionReturn(0);

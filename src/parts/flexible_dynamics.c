@@ -397,6 +397,7 @@ static PetscErrorCode FlexEvaluate(PhlexPart part, PetscReal t, const PhlexPartV
     PetscCall(PhlexFrameEvaluateEnd(&b->frame, X->q, qd, &b->fs));
   }
   PetscCall(ExternalLoads(part, t, X));
+  if (b->damped) PetscCall(PhlexFlexibleDampingEvaluate(part, X->v)); /* R v formed when asked for (flexible_damping.c) */
   PetscCall(PortOutputs(part, X, PETSC_FALSE));
   PetscFunctionReturn(0);
 }
@@ -436,6 +437,11 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
   }
   if (!b->floating) {
     PetscCall(VecAXPY(F->v, -1.0, b->load));
+    if (b->damped) {
+      /* + R v (flexible_damping.c) */
+      PetscCall(PhlexFlexibleDampingForce(part));
+      PetscCall(VecAXPY(F->v, 1.0, b->rv));
+    }
     if (b->spinning) {
       /* the hub's uniform spin: + Cor v + Cen (x - c + u) (flexible_spin.c) */
       PetscCall(MatMultAdd(b->Cor, X->v, F->v, F->v));
@@ -446,6 +452,11 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
   }
   PetscCall(PetscLogEventBegin(PHLEX_FloatResidual, 0, 0, 0, 0));
   PetscCall(VecAXPY(F->v, -1.0, b->fs.bext));
+  if (b->damped) {
+    /* + R v_f: the elastic rows only, the frame's rows undamped */
+    PetscCall(PhlexFlexibleDampingForce(part));
+    PetscCall(VecAXPY(F->v, 1.0, b->rv));
+  }
   PetscCall(PhlexFrameResidual(&b->frame, &b->fs, X->u, X->v, b->ud, F->v, F->q));
   if (b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
     /* the multipliers of int rho v = 0, int rho (x - P) x v = 0 enter through the transposed map (paper Section 5:
@@ -541,6 +552,7 @@ static PetscErrorCode MatMult_Avv(Mat A, Vec x, Vec y)
   PetscFunctionBeginUser;
   PetscCall(MatShellGetContext(A, &b));
   PetscCall(NodeMassMult(b, b->shift, b->Bvv, x, y));
+  if (b->Rsb) PetscCall(MatMultAdd(b->Rsb, x, y, y)); /* structural damping */
   PetscFunctionReturn(0);
 }
 
@@ -554,6 +566,7 @@ static PetscErrorCode MatMult_Avc(Mat A, Vec x, Vec y)
   PetscCall(MatShellGetContext(A, &b));
   for (PetscInt k = 0; k < 9; k++) B[k] = b->Bvv[k] + b->Bvu[k] / b->shift;
   PetscCall(NodeMassMult(b, b->shift, B, x, y));
+  if (b->Rsb) PetscCall(MatMultAdd(b->Rsb, x, y, y)); /* structural damping */
   PetscFunctionReturn(0);
 }
 
@@ -628,8 +641,11 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
     PetscCall(MatSetNearNullSpace(b->Sv, nsp));
     PetscCall(MatNullSpaceDestroy(&nsp));
     PetscCall(PetscObjectSetName((PetscObject)b->Sv, "condensed velocity operator"));
+    PetscCall(PhlexFlexibleDampingSetUp(part)); /* R, in Sv and Jvv below and at every new shift (FlexJacobian) */
     if (!b->floating) {
-      PetscCall(MatDuplicate(b->Mvaij, MAT_COPY_VALUES, &b->Jvv));
+      /* shift Mv, or shift Mv + R on Sv's pattern (R has K's) */
+      if (b->damped) PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, &b->Jvv));
+      else PetscCall(MatDuplicate(b->Mvaij, MAT_COPY_VALUES, &b->Jvv));
     } else {
       PetscCall(PhlexMatCreateShell(b->comm, n, n, N, N, b, MatMult_Avv, &b->Jvv));
       PetscCall(PhlexMatCreateShell(b->comm, n, n, N, N, b, MatMult_Avu, &b->Jvu));
@@ -686,6 +702,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->M         = b->Mvaij;
   ops->K         = b->Kaij;
   ops->load      = b->floating ? NULL : b->load;
+  ops->R         = b->Rsb;
   PetscFunctionReturn(0);
 }
 
@@ -746,6 +763,7 @@ static PetscErrorCode RateOperator(PhlexFlexible b, PetscReal shift, const Petsc
   }
   PetscCall(MatAssemblyBegin(b->Sv, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(b->Sv, MAT_FINAL_ASSEMBLY));
+  if (b->damped) PetscCall(MatAXPY(b->Sv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN)); /* structural damping */
   PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_FALSE));
   PetscCall(MatSetOption(b->Sv, MAT_SYMMETRIC, PETSC_FALSE));
   PetscFunctionReturn(0);
@@ -791,9 +809,10 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   if (new_shift) {
     b->shift = shift;
     if (!b->floating) {
-      PetscCall(MatCopy(b->Mvaij, b->Jvv, b->spinning ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
+      PetscCall(MatCopy(b->Mvaij, b->Jvv, (b->spinning || b->damped) ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
       PetscCall(MatScale(b->Jvv, shift));
       if (b->spinning) PetscCall(MatAXPY(b->Jvv, 1.0, b->Cor, SUBSET_NONZERO_PATTERN));
+      if (b->damped) PetscCall(MatAXPY(b->Jvv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN));
       PetscCall(MatAssemblyBegin(b->Jvv, MAT_FINAL_ASSEMBLY));
       PetscCall(MatAssemblyEnd(b->Jvv, MAT_FINAL_ASSEMBLY));
     }
@@ -812,6 +831,7 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
     PetscCall(MatScale(b->Sv, 1.0 / shift));
     PetscCall(MatAXPY(b->Sv, shift, b->Mvs ? b->Mvs : b->Mvaij, b->Mvs ? SAME_NONZERO_PATTERN : SUBSET_NONZERO_PATTERN));
     if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cor, SAME_NONZERO_PATTERN));
+    if (b->damped) PetscCall(MatAXPY(b->Sv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN)); /* shift Mv + K / shift + R */
   }
   if (converted) {
     PetscCall(MatDestroy(&b->Mvaij));

@@ -398,6 +398,54 @@ static PetscErrorCode AssembleVelocityOperators(PhlexFlexible b, const PhlexUnit
 }
 
 /*@C
+  PhlexFlexibleAssembleDamping - assembles the body's structural damping matrix on its velocity field (non-dimensional,
+  the velocity rows in time T), SBAIJ with the stiffness's pattern
+
+  Collective
+
+  Input Parameters:
++ b - the flexible body (its spaces and cells set up)
+- u - the reference scales
+
+  Output Parameter:
+. R - alpha T Mv + sum over the cells of K_e with the Young's modulus (beta E + eta) / (E_ref T) (eta the cell's
+      Kelvin-Voigt viscosity, the elastic Poisson's ratio): symmetric positive semi-definite
+
+  Notes:
+  The viscous stress Sigma_v = (beta + eta / E) D eps(v) adds G_v^T Sigma_v to the momentum rows of eq. (ph-mixed);
+  eliminated cell by cell like the elastic stress, it is R_K v with R_K the stiffness of the viscous moduli (the
+  element stiffness is linear in E). Rayleigh's alpha Mv acts on the velocity field, which for a floating body is the
+  elastic velocity relative to its frame: the frame's rows (its momenta) are untouched.
+@*/
+PetscErrorCode PhlexFlexibleAssembleDamping(PhlexFlexible b, const PhlexUnits *u, Mat *R)
+{
+  const PhlexElementReferenceIntegrals *ref = &b->ref;
+  const PetscInt                        nv = b->nb_v, nn = nv / 3;
+  PetscReal                            *Me, *Ke;
+
+  PetscFunctionBeginUser;
+  PetscCall(CreateVelocityMatrix(b, R));
+  PetscCall(PetscMalloc2(nv * nv, &Me, nv * nv, &Ke));
+  for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
+    const PetscReal     *g   = &b->cell_geom[10 * c];
+    const PhlexMaterial *mat = &b->materials[b->cell_material[c]];
+    const PetscReal      Ev  = (b->rayleigh_beta * mat->youngs_modulus + mat->viscosity) / (u->modulus * u->time);
+    PetscInt             nodes[PHLEX_MAX_NODES];
+
+    PhlexElementMass(ref, b->rayleigh_alpha * u->time * mat->density / u->density, g[0], Me);
+    PhlexElementStiffness(ref, Ev, mat->poissons_ratio, g[0], &g[1], Ke);
+    for (PetscInt k = 0; k < 9 * nn * nn; k++) Ke[k] += Me[k];
+    CellNodeIndices(b, c, nodes);
+    PetscCall(MatSetValuesBlocked(*R, nn, nodes, nn, nodes, Ke, ADD_VALUES));
+  }
+  PetscCall(PetscFree2(Me, Ke));
+  PetscCall(MatAssemblyBegin(*R, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*R, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscObjectSetName((PetscObject)*R, "structural damping"));
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexFlexibleSetUpLocalDofs - the local-vector offsets of every local cell's velocity closure (the order of
   cell_vdofs; a constrained dof's offset is that of its place in the local vector), once
 

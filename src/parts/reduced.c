@@ -48,6 +48,12 @@ typedef struct {
   PhlexReduction     red;   /* the kind of basis and its parameters (r->type, r->nmodes repeated in it) */
   PetscReal          view_transfer[64], expect_moments_rtol; /* self-checks of the transfer function */
   PetscInt           nview_transfer;
+  /* structural damping (issue 45): per-mode damping ratios on the eigenmodes of (Kr, Mr) and Rayleigh alpha Mr +
+     beta Kr on the elastic coordinates; Rr (m x m, row-major, non-dimensional) NULL when undamped */
+  PetscReal          modal_zeta[PHLEX_MAX_MODAL_RATIOS];
+  PetscInt           nmodal_zeta;
+  PetscReal         *Rr;
+  PetscReal          diss; /* zeta^T Rr zeta at the evaluated state */
 } Reduced;
 
 /* ------------------------------------------------------------------------------------------------------------ */
@@ -58,7 +64,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   Reduced      *r = (Reduced *)part->data;
   PhlexFlexible b;
   PetscInt      type = 0;
-  PetscBool     set_held = PETSC_FALSE, set_full = PETSC_FALSE, set_modes = PETSC_FALSE, set_order = PETSC_FALSE, set_freq = PETSC_FALSE, set_view = PETSC_FALSE, set_fl = PETSC_FALSE;
+  PetscBool     set_zeta = PETSC_FALSE, set_held = PETSC_FALSE, set_full = PETSC_FALSE, set_modes = PETSC_FALSE, set_order = PETSC_FALSE, set_freq = PETSC_FALSE, set_view = PETSC_FALSE, set_fl = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   /* the full body reads its options under the same prefix: the scene of a reduced body is that of the full one */
@@ -76,7 +82,9 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   r->red.krylov_order        = 2;
   r->red.nfrequencies        = PHLEX_KRYLOV_MAX_FREQUENCIES;
   r->red.frequencies[0]      = 0.0;
+  r->nmodal_zeta             = PHLEX_MAX_MODAL_RATIOS;
   PetscOptionsBegin(part->comm, part->prefix, "Reduced body options", NULL);
+  PetscCall(PetscOptionsRealArray("-modal_damping_ratios", "Damping ratios zeta_1,zeta_2,... of the reduced body's modes (the eigenmodes of (Kr, Mr), lowest first; the modes beyond the list take its last value; >= 0, >= 1 over-damped), added to Rayleigh's -rayleigh_alpha, -rayleigh_beta [-]", "ReducedSetFromOptions", r->modal_zeta, &r->nmodal_zeta, &set_zeta));
   PetscCall(PetscOptionsString("-reduced_file", "Reduced body file (HDF5): read if it exists (refused if built for another body), else built and written; empty: built in memory at every run", "ReducedSetFromOptions", r->file, r->file, sizeof(r->file), NULL));
   PetscCall(PetscOptionsEList("-reduction", "Basis of the reduction: free_interface (the body's normal modes with its frame held, plus the static attachment modes of its ports), craig_bampton (the normal modes with its frame and its ports' rigid averages held, plus the static constraint modes of its ports), krylov (moment matching of the ports' transfer function: block Krylov spaces at -reduction_krylov_frequencies)", "ReducedSetFromOptions", PhlexReductionTypes, PHLEX_REDUCTION_NTYPES, PhlexReductionTypes[type], &type, NULL));
   PetscCall(PetscOptionsInt("-reduction_modes", "Normal modes in the basis (craig_bampton: fixed-interface modes; the static modes of the ports, six each, come in addition)", "ReducedSetFromOptions", r->nmodes, &r->nmodes, &set_modes));
@@ -89,6 +97,9 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscCall(PetscOptionsRealArray("-reduction_expect_full_frequencies", "Self-check: the full body's lowest frequencies with its frame held as the basis holds it (clamped at the frame patch, free on mean axes) [Hz]: the reduced ones must bound them from above (Rayleigh-Ritz) and, with free_interface, equal them for the normal modes in the basis; with craig_bampton lie below the held ones, which lie below the reduced ones 6 per port further (interlacing)", "ReducedSetFromOptions", r->expect_full, &r->nexpect_full, &set_full));
   PetscCall(PetscOptionsReal("-reduction_expect_rtol", "Relative tolerance of -reduction_expect_held_frequencies, and the slack of the bounds of -reduction_expect_full_frequencies", "ReducedSetFromOptions", r->expect_rtol, &r->expect_rtol, NULL));
   PetscOptionsEnd();
+  if (!set_zeta) r->nmodal_zeta = 0;
+  for (PetscInt i = 0; i < r->nmodal_zeta; i++) PetscCheck(r->modal_zeta[i] >= 0 && !PetscIsInfOrNanReal(r->modal_zeta[i]), part->comm, PETSC_ERR_USER_INPUT, "body %s: -%smodal_damping_ratios: ratio %" PetscInt_FMT " is %g, must be >= 0 (a negative one feeds energy in)", part->name, part->prefix, i + 1, (double)r->modal_zeta[i]);
+  PetscCheck(!set_zeta || r->nmodal_zeta > 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%smodal_damping_ratios needs at least one value", part->name, part->prefix);
   if (!set_held) r->nexpect_held = 0;
   if (!set_full) r->nexpect_full = 0;
   r->type = (PhlexReductionType)type;
@@ -110,6 +121,8 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscCheck(r->nmodes >= 0, part->comm, PETSC_ERR_USER_INPUT, "body %s: -%sreduction_modes must be >= 0, got %" PetscInt_FMT, part->name, part->prefix, r->nmodes);
   PetscCheck(b->floating || b->frame_patch[0], part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced fixed body needs the clamp of its frame (-%sframe_patch <surface>): a free fixed body has no reduced model", part->name, part->prefix);
   PetscCheck(!b->stiffening && !b->spinning, part->comm, PETSC_ERR_USER_INPUT, "body %s: a reduced body has no %s (its basis is that of the linear body at rest, and the stiffening would need the stress of every basis pair): use the full body (-%stype flexible)", part->name, b->stiffening ? "geometric stiffening (-geometric_stiffening)" : "prescribed spin (-spin)", part->prefix);
+  PetscCheck(b->materials[0].viscosity == 0 && (b->nmaterials < 2 || b->materials[1].viscosity == 0), part->comm, PETSC_ERR_SUP, "body %s: a reduced body takes no Kelvin-Voigt viscosity (-%sviscosity, -%sregion_<name>_viscosity): give its damping per mode (-%smodal_damping_ratios) or as Rayleigh's (-%srayleigh_alpha, -%srayleigh_beta), or use the full body (-%stype flexible)", part->name, part->prefix, part->prefix, part->prefix, part->prefix, part->prefix, part->prefix);
+  for (PetscInt k = 2; k < b->nmaterials; k++) PetscCheck(b->materials[k].viscosity == 0, part->comm, PETSC_ERR_SUP, "body %s: a reduced body takes no Kelvin-Voigt viscosity (-%sregion_%s_viscosity): give its damping per mode (-%smodal_damping_ratios) or as Rayleigh's (-%srayleigh_alpha, -%srayleigh_beta)", part->name, part->prefix, b->materials[k].region, part->prefix, part->prefix, part->prefix);
   {
     /* the elastic initial state is the basis's: a reduced body starts undeformed, its frame placed and moving as given */
     const PhlexIC *iv = &b->ic_velocity, *iu = &b->ic_displacement, *is = &b->ic_stress;
@@ -184,6 +197,63 @@ static PetscErrorCode ReducedExpectFrequencies(PhlexPart part, Reduced *r)
   PetscFunctionReturn(0);
 }
 
+/* the power its dampers dissipate at the evaluated state: zeta^T Rr zeta (the discrete unknowns are replicated) */
+static PetscErrorCode ReducedDissipation(PhlexPart part, PetscReal *D)
+{
+  PetscFunctionBeginUser;
+  *D = ((Reduced *)part->data)->diss;
+  PetscFunctionReturn(0);
+}
+
+/* Rr = Mr V diag(2 zeta_i w_i) V^T Mr + alpha T Mr + beta/T Kr (non-dimensional: the rows Mr zeta' in time T), V the
+   Mr-orthonormal eigenvectors of Kr V = Mr V diag(w_i^2), lowest first: symmetric positive semi-definite, each mode
+   of the undamped pencil damped with the ratio zeta_i + alpha/(2 w) + beta w/2; modes of zero frequency get no modal
+   term. NULL (and no dissipation op) when undamped: an undamped run is the same as before */
+static PetscErrorCode ReducedDampingSetUp(PhlexPart part, Reduced *r)
+{
+  const PetscInt  m = r->md.m;
+  const PetscReal T = part->units->time, alpha = r->fb->rayleigh_alpha, beta = r->fb->rayleigh_beta;
+  PetscBool       modal = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < r->nmodal_zeta; i++)
+    if (r->modal_zeta[i] > 0) modal = PETSC_TRUE;
+  if (!(modal || alpha > 0 || beta > 0) || !m) PetscFunctionReturn(0);
+  PetscCall(PetscCalloc1(m * m, &r->Rr));
+  for (PetscInt k = 0; k < m * m; k++) r->Rr[k] = alpha * T * r->md.Mr[k] + beta / T * r->md.Kr[k];
+  if (modal) {
+    PetscReal   *A, *B, *w, *W, *work, work1;
+    PetscBLASInt bn, lwork = -1, info, one = 1;
+    PetscCall(PetscBLASIntCast(m, &bn));
+    PetscCall(PetscMalloc4(m * m, &A, m * m, &B, m, &w, m * m, &W));
+    /* symmetric: row-major is column-major */
+    PetscCall(PetscArraycpy(A, r->md.Kr, m * m));
+    PetscCall(PetscArraycpy(B, r->md.Mr, m * m));
+    PetscCallBLAS("LAPACKsygv", LAPACKsygv_(&one, "V", "U", &bn, A, &bn, B, &bn, w, &work1, &lwork, &info));
+    PetscCall(PetscBLASIntCast((PetscInt)work1, &lwork));
+    PetscCall(PetscMalloc1(lwork, &work));
+    PetscCallBLAS("LAPACKsygv", LAPACKsygv_(&one, "V", "U", &bn, A, &bn, B, &bn, w, work, &lwork, &info));
+    PetscCall(PetscFree(work));
+    PetscCheck(!info, part->comm, PETSC_ERR_LIB, "body %s: the eigenmodes of the reduced pencil for its modal damping: LAPACK sygv info %d", part->name, (int)info);
+    /* W = Mr V (column j: Mr v_j), then Rr += sum_j d_j W_j W_j^T */
+    for (PetscInt i = 0; i < m; i++)
+      for (PetscInt j = 0; j < m; j++) {
+        PetscReal s = 0.0;
+        for (PetscInt k = 0; k < m; k++) s += r->md.Mr[m * i + k] * A[m * j + k];
+        W[m * j + i] = s;
+      }
+    for (PetscInt j = 0; j < m; j++) {
+      const PetscReal z = r->modal_zeta[PetscMin(j, r->nmodal_zeta - 1)], d = 2.0 * z * PetscSqrtReal(PetscMax(w[j], 0.0));
+      if (d == 0.0) continue;
+      for (PetscInt i = 0; i < m; i++)
+        for (PetscInt k = 0; k < m; k++) r->Rr[m * i + k] += d * W[m * j + i] * W[m * j + k];
+    }
+    PetscCall(PetscFree4(A, B, w, W));
+  }
+  part->ops.dissipation = ReducedDissipation;
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode ReducedSetUp(PhlexPart part)
 {
   Reduced      *r = (Reduced *)part->data;
@@ -222,6 +292,7 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
   }
   PetscCheck(r->md.nports == b->nports, part->comm, PETSC_ERR_PLIB, "body %s: the reduced model has %" PetscInt_FMT " ports, the body %" PetscInt_FMT, part->name, r->md.nports, b->nports);
   m = r->m      = r->md.m;
+  PetscCall(ReducedDampingSetUp(part, r));
   r->nports     = b->nports;
   PetscCall(ReducedExpectFrequencies(part, r));
   if (r->nview_transfer) PetscCall(PhlexReducedViewTransfer(r->full, &r->md, r->nview_transfer, r->view_transfer));
@@ -320,6 +391,15 @@ static PetscErrorCode ReducedView(PhlexPart part, PetscViewer viewer)
   PetscCall(ViewFrequencies(viewer, "reduced frequencies [Hz]:", r->m, r->md.lambda, u));
   if (r->type == PHLEX_REDUCTION_CRAIG_BAMPTON && r->nports) PetscCall(ViewFrequencies(viewer, "full body's frequencies with its ports held (the fixed-interface modes in the basis) [Hz]:", r->md.nnormal, r->md.lambda_full, u));
   else if (r->type != PHLEX_REDUCTION_KRYLOV) PetscCall(ViewFrequencies(viewer, "full body's frequencies of the normal modes in the basis [Hz]:", r->md.nnormal, r->md.lambda_full, u));
+  if (r->nmodal_zeta) {
+    char   list[1024] = "";
+    size_t n;
+    for (PetscInt i = 0; i < r->nmodal_zeta; i++) {
+      PetscCall(PetscStrlen(list, &n));
+      PetscCall(PetscSNPrintf(list + n, sizeof(list) - n, "%s%.6g", i ? ", " : "", (double)r->modal_zeta[i]));
+    }
+    PetscCall(PetscViewerASCIIPrintf(viewer, "modal damping ratios (modes of the reduced pencil, lowest first; the last for the modes beyond): %s\n", list));
+  }
   PetscCall(PetscViewerASCIIPopTab(viewer));
   PetscFunctionReturn(0);
 }
@@ -335,6 +415,7 @@ static PetscErrorCode ReducedDestroy(PhlexPart part)
   PetscCall(PetscFree2(r->etad, r->zetad));
   PetscCall(PetscFree3(r->Lb, r->Lu, r->Lv));
   PetscCall(PetscFree3(r->port_ext, r->port_y, r->port_ub));
+  PetscCall(PetscFree(r->Rr));
   PetscCall(PetscFree(part->data));
   PetscFunctionReturn(0);
 }
@@ -465,6 +546,11 @@ static PetscErrorCode ReducedEvaluate(PhlexPart part, PetscReal t, const PhlexPa
 
   PetscFunctionBeginUser;
   r->t_eval = t;
+  if (r->Rr) {
+    r->diss = 0.0;
+    for (PetscInt k = 0; k < m; k++)
+      for (PetscInt j = 0; j < m; j++) r->diss += zeta[k] * r->Rr[m * k + j] * zeta[j];
+  }
   for (PetscInt k = 0; k < m; k++) etad[k] = zetad[k] = 0.0;
   if (Xdot)
     for (PetscInt k = 0; k < m; k++) {
@@ -604,6 +690,8 @@ static PetscErrorCode ReducedResidual(PhlexPart part, PetscReal t, const PhlexPa
   for (PetscInt k = 0; k < m; k++) {
     PetscReal s = -g[k];
     for (PetscInt j = 0; j < m; j++) s += r->md.Mr[m * k + j] * T * Xdot->q[r->iz + j] + r->md.Kr[m * k + j] * eta[j];
+    if (r->Rr)
+      for (PetscInt j = 0; j < m; j++) s += r->Rr[m * k + j] * zeta[j]; /* structural damping */
     F->q[r->iz + k] = s;
   }
   if (r->floating) {
@@ -707,7 +795,7 @@ static PetscErrorCode ReducedJacobian(PhlexPart part, PetscReal shift, const Phl
         su += Bvu[j] * N[j];
       }
       Dq(iz + k, ie + i) = r->md.Kr[m * k + i] + su;
-      Dq(iz + k, iz + i) = shift * r->md.Mr[m * k + i] + sv;
+      Dq(iz + k, iz + i) = shift * r->md.Mr[m * k + i] + sv + (r->Rr ? r->Rr[m * k + i] : 0.0);
     }
   }
 #undef Dq

@@ -8,6 +8,7 @@
    With B = Ms^{-1} G (applied cell by cell: Ms is block diagonal per cell) and the
    predicted stress Sigma_p = Sigma0 + B v0 / s, eliminating u and Sigma and solving for the increment dv = v - v0:
        (s Mv + K / s) dv = b - G^T Sigma_p,                                             (the condensed right-hand side)
+   (with structural damping T Mv v' + G^T Sigma + R v = b: (s Mv + K / s + R) dv = b - G^T Sigma_p - R v0)
        Sigma = Sigma_p + B dv / s  (= Sigma0 + B v / s),   u = u0 + v / s.
    The factored operator s Mv + K / s is the exact preset's (each body's Sv, its K assembled by the elements); as on
    the generic path, its difference from G^T Ms^{-1} G (about 1e-11 relative on smooth fields) enters the increment
@@ -41,6 +42,7 @@ typedef struct {
   PhlexStressMaps maps; /* per body B = Ms^{-1} G and G^T, cell by cell (the parts' shells) */
   Vec         r;     /* the condensed right-hand side */
   Vec         sp;    /* stress field: Sigma_p */
+  Vec        *Rv;    /* per damped body: R v0 (NULL for an undamped one) */
   PetscReal   shift; /* non-dimensional shift of the operator last handed to the KSP (0: none) */
 } SNES_Condensed;
 
@@ -215,6 +217,12 @@ static PetscErrorCode SNESSetUp_Condensed(SNES snes)
   /* the step's products with B and G^T, cell by cell from the element structure (two passes): nothing assembled */
   PetscCall(PhlexSystemGetStressMaps(sys, "phlexcondensed", &c->maps));
   PetscCall(MatCreateVecs(sys->Jvs, &c->sp, &c->r)); /* stress columns, velocity rows */
+  PetscCall(PetscCalloc1(sys->nfparts, &c->Rv));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
+    if (ops.R) PetscCall(MatCreateVecs(ops.R, NULL, &c->Rv[i]));
+  }
   PetscCall(PetscLogEventEnd(PHLEX_CondensedSetUp, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }
@@ -286,6 +294,14 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
     PetscCall(VecGetSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
     PetscCall(VecAYPX(ri, -1.0, ops.load));
+    if (ops.R) {
+      /* structural damping: r = b - G^T Sigma_p - R v0, the operator holding R (T Mv v' + G^T Sigma + R v = b) */
+      Vec v0i;
+      PetscCall(VecGetSubVector(v0, sys->fis[PHLEX_FIELD_VELOCITY][i], &v0i));
+      PetscCall(MatMult(ops.R, v0i, c->Rv[i]));
+      PetscCall(VecRestoreSubVector(v0, sys->fis[PHLEX_FIELD_VELOCITY][i], &v0i));
+      PetscCall(VecAXPY(ri, -1.0, c->Rv[i]));
+    }
     PetscCall(VecRestoreSubVector(c->r, sys->fis[PHLEX_FIELD_VELOCITY][i], &ri));
   }
   /* dv: the condensed solve, straight into the stage's velocity block; v = v0 + dv */
@@ -320,6 +336,10 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   PetscFunctionBeginUser;
   PetscCall(KSPDestroy(&c->ksp));
   if (c->sys) PetscCall(PhlexSystemStressMapsDestroy(c->sys, &c->maps));
+  if (c->Rv) {
+    for (PetscInt i = 0; i < c->sys->nfparts; i++) PetscCall(VecDestroy(&c->Rv[i]));
+    PetscCall(PetscFree(c->Rv));
+  }
   PetscCall(VecDestroy(&c->r));
   PetscCall(VecDestroy(&c->sp));
   c->shift = 0.0;
