@@ -7,7 +7,18 @@
        c_k = s_k . Delta - g_k(t) = 0          (g = 0 for a workless joint; a prescribed motion otherwise)
    Its impulses Lambda_k are unknowns; their rates lambda_k are the multipliers. They enter the two parts through the
    same port distributions as wrenches, w_a = -T_a^T G S lambda on port a and w_b = T_b^T R_ab^T S lambda on port b, so
-   that w_a . y_a + w_b . y_b = lambda . (c + g): the interconnection is power preserving (lossless for g = 0). */
+   that w_a . y_a + w_b . y_b = lambda . (c + g): the interconnection is power preserving (lossless for g = 0).
+
+   Force elements (issue 45): a joint may also have ne compliant rows s_i (after its nc constraint rows), each a
+   small pH system with a state e_i (elongation, angle, relative displacement or rotation; unknown kind
+   PHLEX_DOF_ELEMENT) and a force impulse (kind PHLEX_DOF_ELEMENT_FORCE) whose rate lambda_i acts on the ports like a
+   multiplier:
+       e_i'      = s_i . Delta                              (the element's state follows its ports)
+       lambda_i  = -(K e + C S_e^T Delta)_i                 (the element's force on b along s_i)
+   stored energy V = 1/2 e^T K e, dissipated power D = (S_e^T Delta)^T C (S_e^T Delta) >= 0 (K, C symmetric
+   positive semi-definite). With the implicit midpoint rule V_{n+1} - V_n = dt e_mid^T K e' exactly, so the
+   balance H_{n+1} - H_n = dt (P - D) holds to solver tolerance with V in H. The unknowns of a joint: nc constraint
+   impulses, ne force impulses, ne states (qoff, qoff + nc, qoff + nc + ne). */
 #ifndef PHLEX_PRIVATE_JOINT_H
 #define PHLEX_PRIVATE_JOINT_H
 
@@ -19,7 +30,9 @@ typedef enum {
   PHLEX_JOINT_CYLINDRICAL,
   PHLEX_JOINT_UNIVERSAL,
   PHLEX_JOINT_PLANAR,
-  PHLEX_JOINT_PRESCRIBED
+  PHLEX_JOINT_PRESCRIBED,
+  PHLEX_JOINT_SPRING_DAMPER, /* force element: a translational spring-damper between the two port points */
+  PHLEX_JOINT_BUSHING        /* force element: six compliant rows (6 x 6 stiffness and damping in the joint frame) */
 } PhlexJointType;
 PETSC_EXTERN const char *const PhlexJointTypes[];
 
@@ -29,6 +42,8 @@ typedef enum {
   PHLEX_ROW_R1, PHLEX_ROW_R2, PHLEX_ROW_R3, /* rotation about e1, e2, e3 */
   PHLEX_ROW_CROSS                           /* universal: rotation about e_a x e_b (both axes rotate with their bodies) */
 } PhlexJointRow;
+
+#define PHLEX_JOINT_MAX_ROWS 13 /* 7 constraint rows and 6 element rows */
 
 typedef struct {
   char      spec[2 * PHLEX_NAME_LEN + 2]; /* "body:port" or "ground" as given */
@@ -80,8 +95,25 @@ struct _p_PhlexJoint {
   /* evaluated */
   PetscReal ya[6], yb[6]; /* port outputs moved to the joint point (body frames) */
   PetscReal Ra[9], Rb[9], Rab[9], G[9]; /* G = R_a^T R_a (the identity but at a step's midpoint) */
-  PetscReal lambda[7];
+  PetscReal lambda[PHLEX_JOINT_MAX_ROWS]; /* constraint multipliers, then the elements' forces */
   PetscReal c[7];
+
+  /* force elements: compliant rows (non-dimensional K, C: ne x ne, row-major, in the element rows' order) */
+  PetscInt      ne;
+  PhlexJointRow erow[6];
+  char          erowname[6][8];
+  PetscReal     Ksi[36], Csi[36];       /* bushing: the matrices as given (SI, rows/columns t1 t2 t3 r1 r2 r3) */
+  PetscBool     Kgiven, Cgiven;
+  PetscReal     stiffness, damping;     /* spring-damper (N/m, N s/m) or rotational (N m/rad, N m s/rad), SI */
+  PetscBool     rot_element;            /* revolute, cylindrical: the free rotation is a spring-damper */
+  PetscReal     rest_length, rest_angle; /* spring-damper [m] (<0: the drawn length); rotational [rad] */
+  PetscReal     K[36], C[36];
+  PetscReal     e[6], edot[6];          /* evaluated: states and their rates (non-dimensional time) */
+  PetscReal     dissipated_work;        /* the energy the element dissipated so far (non-dimensional; the monitor) */
+  PetscInt      ntable;                 /* spring_damper: a force-elongation table (0: linear, K) */
+  PetscReal     table_e[64], table_f[64]; /* its points (SI as given; non-dimensional after set-up) */
+  PetscBool     dg;                     /* the table's force is the discrete gradient over the step (implicit midpoint) */
+  PetscReal     e_start[6];             /* the states at the step's start (the discrete gradient's e_n) */
 
   /* output */
   PetscViewer csv;
@@ -111,7 +143,12 @@ PETSC_INTERN PetscErrorCode PhlexJointRelativeMotion(PhlexJoint, const PhlexPart
 PETSC_INTERN PetscErrorCode PhlexJointRigidGradient(PhlexJoint, PetscReal *, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointDropRow(PhlexJoint, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointOutputOpen(PhlexJoint, PhlexOutput);
-PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
+PETSC_INTERN PetscInt       PhlexJointNumUnknowns(PhlexJoint);
+PETSC_INTERN PetscBool      PhlexJointDamped(PhlexJoint);
+PETSC_INTERN PetscErrorCode PhlexJointElementInitial(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *, PetscReal[6]);
+PETSC_INTERN PetscErrorCode PhlexJointElementEnergy(PhlexJoint, const PetscReal *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointElementStepStart(PhlexJoint, const PetscReal *, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexJointPower(PhlexJoint, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointSourcePower(PhlexJoint, PetscReal, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointDissipation(PhlexJoint, const PetscReal *, PetscReal *);

@@ -40,8 +40,16 @@ typedef enum {
   PHLEX_DOF_VELOCITY,        /* a frame's or point mass's velocity */
   PHLEX_DOF_IMPULSE,         /* a multiplier's impulse */
   PHLEX_DOF_ELASTIC,         /* an elastic coordinate (non-dimensional displacement) */
-  PHLEX_DOF_ELASTIC_VELOCITY /* its rate: a part's n-th elastic velocity is the rate of its n-th elastic coordinate */
+  PHLEX_DOF_ELASTIC_VELOCITY, /* its rate: a part's n-th elastic velocity is the rate of its n-th elastic coordinate */
+  PHLEX_DOF_ELEMENT,          /* a force element's state (elongation, angle): not a constraint, not a frame's motion */
+  PHLEX_DOF_ELEMENT_FORCE     /* a force element's force impulse: its rate is the element's force, like a multiplier's */
 } PhlexDofKind;
+
+/* the unknowns whose rate is a force on the ports (a multiplier or a force element's force) */
+static inline PetscBool PhlexDofIsImpulse(PhlexDofKind kind)
+{
+  return (kind == PHLEX_DOF_IMPULSE || kind == PHLEX_DOF_ELEMENT_FORCE) ? PETSC_TRUE : PETSC_FALSE;
+}
 
 /* Offsets of a moving frame's unknowns among a part's discrete unknowns (-1: absent): position r of the frame
    origin P (inertial), rotation R (row-wise, body to inertial), velocity v_P and angular velocity w (body frame). */

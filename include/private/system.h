@@ -97,6 +97,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemJointSides(PhlexSystem, PhlexJoint, Vec, 
 PETSC_INTERN PetscErrorCode PhlexSystemJointSidesRestore(PhlexSystem, PhlexJoint, Vec, PhlexPartVec[2]);
 PETSC_INTERN PetscErrorCode PhlexSystemEnergy(PhlexSystem, PetscReal, Vec, PetscReal *, PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexSystemUpdateJoints(PhlexSystem, Vec, PetscReal);
+PETSC_INTERN PetscErrorCode PhlexSystemInitElements(PhlexSystem, Vec);
 PETSC_INTERN PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConverged(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);
 PETSC_INTERN PetscErrorCode PhlexSystemSNESConvergedStage(SNES, PetscInt, PetscReal, PetscReal, PetscReal, SNESConvergedReason *, void *);

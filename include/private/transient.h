@@ -22,6 +22,7 @@ typedef struct {
   PetscReal   theta_value;
   PetscReal  *qprev, *lambda; /* discrete unknowns of the previous step, multipliers (step averages) */
   PetscReal  *jpower;         /* power through each joint over the step, with the scheme's quadrature */
+  PetscReal  *jdiss;          /* power each joint's force elements dissipated over the step (the same quadrature) */
   /* momenta of a free system, rotations */
   PetscBool   free_system;
   PetscReal   P0[3], L0[3], Pscale, Lscale, max_dP, max_dL, max_orth, max_defect;

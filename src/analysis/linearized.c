@@ -1139,6 +1139,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
   PetscCall(PetscTime(&t0));
   PetscCall(PhlexSystemCreateForScene(scene, &p.sys, &p.X));
+  for (PetscInt k = 0; k < p.sys->njoints; k++) PetscCheck(!p.sys->joints[k]->ne, scene->comm, PETSC_ERR_SUP, "linearized analysis: joint %s is a force element (%s); the linearised analysis does not take force elements yet (run a transient analysis)", p.sys->joints[k]->name, PhlexJointTypes[p.sys->joints[k]->type]);
   PetscCall(VecDuplicate(p.X, &p.Xdot));
   PetscCall(VecSet(p.Xdot, 0.0));
   PetscCall(BuildDiscreteMap(&p));

@@ -48,6 +48,7 @@ static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscRea
     *P += p;
     *D += d;
     m->jpower[k] += weight * p;
+    m->jdiss[k] += weight * d;
   }
   PetscFunctionReturn(0);
 }
@@ -72,7 +73,7 @@ static PetscErrorCode EnergyAndOutputs(MonitorContext *m, PetscInt step, PetscRe
     PhlexPartVec pv[2];
     PetscReal    gmax;
     PetscCall(PhlexSystemJointSides(sys, j, X, sys->q, pv));
-    PetscCall(PhlexJointOutputStep(j, t, m->lambda + j->qoff, m->jpower[k], &pv[0], &pv[1], &gmax));
+    PetscCall(PhlexJointOutputStep(j, t, m->lambda + j->qoff, m->jpower[k], m->jdiss[k], &pv[0], &pv[1], &gmax));
     PetscCall(PhlexSystemJointSidesRestore(sys, j, X, pv));
     m->max_gap = PetscMax(m->max_gap, gmax);
   }
@@ -188,7 +189,7 @@ static PetscErrorCode CheckStage(TSAdapt adapt, TS ts, PetscReal t, Vec Y, Petsc
     PetscCall(VecAXPBYPCZ(Xe, 1.0 / m->theta_value, 1.0 - 1.0 / m->theta_value, 0.0, Y, m->Xprev));
     PetscCall(PhlexSystemPostStep(sys, Xe, &defect));
     PetscCall(PhlexSystemGather(sys, Xe, sys->q));
-    for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dtn : 0.0;
+    for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = PhlexDofIsImpulse(sys->qkind[k]) ? (sys->q[k] - m->qprev[k]) / dtn : 0.0;
     PetscCall(InputPower(m, t, Y, 1.0, PETSC_TRUE, &P, &D));
     PetscCall(PhlexSystemEnergy(sys, m->tprev + dt, Xe, &kin, &strain, &pot));
     residual = kin + strain + pot - m->Hprev - dtn * (P - D);
@@ -217,6 +218,9 @@ static PetscErrorCode PreStep(TS ts)
   PetscCall(TSGetSolution(ts, &X));
   PetscCall(TSGetTimeStep(ts, &dt));
   PetscCall(PhlexSystemUpdateJoints(m->sys, X, dt));
+  /* the force elements' states at the step's start (a table spring's discrete gradient) */
+  PetscCall(PhlexSystemGather(m->sys, X, m->sys->q));
+  for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], m->sys->q, m->lossless_scheme));
   PetscFunctionReturn(0);
 }
 
@@ -278,7 +282,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   m->last_retry[0] = 0;
   m->snes_failures = 0;
   PetscCall(PetscLogEventBegin(PHLEX_MonitorEnergy, 0, 0, 0, 0));
-  for (PetscInt k = 0; k < sys->njoints; k++) m->jpower[k] = 0.0;
+  for (PetscInt k = 0; k < sys->njoints; k++) m->jpower[k] = m->jdiss[k] = 0.0;
   if (step == 0 && sys->njoints) {
     /* the joints' power at the consistent start */
     PetscReal P0, D0;
@@ -288,7 +292,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     dt = (t - m->tprev) / u->time;
     /* the multipliers of the step: (Lambda_{n+1} - Lambda_n)/dt */
     PetscCall(PhlexSystemGather(sys, X, sys->q));
-    for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - m->qprev[k]) / dt : 0.0;
+    for (PetscInt k = 0; k < sys->nq; k++) m->lambda[k] = PhlexDofIsImpulse(sys->qkind[k]) ? (sys->q[k] - m->qprev[k]) / dt : 0.0;
     if (m->theta && !m->endpoint) {
       PetscObjectState state;
       PetscCheck(m->have_stage, m->scene->comm, PETSC_ERR_PLIB, "step %" PetscInt_FMT ": the theta method's step has no stage", step);
@@ -310,6 +314,8 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
       dissipated = 0.5 * (D0 + D1);
     }
   }
+  /* the work each joint's force elements dissipated (its series reports it with the step) */
+  for (PetscInt k = 0; k < sys->njoints && step > 0; k++) sys->joints[k]->dissipated_work += dt * m->jdiss[k];
   fields = (step == 0 || (m->interval > 0 && step % m->interval == 0)) ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(EnergyAndOutputs(m, step, t, X, fields, &kin, &strain, &pot));
   if (fields) m->last_written = step;
@@ -680,10 +686,10 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       for (PetscInt k = 0; k < sys->nq; k++) {
         const PhlexDofKind kind = sys->qkind[k];
         /* elastic coordinates and their rates: the fields' absolute tolerance (a reduced body's share of the field) */
-        a[k] = kind == PHLEX_DOF_IMPULSE ? 1e300 : (kind == PHLEX_DOF_VELOCITY ? rtol * vchar : ((kind == PHLEX_DOF_ELASTIC || kind == PHLEX_DOF_ELASTIC_VELOCITY) ? atol : rtol));
+        a[k] = PhlexDofIsImpulse(kind) ? 1e300 : (kind == PHLEX_DOF_VELOCITY ? rtol * vchar : ((kind == PHLEX_DOF_ELASTIC || kind == PHLEX_DOF_ELASTIC_VELOCITY) ? atol : rtol));
       }
       PetscCall(PhlexSystemScatter(sys, a, vatol));
-      for (PetscInt k = 0; k < sys->nq; k++) a[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? 0.0 : rtol;
+      for (PetscInt k = 0; k < sys->nq; k++) a[k] = PhlexDofIsImpulse(sys->qkind[k]) ? 0.0 : rtol;
       PetscCall(PhlexSystemScatter(sys, a, vrtol));
       PetscCall(PetscFree(a));
     }
@@ -862,7 +868,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     /* with adaptive steps (BDF's default) the first step is shortened: then the run is not one step */
     if (!m.adaptive && tmax < PETSC_MAX_REAL && dt >= tmax && smax != 1) PetscCall(PetscFPrintf(scene->comm, PETSC_STDERR, "phlex: warning: -ts_dt %g s is not smaller than -ts_max_time %g s: the run is one step\n", (double)dt, (double)tmax));
   }
-  PetscCall(PetscMalloc3(PetscMax(sys->nq, 1), &m.qprev, PetscMax(sys->nq, 1), &m.lambda, PetscMax(sys->njoints, 1), &m.jpower));
+  PetscCall(PetscMalloc4(PetscMax(sys->nq, 1), &m.qprev, PetscMax(sys->nq, 1), &m.lambda, PetscMax(sys->njoints, 1), &m.jpower, PetscMax(sys->njoints, 1), &m.jdiss));
   for (PetscInt k = 0; k < sys->nq; k++) m.lambda[k] = 0.0;
   if (sys->use_aij) {
     /* the assembled operator from a first evaluation at the initial state */
@@ -886,6 +892,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   /* a mechanism starts consistent: loops closed, velocities on the constraints, multipliers solved (a restart
      continues a consistent state) */
   if (sys->njoints && !restarting) PetscCall(PhlexAssemblyClose(sys, 0.0, X, PETSC_TRUE, NULL));
+  if (sys->njoints && !restarting) PetscCall(PhlexSystemInitElements(sys, X)); /* the force elements' states from the closed configuration */
   if (sys->nq && !restarting) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
   /* the stages need neither the whole state's stress blocks nor the assembled G and Ms (the initial state did) */
   if (m.reduced || m.condensed) PetscCall(PhlexSystemReleaseJacobian(sys));
@@ -909,6 +916,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   /* a part with dampers: the summary and the monitor say what was dissipated */
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->ops.dissipation) m.dissipative = PETSC_TRUE;
+  for (PetscInt k = 0; k < sys->njoints; k++)
+    if (PhlexJointDamped(sys->joints[k])) m.dissipative = PETSC_TRUE;
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
   m.watch_balance   = o.watch_balance;
@@ -1045,7 +1054,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(VecDestroy(&m.Xmid));
   PetscCall(VecDestroy(&m.Xprev));
   PetscCall(VecDestroy(&m.Xstage));
-  PetscCall(PetscFree3(m.qprev, m.lambda, m.jpower));
+  PetscCall(PetscFree4(m.qprev, m.lambda, m.jpower, m.jdiss));
   PetscCall(VecDestroy(&X));
   PetscCall(TSDestroy(&ts));
   PetscCall(PhlexSystemDestroy(&sys));

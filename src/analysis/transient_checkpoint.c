@@ -98,6 +98,10 @@ static PetscErrorCode Fingerprint(MonitorContext *m, char **fingerprint, PetscRe
   for (PetscInt k = 0; k < sys->njoints; k++) {
     PetscCall(PetscStrlen(parts, &n));
     PetscCall(PetscSNPrintf(parts + n, len - n, " joint %s:%" PetscInt_FMT, sys->joints[k]->name, sys->joints[k]->nc));
+    if (sys->joints[k]->ne) {
+      PetscCall(PetscStrlen(parts, &n));
+      PetscCall(PetscSNPrintf(parts + n, len - n, "+%" PetscInt_FMT " elements", sys->joints[k]->ne));
+    }
   }
   units[0] = m->scene->units.length, units[1] = m->scene->units.density, units[2] = m->scene->units.modulus, units[3] = m->scene->units.mass;
   PetscFunctionReturn(0);
@@ -272,6 +276,14 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
   PetscCall(PhlexCheckpointWriteReals(v, "/state", "multipliers", n, m->lambda));
   PetscCheck(PackMonitor(m, mon) == CHECKPOINT_NMONITOR, comm, PETSC_ERR_PLIB, "the checkpoint's list of accumulators is out of date");
   PetscCall(PhlexCheckpointWriteReals(v, "/monitor", "accumulators", CHECKPOINT_NMONITOR, mon));
+  if (sys->njoints) {
+    /* the work each joint's force elements dissipated so far (its series continues it) */
+    PetscReal *w;
+    PetscCall(PetscMalloc1(sys->njoints, &w));
+    for (PetscInt k = 0; k < sys->njoints; k++) w[k] = sys->joints[k]->dissipated_work;
+    PetscCall(PhlexCheckpointWriteReals(v, "/monitor", "joint_dissipated_work", sys->njoints, w));
+    PetscCall(PetscFree(w));
+  }
   {
     /* SNES phlexreduced's last Newton contractions set the next stage's linear tolerances: a restart repeats them */
     SNES      snes;
@@ -440,6 +452,18 @@ PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, co
   PetscCall(PhlexCheckpointReadReals(v, "/state", "multipliers", nq, m->lambda));
   PetscCall(PhlexCheckpointReadReals(v, "/monitor", "accumulators", CHECKPOINT_NMONITOR, mon));
   UnpackMonitor(m, mon);
+  if (sys->njoints) {
+    /* absent from the checkpoints of earlier versions (no force elements then: zero) */
+    PetscBool has;
+    PetscCall(PetscViewerHDF5HasDataset(v, "/monitor/joint_dissipated_work", &has));
+    if (has) {
+      PetscReal *w;
+      PetscCall(PetscMalloc1(sys->njoints, &w));
+      PetscCall(PhlexCheckpointReadReals(v, "/monitor", "joint_dissipated_work", sys->njoints, w));
+      for (PetscInt k = 0; k < sys->njoints; k++) sys->joints[k]->dissipated_work = w[k];
+      PetscCall(PetscFree(w));
+    }
+  }
   {
     /* absent from the checkpoints of earlier versions: the first stage then solves every Newton step to the linear
        tolerance (the same solution to Newton's tolerance, not the same bytes) */

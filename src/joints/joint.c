@@ -4,9 +4,10 @@
    joint kinds differ only in the directions they constrain (joint_types.c). */
 #include <phlex_impl.h>
 
-const char *const PhlexJointTypes[] = {"fixed", "revolute", "spherical", "prismatic", "cylindrical", "universal", "planar", "prescribed", "PhlexJointType", "PHLEX_JOINT_", NULL};
+const char *const PhlexJointTypes[] = {"fixed", "revolute", "spherical", "prismatic", "cylindrical", "universal", "planar", "prescribed", "spring_damper", "bushing", "PhlexJointType", "PHLEX_JOINT_", NULL};
 
 PETSC_INTERN PetscErrorCode PhlexJointSelectRows(PhlexJoint);
+static PetscErrorCode Placements(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *, PetscReal[3], PetscReal[9]);
 
 /* ------------------------------------------------------------------------------------------------------------ */
 /* Small helpers                                                                                                 */
@@ -62,22 +63,88 @@ static PetscReal Dot6(const PetscReal a[6], const PetscReal b[6])
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
 }
 
-/* the direction (6-vector, a's body frame) of row k, and its change for a change dRab of R_ab (universal only) */
+/* the joint's rows with a force: its constraint rows, then its force elements' rows */
+static inline PetscInt NumRows(PhlexJoint j)
+{
+  return j->nc + j->ne;
+}
+
+/* A spring's force-elongation table (non-dimensional): f(e) piecewise linear through the points, extended linearly
+   beyond its ends; segment s of e (0 .. n-2) */
+static PetscInt TableSegment(PhlexJoint j, PetscReal e)
+{
+  PetscInt s = 0;
+  while (s < j->ntable - 2 && e > j->table_e[s + 1]) s++;
+  return s;
+}
+
+/* f(e) and its slope */
+static void TableForce(PhlexJoint j, PetscReal e, PetscReal *f, PetscReal *slope)
+{
+  const PetscInt  s = TableSegment(j, e);
+  const PetscReal k = (j->table_f[s + 1] - j->table_f[s]) / (j->table_e[s + 1] - j->table_e[s]);
+
+  *f = j->table_f[s] + k * (e - j->table_e[s]);
+  if (slope) *slope = k;
+}
+
+/* the antiderivative A(e) = int_{e_0}^{e} f (exact: f is linear on each segment) */
+static PetscReal TableAntiderivative(PhlexJoint j, PetscReal e)
+{
+  const PetscInt s = TableSegment(j, e);
+  PetscReal      A = 0.0, f;
+
+  for (PetscInt i = 0; i < s; i++) A += 0.5 * (j->table_f[i] + j->table_f[i + 1]) * (j->table_e[i + 1] - j->table_e[i]);
+  TableForce(j, e, &f, NULL);
+  return A + 0.5 * (j->table_f[s] + f) * (e - j->table_e[s]);
+}
+
+/* the spring's energy V(e) = int_0^e f */
+static PetscReal TablePotential(PhlexJoint j, PetscReal e)
+{
+  return TableAntiderivative(j, e) - TableAntiderivative(j, 0.0);
+}
+
+/* the spring force of a table over a step and its derivative with respect to the stage state e: with the implicit
+   midpoint rule (j->dg) the discrete gradient (V(e1) - V(e0)) / (e1 - e0), e0 the state at the step's start and
+   e1 = 2 e - e0 its end, so that the spring's energy changes by exactly the work of the force; within one segment
+   (V quadratic) that is f(e) itself; otherwise f(e) */
+static void TableStepForce(PhlexJoint j, PetscInt i, PetscReal e, PetscReal *f, PetscReal *dfde)
+{
+  const PetscReal e0 = j->e_start[i], e1 = 2.0 * e - e0, h = e1 - e0;
+
+  if (!j->dg || TableSegment(j, e0) == TableSegment(j, e1) || PetscAbsReal(h) < 1e-12) {
+    TableForce(j, e, f, dfde);
+    return;
+  }
+  {
+    const PetscReal dV = TablePotential(j, e1) - TablePotential(j, e0);
+    PetscReal       f1;
+    TableForce(j, e1, &f1, NULL);
+    *f = dV / h;
+    if (dfde) *dfde = 2.0 * (f1 * h - dV) / (h * h);
+  }
+}
+
+/* the direction (6-vector, a's body frame) of row k (k >= nc: element row k - nc), and its change for a change dRab
+   of R_ab (universal only) */
 static void RowDirection(PhlexJoint j, PetscInt k, const PetscReal Rab[9], const PetscReal *dRab, PetscReal s[6])
 {
+  const PhlexJointRow row = k < j->nc ? j->row[k] : j->erow[k - j->nc];
+
   for (PetscInt c = 0; c < 6; c++) s[c] = 0.0;
-  switch (j->row[k]) {
+  switch (row) {
   case PHLEX_ROW_T1:
   case PHLEX_ROW_T2:
   case PHLEX_ROW_T3:
     if (!dRab)
-      for (PetscInt c = 0; c < 3; c++) s[c] = j->dir[3 * (j->row[k] - PHLEX_ROW_T1) + c];
+      for (PetscInt c = 0; c < 3; c++) s[c] = j->dir[3 * (row - PHLEX_ROW_T1) + c];
     break;
   case PHLEX_ROW_R1:
   case PHLEX_ROW_R2:
   case PHLEX_ROW_R3:
     if (!dRab)
-      for (PetscInt c = 0; c < 3; c++) s[3 + c] = j->dir[3 * (j->row[k] - PHLEX_ROW_R1) + c];
+      for (PetscInt c = 0; c < 3; c++) s[3 + c] = j->dir[3 * (row - PHLEX_ROW_R1) + c];
     break;
   case PHLEX_ROW_CROSS: {
     /* n = e_a x (R_ab e_b): both axes turn with their bodies */
@@ -139,6 +206,88 @@ PetscErrorCode PhlexJointCreate(MPI_Comm comm, const PhlexUnits *units, PetscInt
   PetscFunctionReturn(0);
 }
 
+/* a 6 x 6 matrix option of a bushing: 36 finite values, symmetric, positive semi-definite (checked on the matrix scaled
+   by its diagonal, D^{-1/2} A D^{-1/2}, so that the mixed units of its blocks do not matter) */
+static PetscErrorCode CheckElementMatrix(PhlexJoint j, const char opt[], const PetscReal A[], PetscInt n)
+{
+  PetscReal    amax = 0.0, S[36], w[6], work[64];
+  PetscBLASInt nb = 6, lwork = 64, info;
+  PetscInt     idx[6], m = 0;
+
+  PetscFunctionBeginUser;
+  PetscCheck(n == 36, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s needs 36 values (a 6 x 6 matrix, row-major), got %s%" PetscInt_FMT, j->name, j->prefix, opt, n > 36 ? "more than " : "", n > 36 ? (PetscInt)36 : n);
+  for (PetscInt i = 0; i < 36; i++) {
+    PetscCheck(!PetscIsInfOrNanReal(A[i]), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s: value %" PetscInt_FMT " is not a finite number", j->name, j->prefix, opt, i + 1);
+    amax = PetscMax(amax, PetscAbsReal(A[i]));
+  }
+  for (PetscInt r = 0; r < 6; r++)
+    for (PetscInt c = r + 1; c < 6; c++)
+      PetscCheck(PetscAbsReal(A[6 * r + c] - A[6 * c + r]) <= 1e-12 * amax, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s is not symmetric: entry (%" PetscInt_FMT ",%" PetscInt_FMT ") = %g, entry (%" PetscInt_FMT ",%" PetscInt_FMT ") = %g", j->name, j->prefix, opt, r + 1, c + 1, (double)A[6 * r + c], c + 1, r + 1, (double)A[6 * c + r]);
+  for (PetscInt r = 0; r < 6; r++) {
+    PetscCheck(A[7 * r] >= 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s is not positive semi-definite: diagonal entry %" PetscInt_FMT " is %g", j->name, j->prefix, opt, r + 1, (double)A[7 * r]);
+    if (A[7 * r] > 0) idx[m++] = r;
+    else
+      for (PetscInt c = 0; c < 6; c++) PetscCheck(A[6 * r + c] == 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s is not positive semi-definite: diagonal entry %" PetscInt_FMT " is 0 but entry (%" PetscInt_FMT ",%" PetscInt_FMT ") is %g", j->name, j->prefix, opt, r + 1, r + 1, c + 1, (double)A[6 * r + c]);
+  }
+  if (!m) PetscFunctionReturn(0);
+  for (PetscInt r = 0; r < m; r++)
+    for (PetscInt c = 0; c < m; c++) S[m * r + c] = A[6 * idx[r] + idx[c]] / PetscSqrtReal(A[7 * idx[r]] * A[7 * idx[c]]);
+  nb = (PetscBLASInt)m;
+  PetscCallBLAS("LAPACKsyev", LAPACKsyev_("N", "U", &nb, S, &nb, w, work, &lwork, &info));
+  PetscCheck(info == 0, j->comm, PETSC_ERR_LIB, "joint %s: -%s%s: LAPACK syev failed (info %d)", j->name, j->prefix, opt, (int)info);
+  PetscCheck(w[0] >= -1e-10, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s is not positive semi-definite (indefinite: smallest eigenvalue %.3g of the matrix scaled to a unit diagonal)", j->name, j->prefix, opt, (double)w[0]);
+  PetscFunctionReturn(0);
+}
+
+/* a spring-damper's force-elongation table: pairs, at least two points, finite, elongations strictly increasing; not
+   with -stiffness */
+static PetscErrorCode ForceTableCheck(PhlexJoint j, const PetscReal tab[], PetscInt n, PhlexJointType type, PetscBool stiffness)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(type == PHLEX_JOINT_SPRING_DAMPER, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table is for a spring_damper joint, not %s", j->name, j->prefix, PhlexJointTypes[type]);
+  PetscCheck(!stiffness, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give the spring as -%sstiffness or as -%sforce_table, not both", j->name, j->prefix, j->prefix);
+  PetscCheck(n <= 128, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table holds at most 64 points (pairs elongation, force)", j->name, j->prefix);
+  PetscCheck(n % 2 == 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table needs pairs elongation,force [m, N]; got %" PetscInt_FMT " numbers", j->name, j->prefix, n);
+  PetscCheck(n >= 4, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table needs at least 2 points, got %" PetscInt_FMT, j->name, j->prefix, n / 2);
+  for (PetscInt i = 0; i < n; i++) PetscCheck(!PetscIsInfOrNanReal(tab[i]), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table: value %" PetscInt_FMT " is not a finite number", j->name, j->prefix, i + 1);
+  for (PetscInt i = 1; i < n / 2; i++) PetscCheck(tab[2 * i] > tab[2 * i - 2], j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table: the elongations must increase strictly; point %" PetscInt_FMT " has %g m after %g m", j->name, j->prefix, i + 1, (double)tab[2 * i], (double)tab[2 * i - 2]);
+  j->ntable = n / 2;
+  for (PetscInt i = 0; i < j->ntable; i++) j->table_e[i] = tab[2 * i], j->table_f[i] = tab[2 * i + 1];
+  PetscFunctionReturn(0);
+}
+
+/* the force-element options of a joint: each refused on a kind it does not belong to, values checked */
+static PetscErrorCode ElementOptionsCheck(PhlexJoint j, PhlexJointType type, PetscBool spring_opts, PetscBool rot_opts, const PetscReal K[], PetscInt nK, const PetscReal C[], PetscInt nC)
+{
+  PetscFunctionBeginUser;
+  if (type == PHLEX_JOINT_SPRING_DAMPER) {
+    PetscCheck(!rot_opts, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srotational_stiffness, -%srotational_damping and -%srest_angle are for a revolute or cylindrical joint; a spring_damper takes -%sstiffness, -%sdamping, -%srest_length", j->name, j->prefix, j->prefix, j->prefix, j->prefix, j->prefix, j->prefix);
+    PetscCheck(j->stiffness > 0 || j->damping > 0 || j->ntable, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a spring_damper needs -%sstiffness [N/m] (or -%sforce_table) and/or -%sdamping [N s/m]", j->name, j->prefix, j->prefix, j->prefix);
+  } else PetscCheck(!spring_opts, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sstiffness, -%sdamping and -%srest_length are for a spring_damper joint, not %s (a revolute or cylindrical joint takes -%srotational_stiffness, -%srotational_damping)", j->name, j->prefix, j->prefix, j->prefix, PhlexJointTypes[type], j->prefix, j->prefix);
+  if (type == PHLEX_JOINT_SPRING_DAMPER || rot_opts) {
+    const char *ks = type == PHLEX_JOINT_SPRING_DAMPER ? "stiffness" : "rotational_stiffness", *cs = type == PHLEX_JOINT_SPRING_DAMPER ? "damping" : "rotational_damping";
+    PetscCheck(j->stiffness >= 0 && !PetscIsInfOrNanReal(j->stiffness), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s must be a finite number >= 0 [%s], got %g", j->name, j->prefix, ks, type == PHLEX_JOINT_SPRING_DAMPER ? "N/m" : "N m/rad", (double)j->stiffness);
+    PetscCheck(j->damping >= 0 && !PetscIsInfOrNanReal(j->damping), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%s%s must be a finite number >= 0 [%s], got %g", j->name, j->prefix, cs, type == PHLEX_JOINT_SPRING_DAMPER ? "N s/m" : "N m s/rad", (double)j->damping);
+  }
+  if (type == PHLEX_JOINT_SPRING_DAMPER && j->rest_length != -1.0) PetscCheck(j->rest_length >= 0 && !PetscIsInfOrNanReal(j->rest_length), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_length must be a finite length >= 0 [m], got %g", j->name, j->prefix, (double)j->rest_length);
+  if (rot_opts) {
+    PetscCheck(type == PHLEX_JOINT_REVOLUTE || type == PHLEX_JOINT_CYLINDRICAL, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srotational_stiffness, -%srotational_damping and -%srest_angle act on a free rotation (a revolute or cylindrical joint); a %s joint has none", j->name, j->prefix, j->prefix, j->prefix, PhlexJointTypes[type]);
+    PetscCheck(!PetscIsInfOrNanReal(j->rest_angle), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle must be a finite angle [deg]", j->name, j->prefix);
+    j->rot_element = PETSC_TRUE;
+    j->rest_angle *= PETSC_PI / 180.0;
+  }
+  if (type == PHLEX_JOINT_BUSHING) {
+    PetscCheck(nK >= 0 || nC >= 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a bushing needs -%sstiffness_matrix and/or -%sdamping_matrix (36 values each)", j->name, j->prefix, j->prefix);
+    if (nK >= 0) PetscCall(CheckElementMatrix(j, "stiffness_matrix", K, nK));
+    if (nC >= 0) PetscCall(CheckElementMatrix(j, "damping_matrix", C, nC));
+    for (PetscInt i = 0; i < 36; i++) {
+      j->Ksi[i] = nK >= 0 ? K[i] : 0.0;
+      j->Csi[i] = nC >= 0 ? C[i] : 0.0;
+    }
+  } else PetscCheck(nK < 0 && nC < 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sstiffness_matrix and -%sdamping_matrix are for a bushing (-%stype bushing), not %s", j->name, j->prefix, j->prefix, j->prefix, PhlexJointTypes[type]);
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexJointSetFromOptions - reads a joint
 
@@ -158,13 +307,24 @@ PetscErrorCode PhlexJointCreate(MPI_Comm comm, const PhlexUnits *units, PetscInt
 . -drive_profile_*            - time profile of the drive velocity
 . -velocity vx,vy,vz          - prescribed: the port point's velocity (inertial) [m/s]
 . -angular_velocity wx,wy,wz  - prescribed: the port's angular velocity (inertial) [rad/s]
-- -profile_*                  - prescribed: time profile of those
+. -profile_*                  - prescribed: time profile of those
+. -stiffness k                - spring_damper: axial stiffness [N/m]
+. -damping c                  - spring_damper: axial damping [N s/m]
+. -rest_length l              - spring_damper: length at zero force [m] (default: the drawn distance of the ports)
+. -rotational_stiffness k     - revolute, cylindrical: a torsion spring on the free rotation [N m/rad]
+. -rotational_damping c       - revolute, cylindrical: viscous friction on the free rotation [N m s/rad]
+. -rest_angle a               - revolute, cylindrical: the torsion spring's zero-moment angle [deg] (default 0: drawn)
+. -stiffness_matrix k11,...   - bushing: 6 x 6 stiffness, row-major, rows/columns t1 t2 t3 r1 r2 r3 of the joint frame
+- -damping_matrix c11,...     - bushing: 6 x 6 damping, the same layout (SI: N/m, N/rad, N m/m, N m/rad; N s/m, ...)
 @*/
 PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
 {
   char    **ports;
   PetscInt  nports, nalloc, type = PHLEX_JOINT_REVOLUTE, comp = 0;
   PetscBool ftype = PETSC_FALSE, fports = PETSC_FALSE, fdrive = PETSC_FALSE, fcomp = PETSC_FALSE, fdi = PETSC_FALSE;
+  PetscBool fk = PETSC_FALSE, fc = PETSC_FALSE, fl = PETSC_FALSE, frk = PETSC_FALSE, frc = PETSC_FALSE, fra = PETSC_FALSE;
+  PetscReal Kbuf[37], Cbuf[37];
+  PetscInt  nK = 37, nC = 37;
   char      who[PHLEX_NAME_LEN + 16];
   const char *const comps[] = {"rotation", "translation", "PhlexDriveComponent", "", NULL};
 
@@ -175,7 +335,7 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   PetscOptionsBegin(j->comm, j->prefix, "Joint options", NULL);
   PetscCall(PetscOptionsString("-name", "Name of the joint (messages, output files)", "PhlexJointSetFromOptions", j->name, j->name, sizeof(j->name), NULL));
   PetscCall(PetscSNPrintf(who, sizeof(who), "joint %s", j->name));
-  PetscCall(PetscOptionsEList("-type", "Joint kind: fixed, revolute, spherical, prismatic, cylindrical, universal, planar, prescribed (a port's motion)", "PhlexJointSetFromOptions", PhlexJointTypes, 8, PhlexJointTypes[type], &type, &ftype));
+  PetscCall(PetscOptionsEList("-type", "Joint kind: fixed, revolute, spherical, prismatic, cylindrical, universal, planar, prescribed (a port's motion); force elements: spring_damper (between the two port points), bushing (6 x 6 stiffness and damping)", "PhlexJointSetFromOptions", PhlexJointTypes, 10, PhlexJointTypes[type], &type, &ftype));
   PetscCall(PetscOptionsStringArray("-ports", "The two ports joined: body:port,body:port or body:port,ground (prescribed: body:port)", "PhlexJointSetFromOptions", ports, &nports, &fports));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, j->comm, who, j->prefix, "-axis", "Axis (inertial, drawn configuration): revolute, prismatic, cylindrical, universal (on the first port), planar (normal)", "PhlexJointSetFromOptions", 3, j->axis, &j->axis_given));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, j->comm, who, j->prefix, "-axis2", "Universal joint: the axis on the second port (orthogonal to -axis)", "PhlexJointSetFromOptions", 3, j->axis2, &j->axis2_given));
@@ -186,8 +346,28 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   PetscCall(PetscOptionsEList("-drive_component", "Cylindrical joint: the driven motion", "PhlexJointSetFromOptions", comps, 2, comps[comp], &comp, &fcomp));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, j->comm, who, j->prefix, "-velocity", "Prescribed motion: velocity of the port point (inertial) [m/s]", "PhlexJointSetFromOptions", 3, j->presc_velocity, &j->presc_v));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, j->comm, who, j->prefix, "-angular_velocity", "Prescribed motion: angular velocity of the port (inertial) [rad/s]", "PhlexJointSetFromOptions", 3, j->presc_angular, &j->presc_w));
+  j->rest_length = -1.0;
+  PetscCall(PetscOptionsReal("-stiffness", "Spring-damper: axial stiffness [N/m] (force on the second port -k (length - rest length) along the line)", "PhlexJointSetFromOptions", j->stiffness, &j->stiffness, &fk));
+  PetscCall(PetscOptionsReal("-damping", "Spring-damper: axial damping [N s/m]", "PhlexJointSetFromOptions", j->damping, &j->damping, &fc));
+  PetscCall(PetscOptionsReal("-rest_length", "Spring-damper: length at zero spring force [m] (default: the drawn distance of the two port points)", "PhlexJointSetFromOptions", j->rest_length, &j->rest_length, &fl));
+  PetscCall(PetscOptionsReal("-rotational_stiffness", "Revolute, cylindrical: torsion spring on the free rotation [N m/rad]", "PhlexJointSetFromOptions", j->stiffness, &j->stiffness, &frk));
+  PetscCall(PetscOptionsReal("-rotational_damping", "Revolute, cylindrical: viscous friction (a rotational damper) on the free rotation [N m s/rad]", "PhlexJointSetFromOptions", j->damping, &j->damping, &frc));
+  PetscCall(PetscOptionsReal("-rest_angle", "Revolute, cylindrical: the torsion spring's zero-moment angle relative to the drawn configuration [deg]", "PhlexJointSetFromOptions", j->rest_angle, &j->rest_angle, &fra));
+  {
+    PetscReal tab[129];
+    PetscInt  ntab = 129;
+    PetscBool ftab = PETSC_FALSE;
+    PetscCall(PetscOptionsRealArray("-force_table", "Spring-damper: force-elongation table e0,f0,e1,f1,... [m, N] (the tension f(e): the force on the second port is -f along the line; elongation = length - rest length, strictly increasing; piecewise linear, extended linearly beyond its ends), instead of -stiffness", "PhlexJointSetFromOptions", tab, &ntab, &ftab));
+    if (ftab && ftype) PetscCall(ForceTableCheck(j, tab, ntab, (PhlexJointType)type, fk && j->stiffness != 0));
+    fl = (PetscBool)(fl || ftab);
+  }
+  PetscCall(PetscArrayzero(Kbuf, 37));
+  PetscCall(PetscArrayzero(Cbuf, 37));
+  PetscCall(PetscOptionsRealArray("-stiffness_matrix", "Bushing: 6 x 6 stiffness, row-major, rows and columns t1,t2,t3,r1,r2,r3 of the joint frame [N/m, N/rad; N m/m, N m/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Kbuf, &nK, &j->Kgiven));
+  PetscCall(PetscOptionsRealArray("-damping_matrix", "Bushing: 6 x 6 damping, the same layout [N s/m, N s/rad; N m s/m, N m s/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Cbuf, &nC, &j->Cgiven));
   PetscOptionsEnd();
-  PetscCheck(ftype, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give its kind: -%stype fixed|revolute|spherical|prismatic|cylindrical|universal|planar|prescribed", j->name, j->prefix);
+  if (ftype) PetscCall(ElementOptionsCheck(j, (PhlexJointType)type, fk || fc || fl, frk || frc || fra, Kbuf, j->Kgiven ? nK : -1, Cbuf, j->Cgiven ? nC : -1));
+  PetscCheck(ftype, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give its kind: -%stype fixed|revolute|spherical|prismatic|cylindrical|universal|planar|prescribed|spring_damper|bushing", j->name, j->prefix);
   j->type = (PhlexJointType)type;
   PetscCheck(fports, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give its ports: -%sports body:port,body:port (or body:port,ground)", j->name, j->prefix);
   if (j->type == PHLEX_JOINT_PRESCRIBED) {
@@ -206,7 +386,7 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   {
     const PetscBool needs_axis = (j->type == PHLEX_JOINT_REVOLUTE || j->type == PHLEX_JOINT_PRISMATIC || j->type == PHLEX_JOINT_CYLINDRICAL || j->type == PHLEX_JOINT_UNIVERSAL || j->type == PHLEX_JOINT_PLANAR) ? PETSC_TRUE : PETSC_FALSE;
     PetscCheck(!needs_axis || j->axis_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a %s joint needs its axis: -%saxis x,y,z", j->name, PhlexJointTypes[j->type], j->prefix);
-    PetscCheck(needs_axis || !j->axis_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a %s joint has no axis (-%saxis)", j->name, PhlexJointTypes[j->type], j->prefix);
+    PetscCheck(needs_axis || j->type == PHLEX_JOINT_BUSHING || !j->axis_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a %s joint has no axis (-%saxis)", j->name, PhlexJointTypes[j->type], j->prefix);
     PetscCheck(!j->axis_given || PhlexNorm3(j->axis) > 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%saxis must not be the zero vector", j->name, j->prefix);
     PetscCheck(j->type == PHLEX_JOINT_UNIVERSAL || !j->axis2_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%saxis2 is for a universal joint", j->name, j->prefix);
     PetscCheck(j->type != PHLEX_JOINT_UNIVERSAL || j->axis2_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a universal joint needs the axis on its second port: -%saxis2 x,y,z", j->name, j->prefix);
@@ -232,6 +412,8 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
     j->drive_row = (j->type == PHLEX_JOINT_PRISMATIC || (j->type == PHLEX_JOINT_CYLINDRICAL && comp == 1)) ? PHLEX_ROW_T3 : PHLEX_ROW_R3;
     if (j->drive_row == PHLEX_ROW_R3) j->drive_initial *= PETSC_PI / 180.0;
   }
+  PetscCheck(!(j->rot_element && j->drive_row == PHLEX_ROW_R3), j->comm, PETSC_ERR_USER_INPUT, "joint %s: its free rotation is driven (-%sdrive_velocity): it cannot also carry a rotational spring-damper (-%srotational_stiffness, -%srotational_damping)", j->name, j->prefix, j->prefix, j->prefix);
+
   if (j->type == PHLEX_JOINT_PRESCRIBED) {
     char prefix[256], what[256];
     PetscCall(PetscSNPrintf(what, sizeof(what), "joint %s, prescribed motion", j->name));
@@ -297,6 +479,11 @@ PetscErrorCode PhlexJointResolve(PhlexJoint j, PetscInt nparts, const PhlexPart 
   PetscCheck(!(j->side[0].part == j->side[1].part && j->side[0].port == j->side[1].port), j->comm, PETSC_ERR_USER_INPUT, "joint %s: a port cannot be joined to itself (-%sports %s,%s)", j->name, j->prefix, j->side[0].spec, j->side[1].spec);
   for (PetscInt s = 0; s < 2; s++)
     if (!PhlexPartIsGround(j->side[s].part)) j->side[s].part->port_used[j->side[s].port] = PETSC_TRUE;
+  if (j->type == PHLEX_JOINT_SPRING_DAMPER) {
+    const PetscBool ground = (PhlexPartIsGround(j->side[0].part) || PhlexPartIsGround(j->side[1].part)) ? PETSC_TRUE : PETSC_FALSE;
+    PetscCheck(!ground || j->position_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a spring_damper to the ground needs its ground end: -%sposition x,y,z [m]", j->name, j->prefix);
+    PetscCheck(ground || !j->position_given, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a spring_damper between two bodies acts between their port points; -%sposition is only for its end on the ground", j->name, j->prefix);
+  }
   PetscCall(PhlexJointSelectRows(j));
   PetscFunctionReturn(0);
 }
@@ -350,6 +537,8 @@ PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const Phlex
       PhlexMatTVec3(Rp[s], d, side->offset);
     } else
       for (PetscInt k = 0; k < 3; k++) side->offset[k] = 0.0; /* the port points must meet: the assembly closes a gap */
+    if (j->type == PHLEX_JOINT_SPRING_DAMPER && !PhlexPartIsGround(side->part))
+      for (PetscInt k = 0; k < 3; k++) side->offset[k] = 0.0; /* a spring-damper's ends are its port points */
   }
   /* the joint frame (rows e1, e2, e3) in a's port frame */
   {
@@ -366,6 +555,13 @@ PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const Phlex
     }
   }
   PhlexMatTMat3(Rp[0], Rp[1], j->Rrel0);
+  if (j->type == PHLEX_JOINT_SPRING_DAMPER) {
+    PetscReal dx[3], E[9], len;
+    PetscCall(Placements(j, Xa, Xb, dx, E));
+    len = PhlexNorm3(dx);
+    PetscCheck(len > 1e-12, j->comm, PETSC_ERR_USER_INPUT, "joint %s: the ends of the spring_damper (%s and %s) coincide as drawn: its line of action has no direction", j->name, j->side[0].spec, j->side[1].spec);
+    if (j->rest_length < 0) j->rest_length = len * u->length;
+  }
   PetscCall(PhlexJointUpdateGeometry(j, Xa, Xb));
   PetscFunctionReturn(0);
 }
@@ -399,6 +595,15 @@ PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint j, const PhlexPartVec *Xa, co
       for (PetscInt k = 0; k < 3; k++) side->arm[k] = side->offset[k];
     else PhlexMatVec3(P[s], side->offset, side->arm);
   }
+  if (j->type == PHLEX_JOINT_SPRING_DAMPER) {
+    /* the line of action between the two ends (e3 of the joint frame), held over the step like every joint direction */
+    PetscReal dx[3], E[9];
+    PetscCall(Placements(j, Xa, Xb, dx, E));
+    if (PhlexNorm3(dx) > 1e-12) {
+      PetscReal e1[3] = {j->frame[0], j->frame[1], j->frame[2]}; /* e1 kept as close as it can stay */
+      PhlexCompleteFrame(dx, e1, j->frame);
+    }
+  }
   for (PetscInt r = 0; r < 3; r++) PhlexMatVec3(P[0], j->frame + 3 * r, j->dir + 3 * r);
   PhlexMatVec3(P[1], j->axis_b, j->eb);
   PetscFunctionReturn(0);
@@ -429,15 +634,20 @@ PetscErrorCode PhlexJointEvaluate(PhlexJoint j, PetscReal t, const PetscReal *q,
   SideRotation(j, 1, q, j->Rb);
   PhlexMatTMat3(j->Ra, j->Rb, j->Rab);
   PhlexMatTMat3(j->Ra, j->Ra, j->G);
-  for (PetscInt k = 0; k < j->nc; k++) j->lambda[k] = qd ? T * qd[j->qoff + k] : 0.0;
+  for (PetscInt k = 0; k < NumRows(j); k++) j->lambda[k] = qd ? T * qd[j->qoff + k] : 0.0;
+  for (PetscInt i = 0; i < j->ne; i++) {
+    j->e[i]    = q[j->qoff + NumRows(j) + i];
+    j->edot[i] = qd ? T * qd[j->qoff + NumRows(j) + i] : 0.0;
+  }
   PetscFunctionReturn(0);
 }
 
-/* the joint's wrench on b at the joint point, a's body frame: w_J = sum_k lambda_k s_k */
+/* the joint's wrench on b at the joint point, a's body frame: w_J = sum_k lambda_k s_k (constraint rows and force
+   elements) */
 static void JointWrench(PhlexJoint j, const PetscReal *lambda, const PetscReal *dRab, PetscReal w[6])
 {
   for (PetscInt c = 0; c < 6; c++) w[c] = 0.0;
-  for (PetscInt k = 0; k < j->nc; k++) {
+  for (PetscInt k = 0; k < NumRows(j); k++) {
     PetscReal s[6];
     RowDirection(j, k, j->Rab, dRab, s);
     for (PetscInt c = 0; c < 6; c++) w[c] += lambda[k] * s[c];
@@ -473,7 +683,7 @@ static void WrenchesRDerivative(PhlexJoint j, PetscInt t, PetscInt m, const Pets
   PetscReal dwJ[6] = {0, 0, 0, 0, 0, 0};
 
   RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
-  for (PetscInt k = 0; k < j->nc; k++)
+  for (PetscInt k = 0; k < NumRows(j); k++)
     if (j->row[k] == PHLEX_ROW_CROSS) {
       PetscReal dsk[6];
       RowDirection(j, k, j->Rab, dRab, dsk);
@@ -548,6 +758,25 @@ PetscErrorCode PhlexJointResidual(PhlexJoint j, PetscReal t, PetscReal *f)
     j->c[k]           = Dot6(s, D);
     f[j->qoff + k]    = j->c[k] - g;
   }
+  if (j->ne) {
+    PetscReal sD[6];
+    for (PetscInt i = 0; i < j->ne; i++) {
+      PetscReal s[6];
+      RowDirection(j, j->nc + i, j->Rab, NULL, s);
+      sD[i] = Dot6(s, D);
+    }
+    for (PetscInt i = 0; i < j->ne; i++) {
+      PetscReal F = j->lambda[j->nc + i];
+      for (PetscInt l = 0; l < j->ne; l++) F += j->K[j->ne * i + l] * j->e[l] + j->C[j->ne * i + l] * sD[l];
+      if (j->ntable) {
+        PetscReal ft;
+        TableStepForce(j, i, j->e[i], &ft, NULL);
+        F += ft;
+      }
+      f[j->qoff + j->nc + i]     = F;                 /* lambda = -(K e + C s.Delta) */
+      f[j->qoff + NumRows(j) + i] = j->edot[i] - sD[i]; /* e' = s.Delta */
+    }
+  }
   PetscFunctionReturn(0);
 }
 
@@ -576,9 +805,68 @@ PetscErrorCode PhlexJointPower(PhlexJoint j, const PetscReal *lambda, PetscReal 
 @*/
 PetscErrorCode PhlexJointDissipation(PhlexJoint j, const PetscReal *lambda, PetscReal *D)
 {
+  PetscReal Dl[6], sD[6];
+
   PetscFunctionBeginUser;
   (void)lambda;
   *D = 0.0;
+  if (!j->ne) PetscFunctionReturn(0);
+  Relative(j, Dl);
+  for (PetscInt i = 0; i < j->ne; i++) {
+    PetscReal s[6];
+    RowDirection(j, j->nc + i, j->Rab, NULL, s);
+    sD[i] = Dot6(s, Dl);
+  }
+  /* the force elements' dampers: (S^T Delta)^T C (S^T Delta) >= 0 */
+  for (PetscInt i = 0; i < j->ne; i++)
+    for (PetscInt l = 0; l < j->ne; l++) *D += sD[i] * j->C[j->ne * i + l] * sD[l];
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointNumUnknowns - the joint's discrete unknowns: its constraint impulses, its force elements' force impulses and
+  their states
+@*/
+PetscInt PhlexJointNumUnknowns(PhlexJoint j)
+{
+  return j->nc + 2 * j->ne;
+}
+
+/*@C
+  PhlexJointDamped - whether the joint's force elements have dampers (it dissipates)
+@*/
+PetscBool PhlexJointDamped(PhlexJoint j)
+{
+  for (PetscInt k = 0; k < j->ne * j->ne; k++)
+    if (j->C[k] != 0) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
+/*@C
+  PhlexJointElementEnergy - the energy stored in the joint's force elements, 1/2 e^T K e (non-dimensional), at the
+  discrete unknowns q (replicated)
+@*/
+PetscErrorCode PhlexJointElementEnergy(PhlexJoint j, const PetscReal *q, PetscReal *V)
+{
+  const PetscReal *e = q + j->qoff + NumRows(j);
+
+  PetscFunctionBeginUser;
+  *V = 0.0;
+  for (PetscInt i = 0; i < j->ne; i++)
+    for (PetscInt l = 0; l < j->ne; l++) *V += 0.5 * e[i] * j->K[j->ne * i + l] * e[l];
+  if (j->ntable) *V += TablePotential(j, e[0]);
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointElementStepStart - before a step: the force elements' states at its start (q: replicated) and whether the
+  scheme is the implicit midpoint rule, whose stage takes a table spring's force as the discrete gradient over the step
+@*/
+PetscErrorCode PhlexJointElementStepStart(PhlexJoint j, const PetscReal *q, PetscBool midpoint)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < j->ne; i++) j->e_start[i] = q[j->qoff + NumRows(j) + i];
+  j->dg = (PetscBool)(midpoint && j->ntable > 0);
   PetscFunctionReturn(0);
 }
 
@@ -614,12 +902,25 @@ static PetscErrorCode RowsFromPortChange(PhlexJoint j, PetscInt s, const PetscRe
     Rotate6(j->G, PETSC_FALSE, dyt, r);
     for (PetscInt c = 0; c < 6; c++) r[c] = -r[c];
   }
-  for (PetscInt k = 0; k < j->nc; k++) {
+  for (PetscInt k = 0; k < NumRows(j); k++) {
     PetscReal sk[6];
     RowDirection(j, k, j->Rab, NULL, sk);
     rows[k] = Dot6(sk, r);
   }
   PetscFunctionReturn(0);
+}
+
+/* out[stride * row] += the change of the joint's residual rows for changes rows[k] = s_k . dDelta (k < nc + ne): a
+   constraint row takes its own, an element's force row C rows_e, its state row -rows_e */
+static void AddRows(PhlexJoint j, const PetscReal rows[], PetscReal *out, PetscInt stride)
+{
+  for (PetscInt k = 0; k < j->nc; k++) out[stride * (j->qoff + k)] += rows[k];
+  for (PetscInt i = 0; i < j->ne; i++) {
+    PetscReal F = 0.0;
+    for (PetscInt l = 0; l < j->ne; l++) F += j->C[j->ne * i + l] * rows[j->nc + l];
+    out[stride * (j->qoff + j->nc + i)] += F;
+    out[stride * (j->qoff + NumRows(j) + i)] -= rows[j->nc + i];
+  }
 }
 
 /*@C
@@ -646,16 +947,16 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
     if (PhlexPartIsGround(p)) continue;
     /* rows x the part's discrete unknowns, through its port */
     for (PetscInt m = 0; m < p->nq; m++) {
-      PetscReal dy[6], rows[7];
+      PetscReal dy[6], rows[PHLEX_JOINT_MAX_ROWS];
       work[m] = 1.0;
       PetscCall((*p->ops.portlinear)(p, j->side[s].port, NULL, 0.0, NULL, work, dy));
       work[m] = 0.0;
       PetscCall(RowsFromPortChange(j, s, dy, rows));
-      for (PetscInt k = 0; k < j->nc; k++) D[ld * (j->qoff + k) + p->qoff + m] += rows[k];
+      AddRows(j, rows, D + p->qoff + m, ld);
     }
-    /* the part's rows x the impulses: -shift (generalized force of d w / d lambda_k) */
-    for (PetscInt k = 0; k < j->nc; k++) {
-      PetscReal e[7] = {0, 0, 0, 0, 0, 0, 0}, wk[6], w[2][6];
+    /* the part's rows x the impulses (constraints' and elements'): -shift (generalized force of d w / d lambda_k) */
+    for (PetscInt k = 0; k < NumRows(j); k++) {
+      PetscReal e[PHLEX_JOINT_MAX_ROWS] = {0}, wk[6], w[2][6];
       e[k] = 1.0;
       JointWrench(j, e, NULL, wk);
       PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
@@ -676,11 +977,15 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
       Rotate6(dRab, PETSC_FALSE, j->yb, r);
       Rotate6(dG, PETSC_FALSE, j->ya, ra);
       for (PetscInt c = 0; c < 6; c++) r[c] -= ra[c];
-      for (PetscInt k = 0; k < j->nc; k++) {
-        PetscReal sk[6], dsk[6];
-        RowDirection(j, k, j->Rab, NULL, sk);
-        RowDirection(j, k, j->Rab, dRab, dsk);
-        D[ld * (j->qoff + k) + col] += Dot6(sk, r) + (j->row[k] == PHLEX_ROW_CROSS ? Dot6(dsk, Dl) : 0.0);
+      {
+        PetscReal dc[PHLEX_JOINT_MAX_ROWS];
+        for (PetscInt k = 0; k < NumRows(j); k++) {
+          PetscReal sk[6], dsk[6];
+          RowDirection(j, k, j->Rab, NULL, sk);
+          RowDirection(j, k, j->Rab, dRab, dsk);
+          dc[k] = Dot6(sk, r) + (k < j->nc && j->row[k] == PHLEX_ROW_CROSS ? Dot6(dsk, Dl) : 0.0);
+        }
+        AddRows(j, dc, D + col, ld);
       }
       for (PetscInt t = 0; t < 2; t++) {
         PhlexPart pt = j->side[t].part;
@@ -689,6 +994,18 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
         for (PetscInt i = 0; i < pt->nq; i++) D[ld * (pt->qoff + i) + col] -= work[i];
         PetscCall(PetscArrayzero(work, pt->nq));
       }
+    }
+  }
+  /* the force elements' own entries: lambda_i = T Lambda_i' and e_i' (shift), the springs K */
+  for (PetscInt i = 0; i < j->ne; i++) {
+    const PetscInt fi = j->qoff + j->nc + i, ei = j->qoff + NumRows(j) + i;
+    D[ld * fi + fi] += shift;
+    D[ld * ei + ei] += shift;
+    for (PetscInt l = 0; l < j->ne; l++) D[ld * fi + j->qoff + NumRows(j) + l] += j->K[j->ne * i + l];
+    if (j->ntable) {
+      PetscReal ft, dft;
+      TableStepForce(j, i, j->e[i], &ft, &dft);
+      D[ld * fi + ei] += dft;
     }
   }
   PetscCall(PetscFree(work));
@@ -700,10 +1017,10 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
    x_R of both sides */
 static PetscErrorCode WrenchChange(PhlexJoint j, PetscInt s, PetscReal shift, const PetscReal *x, PetscReal dw[6])
 {
-  PetscReal dl[7], wk[6], w[2][6], wJ[6];
+  PetscReal dl[PHLEX_JOINT_MAX_ROWS], wk[6], w[2][6], wJ[6];
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < j->nc; k++) dl[k] = shift * x[j->qoff + k];
+  for (PetscInt k = 0; k < NumRows(j); k++) dl[k] = shift * x[j->qoff + k];
   JointWrench(j, dl, NULL, wk);
   PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
   for (PetscInt c = 0; c < 6; c++) dw[c] = w[s][c];
@@ -771,11 +1088,11 @@ PetscErrorCode PhlexJointBorderMultTransposeSummed(PhlexJoint j, PhlexPart part,
 {
   PetscFunctionBeginUser;
   for (PetscInt s = 0; s < 2; s++) {
-    PetscReal dy[6], rows[7];
+    PetscReal dy[6], rows[PHLEX_JOINT_MAX_ROWS];
     if (j->side[s].part != part) continue;
     PetscCall((*part->fieldops->portlinearsummed)(part, j->side[s].port, xu, au, xv, sums + s * PHLEX_PORT_SUMS, NULL, dy));
     PetscCall(RowsFromPortChange(j, s, dy, rows));
-    for (PetscInt k = 0; k < j->nc; k++) y[j->qoff + k] += rows[k];
+    AddRows(j, rows, y, 1);
   }
   PetscFunctionReturn(0);
 }
@@ -798,9 +1115,9 @@ PetscErrorCode PhlexJointBorderRows(PhlexJoint j, PhlexPart part, Mat Y, PetscRe
     PetscCall(PetscMalloc1(6 * k, &dy));
     PetscCall((*part->fieldops->portlinearblock)(part, j->side[s].port, Y, shiftinv, dy));
     for (PetscInt col = 0; col < k; col++) {
-      PetscReal rows[7];
+      PetscReal rows[PHLEX_JOINT_MAX_ROWS];
       PetscCall(RowsFromPortChange(j, s, dy + 6 * col, rows));
-      for (PetscInt r = 0; r < j->nc; r++) out[j->qoff + r + ld * col] += rows[r];
+      AddRows(j, rows, out + ld * col, 1);
     }
     PetscCall(PetscFree(dy));
   }
@@ -822,8 +1139,8 @@ PetscErrorCode PhlexJointBorderCoefficients(PhlexJoint j, PhlexPart part, PetscR
     if (j->side[s].part != part) continue;
     PetscCall((*part->fieldops->portbasiscolumn)(part, j->side[s].port, &c0));
     if (c0 < 0) continue; /* no field force on this port (a frame patch) */
-    for (PetscInt k = 0; k < j->nc; k++) {
-      PetscReal e[7] = {0, 0, 0, 0, 0, 0, 0}, wk[6], w[2][6];
+    for (PetscInt k = 0; k < NumRows(j); k++) {
+      PetscReal e[PHLEX_JOINT_MAX_ROWS] = {0}, wk[6], w[2][6];
       e[k] = 1.0;
       JointWrench(j, e, NULL, wk);
       PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
@@ -853,7 +1170,7 @@ PetscErrorCode PhlexJointRigidGradient(PhlexJoint j, PetscReal *G, PetscInt ld)
     PhlexPart p = j->side[s].part;
     if (PhlexPartIsGround(p)) continue;
     for (PetscInt m = 0; m < p->nq; m++) {
-      PetscReal *dq, dy[6], rows[7];
+      PetscReal *dq, dy[6], rows[PHLEX_JOINT_MAX_ROWS];
       if (p->qkind[m] != PHLEX_DOF_VELOCITY) continue;
       PetscCall(PetscCalloc1(p->nq, &dq));
       dq[m] = 1.0;
@@ -1043,7 +1360,23 @@ PetscErrorCode PhlexJointView(PhlexJoint j, PetscViewer viewer)
     PetscCall(PetscStrlcat(rows, k ? " " : "", sizeof(rows)));
     PetscCall(PetscStrlcat(rows, j->rowname[k], sizeof(rows)));
   }
-  PetscCall(PetscViewerASCIIPrintf(viewer, "joint %s: %s between %s and %s, constrains %s", j->name, PhlexJointTypes[j->type], j->side[0].spec, j->side[1].spec, rows));
+  if (j->nc) PetscCall(PetscViewerASCIIPrintf(viewer, "joint %s: %s between %s and %s, constrains %s", j->name, PhlexJointTypes[j->type], j->side[0].spec, j->side[1].spec, rows));
+  else PetscCall(PetscViewerASCIIPrintf(viewer, "joint %s: %s between %s and %s", j->name, PhlexJointTypes[j->type], j->side[0].spec, j->side[1].spec));
+  PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_FALSE)); /* the rest of the line: no indentation before each piece */
+  if (j->ne) {
+    char line[256] = "; force element on", more[160];
+    for (PetscInt i = 0; i < j->ne; i++) {
+      PetscCall(PetscStrlcat(line, " ", sizeof(line)));
+      PetscCall(PetscStrlcat(line, j->erowname[i], sizeof(line)));
+    }
+    more[0] = 0;
+    if (j->type == PHLEX_JOINT_SPRING_DAMPER && j->ntable) PetscCall(PetscSNPrintf(more, sizeof(more), " (force table of %" PetscInt_FMT " points, c %.6g N s/m, rest length %.6g m)", j->ntable, (double)j->damping, (double)j->rest_length));
+    else if (j->type == PHLEX_JOINT_SPRING_DAMPER && j->rest_length >= 0) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N/m, c %.6g N s/m, rest length %.6g m)", (double)j->stiffness, (double)j->damping, (double)j->rest_length));
+    else if (j->type == PHLEX_JOINT_SPRING_DAMPER) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N/m, c %.6g N s/m, rest length as drawn)", (double)j->stiffness, (double)j->damping));
+    else if (j->rot_element) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N m/rad, c %.6g N m s/rad, rest angle %.6g deg)", (double)j->stiffness, (double)j->damping, (double)(j->rest_angle * 180.0 / PETSC_PI)));
+    PetscCall(PetscStrlcat(line, more, sizeof(line)));
+    PetscCall(PetscViewerASCIIPrintf(viewer, "%s", line));
+  }
   if (j->drive_row >= 0) PetscCall(PetscViewerASCIIPrintf(viewer, " (%s driven at %.15g %s)", j->rowname[j->nc - 1], (double)j->drive_velocity, j->row[j->nc - 1] == PHLEX_ROW_R3 ? "rad/s" : "m/s"));
   if (j->rot_dropped) PetscCall(PetscViewerASCIIPrintf(viewer, "; rotations free (a point mass has no orientation)"));
   if (j->ndropped) {
@@ -1051,6 +1384,7 @@ PetscErrorCode PhlexJointView(PhlexJoint j, PetscViewer viewer)
     for (PetscInt k = 0; k < j->ndropped; k++) PetscCall(PetscViewerASCIIPrintf(viewer, " %s", j->dropped[k]));
   }
   PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
+  PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_TRUE));
   PetscFunctionReturn(0);
 }
 
@@ -1091,6 +1425,15 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
     PetscCall(PetscStrlcat(header, col, sizeof(header)));
   }
   PetscCall(PetscStrlcat(header, ",power", sizeof(header)));
+  if (j->ne) {
+    for (PetscInt i = 0; i < j->ne; i++) {
+      char col[48];
+      PetscCall(PetscSNPrintf(col, sizeof(col), ",state_%s,force_%s", j->erowname[i], j->erowname[i]));
+      PetscCall(PetscStrlcat(header, col, sizeof(header)));
+    }
+    if (j->type == PHLEX_JOINT_SPRING_DAMPER) PetscCall(PetscStrlcat(header, ",length_minus_rest", sizeof(header)));
+    PetscCall(PetscStrlcat(header, ",stored_energy,dissipated_power,dissipated_work", sizeof(header)));
+  }
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_joint.csv", j->name));
   PetscCall(PhlexOutputCSVOpen(out, name, header, &j->csv));
   PetscFunctionReturn(0);
@@ -1099,11 +1442,13 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
 /*@C
   PhlexJointOutputStep - one row of the joint's series (SI): the multipliers lambda of the step and the power P
   through the joint over the step (non-dimensional, from the monitor: at the state where the scheme enforces the
-  constraints), the relative motion and the violations at the state X; returns the largest violation (SI: m or rad)
+  constraints), the relative motion and the violations at the state X; with force elements their states and forces, the
+  stored energy at X (the joint evaluated at X), the power Dstep its dampers dissipated over the step and their work so
+  far; returns the largest violation (SI: m or rad)
 
   Collective
 @*/
-PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
+PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, PetscReal Dstep, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
 {
   const PhlexUnits *u = j->units;
   PetscReal         wJ[6], mo[6], gap[7];
@@ -1127,7 +1472,48 @@ PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *
     const PetscBool length = j->row[k] <= PHLEX_ROW_T3 ? PETSC_TRUE : PETSC_FALSE;
     PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(length ? gap[k] * u->length : gap[k])));
   }
-  PetscCall(PhlexCSVPrintf(j->csv, ",%.12e\n", (double)(P * u->power)));
+  PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(P * u->power)));
+  if (j->ne) {
+    PetscReal V = 0.0;
+    for (PetscInt i = 0; i < j->ne; i++) {
+      const PetscBool length = j->erow[i] <= PHLEX_ROW_T3 ? PETSC_TRUE : PETSC_FALSE;
+      PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e", (double)(length ? j->e[i] * u->length : j->e[i]), (double)(lambda[j->nc + i] * u->force * (length ? 1.0 : u->length))));
+      for (PetscInt l = 0; l < j->ne; l++) V += 0.5 * j->e[i] * j->K[j->ne * i + l] * j->e[l];
+    }
+    if (j->ntable) V += TablePotential(j, j->e[0]);
+    if (j->type == PHLEX_JOINT_SPRING_DAMPER) {
+      PetscReal dx[3], E[9];
+      PetscCall(Placements(j, Xa, Xb, dx, E));
+      PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(PhlexNorm3(dx) * u->length - j->rest_length)));
+    }
+    PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e,%.12e", (double)(V * u->energy), (double)(Dstep * u->power), (double)(j->dissipated_work * u->energy)));
+  }
+  PetscCall(PhlexCSVPrintf(j->csv, "\n"));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointElementInitial - the initial states of the joint's force elements from the placements of its ports: the
+  spring-damper's length minus its rest length, the torsion spring's angle minus its rest angle, the bushing's
+  relative displacement and rotation vector in its joint frame (non-dimensional)
+
+  Collective
+@*/
+PetscErrorCode PhlexJointElementInitial(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal e0[6])
+{
+  PetscReal dx[3], E[9], phi[3];
+
+  PetscFunctionBeginUser;
+  if (!j->ne) PetscFunctionReturn(0);
+  PetscCall(Placements(j, Xa, Xb, dx, E));
+  PhlexRotationVector(E, phi);
+  for (PetscInt i = 0; i < j->ne; i++) {
+    const PhlexJointRow r = j->erow[i];
+    if (j->type == PHLEX_JOINT_SPRING_DAMPER) e0[i] = PhlexNorm3(dx) - j->rest_length / j->units->length;
+    else if (j->rot_element) e0[i] = AngleAboutAxis(j, E) - j->rest_angle;
+    else if (r <= PHLEX_ROW_T3) e0[i] = PhlexDot3(j->frame + 3 * (r - PHLEX_ROW_T1), dx);
+    else e0[i] = PhlexDot3(j->frame + 3 * (r - PHLEX_ROW_R1), phi);
+  }
   PetscFunctionReturn(0);
 }
 

@@ -5,6 +5,49 @@
 
 static const char *const RowNames[] = {"t1", "t2", "t3", "r1", "r2", "r3", "cross"};
 
+/* The force elements' rows (after the constraint rows) and their non-dimensional stiffness and damping. Row i of K
+   is a force (translation row, unit units->force) or a moment (rotation row, force x length); column l multiplies a
+   length (translation state, units->length) or an angle. So K*_il = K_il c_i c_l / (F L) with c = L for a translation
+   row and 1 for a rotation row (a congruence: K* stays symmetric positive semi-definite), and C*_il likewise with
+   the rates' scales (L/T, 1/T): C*_il = C_il c_i c_l / (F L T). */
+static PetscErrorCode SelectElementRows(PhlexJoint j)
+{
+  const PhlexUnits *u = j->units;
+  PetscInt          idx[6];
+
+  PetscFunctionBeginUser;
+  j->ne = 0;
+  if (j->type == PHLEX_JOINT_SPRING_DAMPER) {
+    j->erow[0] = PHLEX_ROW_T3, idx[0] = 0;
+    j->ne      = 1;
+  } else if (j->type == PHLEX_JOINT_BUSHING) {
+    const PetscBool rot = (j->side[0].rotation && j->side[1].rotation) ? PETSC_TRUE : PETSC_FALSE;
+    for (PetscInt k = PHLEX_ROW_T1; k <= (rot ? PHLEX_ROW_R3 : PHLEX_ROW_T3); k++) j->erow[j->ne] = (PhlexJointRow)k, idx[j->ne] = k, j->ne++;
+    if (!rot) j->rot_dropped = PETSC_TRUE;
+  } else if (j->rot_element) {
+    PetscCheck(j->side[0].rotation && j->side[1].rotation, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a rotational spring-damper (-%srotational_stiffness, -%srotational_damping) needs ports with an orientation; %s is a point", j->name, j->prefix, j->prefix, j->side[j->side[0].rotation ? 1 : 0].spec);
+    j->erow[0] = PHLEX_ROW_R3, idx[0] = 5;
+    j->ne      = 1;
+  }
+  for (PetscInt i = 0; i < j->ntable; i++) {
+    j->table_e[i] /= u->length;
+    j->table_f[i] /= u->force;
+  }
+  for (PetscInt i = 0; i < j->ne; i++) {
+    const PetscReal ci = j->erow[i] <= PHLEX_ROW_T3 ? u->length : 1.0;
+    PetscCall(PetscStrcpy(j->erowname[i], RowNames[j->erow[i]]));
+    for (PetscInt l = 0; l < j->ne; l++) {
+      const PetscReal cl = j->erow[l] <= PHLEX_ROW_T3 ? u->length : 1.0;
+      PetscReal       k, c;
+      if (j->type == PHLEX_JOINT_BUSHING) k = j->Ksi[6 * idx[i] + idx[l]], c = j->Csi[6 * idx[i] + idx[l]];
+      else k = j->stiffness, c = j->damping;
+      j->K[j->ne * i + l] = k * ci * cl / (u->force * u->length);
+      j->C[j->ne * i + l] = c * ci * cl / (u->force * u->length * u->time);
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
 PETSC_INTERN PetscErrorCode PhlexJointSelectRows(PhlexJoint j)
 {
   PhlexJointRow rows[7];
@@ -35,6 +78,9 @@ PETSC_INTERN PetscErrorCode PhlexJointSelectRows(PhlexJoint j)
   case PHLEX_JOINT_PLANAR: /* sliding in the plane normal to e3 and rotation about e3 free */
     rows[n++] = PHLEX_ROW_T3, rows[n++] = PHLEX_ROW_R1, rows[n++] = PHLEX_ROW_R2;
     break;
+  case PHLEX_JOINT_SPRING_DAMPER: /* no constraint: one element row along the line of action (e3) */
+  case PHLEX_JOINT_BUSHING:       /* no constraint: six element rows */
+    break;
   case PHLEX_JOINT_PRESCRIBED: /* the given velocities of the port (inertial frame: a is the ground) */
     if (j->presc_v)
       for (PetscInt k = PHLEX_ROW_T1; k <= PHLEX_ROW_T3; k++) rows[n++] = (PhlexJointRow)k;
@@ -57,6 +103,7 @@ PETSC_INTERN PetscErrorCode PhlexJointSelectRows(PhlexJoint j)
     j->nc++;
   }
   if (j->drive_row >= 0) j->drive_row = j->nc - 1;
-  PetscCheck(j->nc > 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a %s joint between %s and %s constrains nothing (a point mass has no orientation)", j->name, PhlexJointTypes[j->type], j->side[0].spec, j->side[1].spec);
+  PetscCall(SelectElementRows(j));
+  PetscCheck(j->nc > 0 || j->ne > 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a %s joint between %s and %s constrains nothing (a point mass has no orientation)", j->name, PhlexJointTypes[j->type], j->side[0].spec, j->side[1].spec);
   PetscFunctionReturn(0);
 }

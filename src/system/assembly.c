@@ -151,7 +151,7 @@ PetscErrorCode PhlexAssemblyRedundancy(PhlexSystem sys, Vec X, PetscInt *ndroppe
       if (j->drive_row > ridx[i]) j->drive_row--;
       PetscCall(PhlexJointDropRow(j, ridx[i]));
     }
-    for (PetscInt k = 0; k < sys->njoints; k++) PetscCheck(sys->joints[k]->nc > 0, sys->comm, PETSC_ERR_USER_INPUT, "joint %s: every component is redundant: remove the joint", sys->joints[k]->name);
+    for (PetscInt k = 0; k < sys->njoints; k++) PetscCheck(sys->joints[k]->nc > 0 || sys->joints[k]->ne > 0, sys->comm, PETSC_ERR_USER_INPUT, "joint %s: every component is redundant: remove the joint", sys->joints[k]->name);
   }
   PetscCall(PetscFree(G));
   PetscCall(PetscFree5(Q, order, jidx, ridx, redundant));
@@ -388,7 +388,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < sys->nq; k++)
-    if (sys->qkind[k] == PHLEX_DOF_IMPULSE) impulses = PETSC_TRUE;
+    if (PhlexDofIsImpulse(sys->qkind[k])) impulses = PETSC_TRUE; /* the forces of force elements are solved too */
   if (!impulses) PetscFunctionReturn(0);
   PetscCall(PetscLogEventBegin(PHLEX_Assembly, 0, 0, 0, 0));
   c.sys = sys;
@@ -503,7 +503,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     PetscCall(PetscMalloc1(sys->nq, &q0));
     PetscCall(PhlexSystemGather(sys, X, q0));
     PetscCall(PhlexSystemGather(sys, Y, sys->q));
-    for (PetscInt k = 0; k < sys->nq; k++) lambda0[k] = sys->qkind[k] == PHLEX_DOF_IMPULSE ? (sys->q[k] - q0[k]) / (c.eps / u->time) : 0.0;
+    for (PetscInt k = 0; k < sys->nq; k++) lambda0[k] = PhlexDofIsImpulse(sys->qkind[k]) ? (sys->q[k] - q0[k]) / (c.eps / u->time) : 0.0;
     PetscCall(PetscFree(q0));
   }
   PetscCall(SNESDestroy(&snes));

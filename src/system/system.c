@@ -326,15 +326,19 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
     sys->joints[k]->qoff = sys->nq;
-    sys->nq += sys->joints[k]->nc;
+    sys->nq += PhlexJointNumUnknowns(sys->joints[k]);
   }
   sys->qlocal                     = rank == 0 ? sys->nq : 0;
   nlocal[PHLEX_FIELD_DISCRETE]    = sys->qlocal;
   PetscCall(PetscCalloc5(PetscMax(sys->nq, 1), &sys->q, PetscMax(sys->nq, 1), &sys->qd, PetscMax(sys->nq, 1), &sys->fq, PetscMax(sys->nq * sys->nq, 1), &sys->D, PetscMax(sys->nq, 1), &sys->qkind));
   for (PetscInt i = 0; i < sys->nparts; i++)
     for (PetscInt k = 0; k < sys->parts[i]->nq; k++) sys->qkind[sys->parts[i]->qoff + k] = sys->parts[i]->qkind[k];
-  for (PetscInt k = 0; k < sys->njoints; k++)
-    for (PetscInt r = 0; r < sys->joints[k]->nc; r++) sys->qkind[sys->joints[k]->qoff + r] = PHLEX_DOF_IMPULSE;
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    const PhlexJoint j = sys->joints[k];
+    for (PetscInt r = 0; r < j->nc; r++) sys->qkind[j->qoff + r] = PHLEX_DOF_IMPULSE;
+    for (PetscInt r = 0; r < j->ne; r++) sys->qkind[j->qoff + j->nc + r] = PHLEX_DOF_ELEMENT_FORCE;
+    for (PetscInt r = 0; r < j->ne; r++) sys->qkind[j->qoff + j->nc + j->ne + r] = PHLEX_DOF_ELEMENT;
+  }
 
   /* the layout: the fields present */
   for (PetscInt f = 0; f < PHLEX_NUM_FIELDS; f++) sys->field[f] = -1;
@@ -931,8 +935,43 @@ PetscErrorCode PhlexSystemEnergy(PhlexSystem sys, PetscReal t, Vec X, PetscReal 
     PetscCall((*p->ops.energy)(p, &pv[i], &k, &s, &v));
     *kin += k, *strain += s, *pot += v;
   }
+  /* the energy stored in the joints' force elements (springs) counts as strain energy */
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PetscReal V;
+    PetscCall(PhlexJointElementEnergy(sys->joints[k], sys->q, &V));
+    *strain += V;
+  }
   for (PetscInt i = 0; i < sys->nparts; i++) PetscCall(PhlexPartRestoreVec(sys->parts[i], X, &pv[i]));
   PetscCall(PetscFree(pv));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemInitElements - the initial states of the joints' force elements from the configuration in X (after the
+  assembly closed the joints), written into X
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemInitElements(PhlexSystem sys, Vec X)
+{
+  PetscBool any = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < sys->njoints; k++)
+    if (sys->joints[k]->ne) any = PETSC_TRUE;
+  if (!any) PetscFunctionReturn(0);
+  PetscCall(PhlexSystemGather(sys, X, sys->q));
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PhlexJoint   j = sys->joints[k];
+    PhlexPartVec pv[2];
+    PetscReal    e0[6];
+    if (!j->ne) continue;
+    PetscCall(PhlexSystemJointSides(sys, j, X, sys->q, pv));
+    PetscCall(PhlexJointElementInitial(j, &pv[0], &pv[1], e0));
+    PetscCall(PhlexSystemJointSidesRestore(sys, j, X, pv));
+    for (PetscInt i = 0; i < j->ne; i++) sys->q[j->qoff + j->nc + j->ne + i] = e0[i];
+  }
+  PetscCall(PhlexSystemScatter(sys, sys->q, X));
   PetscFunctionReturn(0);
 }
 
