@@ -218,9 +218,16 @@ static PetscErrorCode PreStep(TS ts)
   PetscCall(TSGetSolution(ts, &X));
   PetscCall(TSGetTimeStep(ts, &dt));
   PetscCall(PhlexSystemUpdateJoints(m->sys, X, dt));
-  /* the force elements' states at the step's start (a table spring's discrete gradient) */
-  PetscCall(PhlexSystemGather(m->sys, X, m->sys->q));
-  for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], m->sys->q, m->lossless_scheme));
+  /* the force elements' states at the step's start (a table spring's discrete gradient; only a table needs them) */
+  {
+    PetscBool table = PETSC_FALSE;
+    for (PetscInt k = 0; k < m->sys->njoints; k++)
+      if (m->sys->joints[k]->ntable > 0) table = PETSC_TRUE;
+    if (table) {
+      PetscCall(PhlexSystemGather(m->sys, X, m->sys->q));
+      for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], m->sys->q, m->lossless_scheme));
+    }
+  }
   PetscFunctionReturn(0);
 }
 
