@@ -1139,6 +1139,8 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
   PetscCall(PetscTime(&t0));
   PetscCall(PhlexSystemCreateForScene(scene, &p.sys, &p.X));
+  /* its operators are the undamped ones at rest: a damper's R v would read as motion (refused, naming the options) */
+  for (PetscInt i = 0; i < p.sys->nparts; i++) PetscCheck(!p.sys->parts[i]->ops.dissipation, scene->comm, PETSC_ERR_SUP, "linearized analysis: body %s has structural damping (-%srayleigh_alpha, -%srayleigh_beta, -%sviscosity or -%smodal_damping_ratios); the linearised analysis gives undamped modes: run it without those options", p.sys->parts[i]->name, p.sys->parts[i]->prefix, p.sys->parts[i]->prefix, p.sys->parts[i]->prefix, p.sys->parts[i]->prefix);
   for (PetscInt k = 0; k < p.sys->njoints; k++) PetscCheck(!p.sys->joints[k]->ne, scene->comm, PETSC_ERR_SUP, "linearized analysis: joint %s is a force element (%s); the linearised analysis does not take force elements yet (run a transient analysis)", p.sys->joints[k]->name, PhlexJointTypes[p.sys->joints[k]->type]);
   PetscCall(VecDuplicate(p.X, &p.Xdot));
   PetscCall(VecSet(p.Xdot, 0.0));

@@ -481,7 +481,7 @@ static PetscErrorCode JacobianReuseOption(MPI_Comm comm, PetscReal *rate, PetscB
   PetscFunctionBeginUser;
   *rate = 0.0;
   PetscOptionsBegin(comm, NULL, "Transient analysis: Newton", NULL);
-  PetscCall(PetscOptionsReal("-snes_reuse_jacobian_below", "Newton (SNES newtonls) keeps the Jacobian and its factorization for the next iteration of a step when the last iteration reduced the residual norm by at least this factor (a stale Jacobian then contracts about as fast, at the cost of a residual); 0: a new Jacobian every iteration (options/solver/rigid.opts: 1e-3)", "PhlexSystemSNESConverged", *rate, rate, set));
+  PetscCall(PetscOptionsReal("-snes_reuse_jacobian_below", "Newton (SNES newtonls) keeps the Jacobian and its factorization for the next iteration of a step when the last iteration reduced the residual norm by at least this factor (a stale Jacobian then contracts about as fast, at the cost of a residual); 0: a new Jacobian every iteration (options/solver/rigid.opts: 0.1)", "PhlexSystemSNESConverged", *rate, rate, set));
   PetscOptionsEnd();
   PetscCheck(*rate >= 0 && *rate < 1, comm, PETSC_ERR_USER_INPUT, "-snes_reuse_jacobian_below must be in [0, 1) (0: off), got %g", (double)*rate);
   PetscFunctionReturn(0);

@@ -246,7 +246,7 @@ static PetscErrorCode ForceTableCheck(PhlexJoint j, const PetscReal tab[], Petsc
   PetscFunctionBeginUser;
   PetscCheck(type == PHLEX_JOINT_SPRING_DAMPER, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table is for a spring_damper joint, not %s", j->name, j->prefix, PhlexJointTypes[type]);
   PetscCheck(!stiffness, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give the spring as -%sstiffness or as -%sforce_table, not both", j->name, j->prefix, j->prefix);
-  PetscCheck(n <= 128, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table holds at most 64 points (pairs elongation, force)", j->name, j->prefix);
+  PetscCheck(n <= 128, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table holds at most 64 points (128 numbers: pairs elongation, force); got more", j->name, j->prefix);
   PetscCheck(n % 2 == 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table needs pairs elongation,force [m, N]; got %" PetscInt_FMT " numbers", j->name, j->prefix, n);
   PetscCheck(n >= 4, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table needs at least 2 points, got %" PetscInt_FMT, j->name, j->prefix, n / 2);
   for (PetscInt i = 0; i < n; i++) PetscCheck(!PetscIsInfOrNanReal(tab[i]), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sforce_table: value %" PetscInt_FMT " is not a finite number", j->name, j->prefix, i + 1);
@@ -272,7 +272,7 @@ static PetscErrorCode ElementOptionsCheck(PhlexJoint j, PhlexJointType type, Pet
   if (type == PHLEX_JOINT_SPRING_DAMPER && j->rest_length != -1.0) PetscCheck(j->rest_length >= 0 && !PetscIsInfOrNanReal(j->rest_length), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_length must be a finite length >= 0 [m], got %g", j->name, j->prefix, (double)j->rest_length);
   if (rot_opts) {
     PetscCheck(type == PHLEX_JOINT_REVOLUTE || type == PHLEX_JOINT_CYLINDRICAL, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srotational_stiffness, -%srotational_damping and -%srest_angle act on a free rotation (a revolute or cylindrical joint); a %s joint has none", j->name, j->prefix, j->prefix, j->prefix, PhlexJointTypes[type]);
-    PetscCheck(!PetscIsInfOrNanReal(j->rest_angle), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle must be a finite angle [deg]", j->name, j->prefix);
+    PetscCheck(!PetscIsInfOrNanReal(j->rest_angle), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle must be a finite angle [deg], got %g", j->name, j->prefix, (double)j->rest_angle);
     j->rot_element = PETSC_TRUE;
     j->rest_angle *= PETSC_PI / 180.0;
   }
@@ -350,6 +350,8 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   PetscCall(PetscOptionsReal("-stiffness", "Spring-damper: axial stiffness [N/m] (force on the second port -k (length - rest length) along the line)", "PhlexJointSetFromOptions", j->stiffness, &j->stiffness, &fk));
   PetscCall(PetscOptionsReal("-damping", "Spring-damper: axial damping [N s/m]", "PhlexJointSetFromOptions", j->damping, &j->damping, &fc));
   PetscCall(PetscOptionsReal("-rest_length", "Spring-damper: length at zero spring force [m] (default: the drawn distance of the two port points)", "PhlexJointSetFromOptions", j->rest_length, &j->rest_length, &fl));
+  /* -1 marks "as drawn" (set up later): a typed -1 is refused like any negative length */
+  PetscCheck(!fl || (j->rest_length >= 0 && !PetscIsInfOrNanReal(j->rest_length)), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_length must be a finite length >= 0 [m], got %g", j->name, j->prefix, (double)j->rest_length);
   PetscCall(PetscOptionsReal("-rotational_stiffness", "Revolute, cylindrical: torsion spring on the free rotation [N m/rad]", "PhlexJointSetFromOptions", j->stiffness, &j->stiffness, &frk));
   PetscCall(PetscOptionsReal("-rotational_damping", "Revolute, cylindrical: viscous friction (a rotational damper) on the free rotation [N m s/rad]", "PhlexJointSetFromOptions", j->damping, &j->damping, &frc));
   PetscCall(PetscOptionsReal("-rest_angle", "Revolute, cylindrical: the torsion spring's zero-moment angle relative to the drawn configuration [deg]", "PhlexJointSetFromOptions", j->rest_angle, &j->rest_angle, &fra));
@@ -531,7 +533,9 @@ PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const Phlex
     PhlexJointSide *side = &j->side[s];
     if (PhlexPartIsGround(side->part)) {
       for (PetscInt k = 0; k < 3; k++) side->offset[k] = xJ[k];
-    } else if (j->position_given) {
+    } else if (j->position_given || j->type == PHLEX_JOINT_BUSHING) {
+      /* a bushing closes no gap (no constraint rows): each side reaches the joint point from its own port, so the
+         drawn pose is its rest (zero deflection) */
       PetscReal d[3];
       for (PetscInt k = 0; k < 3; k++) d[k] = xJ[k] - xp[s][k];
       PhlexMatTVec3(Rp[s], d, side->offset);
@@ -683,7 +687,7 @@ static void WrenchesRDerivative(PhlexJoint j, PetscInt t, PetscInt m, const Pets
   PetscReal dwJ[6] = {0, 0, 0, 0, 0, 0};
 
   RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
-  for (PetscInt k = 0; k < NumRows(j); k++)
+  for (PetscInt k = 0; k < j->nc; k++) /* the cross direction is a constraint row's (no element row has one) */
     if (j->row[k] == PHLEX_ROW_CROSS) {
       PetscReal dsk[6];
       RowDirection(j, k, j->Rab, dRab, dsk);
@@ -1370,7 +1374,8 @@ PetscErrorCode PhlexJointView(PhlexJoint j, PetscViewer viewer)
       PetscCall(PetscStrlcat(line, j->erowname[i], sizeof(line)));
     }
     more[0] = 0;
-    if (j->type == PHLEX_JOINT_SPRING_DAMPER && j->ntable) PetscCall(PetscSNPrintf(more, sizeof(more), " (force table of %" PetscInt_FMT " points, c %.6g N s/m, rest length %.6g m)", j->ntable, (double)j->damping, (double)j->rest_length));
+    if (j->type == PHLEX_JOINT_SPRING_DAMPER && j->ntable && j->rest_length >= 0) PetscCall(PetscSNPrintf(more, sizeof(more), " (force table of %" PetscInt_FMT " points, c %.6g N s/m, rest length %.6g m)", j->ntable, (double)j->damping, (double)j->rest_length));
+    else if (j->type == PHLEX_JOINT_SPRING_DAMPER && j->ntable) PetscCall(PetscSNPrintf(more, sizeof(more), " (force table of %" PetscInt_FMT " points, c %.6g N s/m, rest length as drawn)", j->ntable, (double)j->damping));
     else if (j->type == PHLEX_JOINT_SPRING_DAMPER && j->rest_length >= 0) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N/m, c %.6g N s/m, rest length %.6g m)", (double)j->stiffness, (double)j->damping, (double)j->rest_length));
     else if (j->type == PHLEX_JOINT_SPRING_DAMPER) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N/m, c %.6g N s/m, rest length as drawn)", (double)j->stiffness, (double)j->damping));
     else if (j->rot_element) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N m/rad, c %.6g N m s/rad, rest angle %.6g deg)", (double)j->stiffness, (double)j->damping, (double)(j->rest_angle * 180.0 / PETSC_PI)));

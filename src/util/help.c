@@ -19,6 +19,7 @@ static char         *pending; /* the current line of stdout, built from several 
 static size_t        npending, maxpending;
 static char        **lines; /* help: the option lines printed so far (a repeated one is skipped); capture: names */
 static char          boundary_head[512]; /* a -dm_plex_boundary_label line whose garbage value held a newline: its start, up to '<' */
+static int           boundary_dropped;   /* the lines of its garbage dropped so far */
 static PetscInt      nlines, maxlines;
 static PetscErrorCode (*vfprintf_default)(FILE *, const char[], va_list);
 
@@ -157,14 +158,18 @@ static PetscErrorCode EmitLine(const char *line)
     const char *tail = strstr(line, ">: Label to mark the mesh boundary"), *head = strstr(line, "dm_plex_boundary_label <");
     char        rebuilt[1024];
     if (boundary_head[0]) {
-      if (!tail) PetscFunctionReturn(0);
-      PetscCall(PetscSNPrintf(rebuilt, sizeof(rebuilt), "%s%s", boundary_head, tail));
+      /* its garbage spans a few lines at most; should the tail's text ever change, the held line is given back with
+         an empty value after 8 lines, and nothing else of the help is lost beyond those */
+      if (!tail && ++boundary_dropped <= 8) PetscFunctionReturn(0);
+      PetscCall(PetscSNPrintf(rebuilt, sizeof(rebuilt), "%s%s", boundary_head, tail ? tail : ">\n"));
+      boundary_dropped = 0;
       boundary_head[0] = 0;
       PetscCall(EmitLine(rebuilt));
-      PetscFunctionReturn(0);
+      if (tail) PetscFunctionReturn(0); /* else this line is the help's own again: printed below */
     }
     if (head && !tail) {
       PetscCall(PetscSNPrintf(boundary_head, sizeof(boundary_head), "%.*s", (int)(head - line) + 24, line));
+      boundary_dropped = 0;
       PetscFunctionReturn(0);
     }
   }
