@@ -793,6 +793,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     }
   }
   if (PhlexHelpGetMode() == PHLEX_HELP_SOLVERS) {
+    PetscReal rate;
+    PetscBool set;
+    PetscCall(JacobianReuseOption(scene->comm, &rate, &set)); /* the solver preset's Newton option, listed too */
     PetscCall(PetscViewerDestroy(&m.monitor));
     PetscCall(VecDestroy(&X));
     PetscCall(TSDestroy(&ts));
