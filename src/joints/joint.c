@@ -368,6 +368,8 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   PetscCall(PetscOptionsRealArray("-stiffness_matrix", "Bushing: 6 x 6 stiffness, row-major, rows and columns t1,t2,t3,r1,r2,r3 of the joint frame [N/m, N/rad; N m/m, N m/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Kbuf, &nK, &j->Kgiven));
   PetscCall(PetscOptionsRealArray("-damping_matrix", "Bushing: 6 x 6 damping, the same layout [N s/m, N s/rad; N m s/m, N m s/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Cbuf, &nC, &j->Cgiven));
   PetscOptionsEnd();
+  /* a rest angle alone would make a torsion element of nothing */
+  PetscCheck(!fra || frk || frc, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle %g is the zero-moment angle of a torsion spring: give -%srotational_stiffness (and/or -%srotational_damping) too", j->name, j->prefix, (double)j->rest_angle, j->prefix, j->prefix);
   if (ftype) PetscCall(ElementOptionsCheck(j, (PhlexJointType)type, fk || fc || fl, frk || frc || fra, Kbuf, j->Kgiven ? nK : -1, Cbuf, j->Cgiven ? nC : -1));
   PetscCheck(ftype, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give its kind: -%stype fixed|revolute|spherical|prismatic|cylindrical|universal|planar|prescribed|spring_damper|bushing", j->name, j->prefix);
   j->type = (PhlexJointType)type;
