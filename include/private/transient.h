@@ -14,6 +14,7 @@ typedef struct {
   PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax, Emax; /* Emax: largest kinetic + strain energy */
   PetscReal   dissipated_total; /* the energy the dampers dissipated (>= 0); max_work: the largest of it and |work_total| */
   PetscBool   dissipative;      /* a part or joint has dampers (the summary and the monitor show the dissipation) */
+  PetscBool   element_tables;   /* a force element has a force table (its discrete gradient needs e_n) */
   PetscViewer energy_csv, monitor;
   PetscInt    interval, last_written;
   PetscBool   theta, endpoint;

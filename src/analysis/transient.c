@@ -220,10 +220,7 @@ static PetscErrorCode PreStep(TS ts)
   PetscCall(PhlexSystemUpdateJoints(m->sys, X, dt));
   /* the force elements' states at the step's start (a table spring's discrete gradient; only a table needs them) */
   {
-    PetscBool table = PETSC_FALSE;
-    for (PetscInt k = 0; k < m->sys->njoints; k++)
-      if (m->sys->joints[k]->ntable > 0) table = PETSC_TRUE;
-    if (table) {
+    if (m->element_tables) {
       PetscCall(PhlexSystemGather(m->sys, X, m->sys->q));
       for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], m->sys->q, m->lossless_scheme));
     }
@@ -926,8 +923,10 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   /* a part with dampers: the summary and the monitor say what was dissipated */
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->ops.dissipation) m.dissipative = PETSC_TRUE;
-  for (PetscInt k = 0; k < sys->njoints; k++)
+  for (PetscInt k = 0; k < sys->njoints; k++) {
     if (PhlexJointDamped(sys->joints[k])) m.dissipative = PETSC_TRUE;
+    if (sys->joints[k]->ntable > 0) m.element_tables = PETSC_TRUE; /* PreStep keeps their states at a step's start */
+  }
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
   m.watch_balance   = o.watch_balance;
