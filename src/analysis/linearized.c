@@ -22,11 +22,16 @@
    A part of the elastic velocities' rows in their columns (Kr eta), becomes K_zz = -A_ze E_ee^{-1} A_ez on the
    elastic velocities zeta, which are kept with the frames' velocities.
 
+   Force elements and damping (linearized_damped.c): an element's force impulses and states are eliminated onto the
+   velocities (its springs on K, its dampers on R); with damping (the bodies' R, a reduced body's modal damping, the
+   dampers) the pencil is quadratic, (K + lambda R + lambda^2 M) with the constraints' saddle point, solved by SLEPc PEP
+   and reported as undamped natural frequency and damping ratio per mode.
+
    Everything that does not depend on the configuration is built once: K and M of the field (body frame), the
    eigensolver and the symbolic factorisation; per configuration only the constraint rows and the frame couplings are
    rebuilt (the joints turn), and the loop is closed by the assembly's Newton at the swept drive position. */
 #include <phlex_impl.h>
-#include <slepcpep.h>
+#include <private/linearized.h>
 
 typedef struct {
   PetscInt  nev;
@@ -39,6 +44,9 @@ typedef struct {
   PetscReal expected[65], rtol, rmax;
   PetscInt  nexp;
   PetscBool has_exp;
+  PetscReal zexpected[65], zrtol; /* damping ratios expected (self-check) */
+  PetscInt  nzexp;
+  PetscBool has_zexp;
   PetscReal spins[1025];    /* spin rates of the configurations [rad/s] (a sweep over a body's -spin) */
   PetscInt  nspins;
   PetscBool coriolis;       /* keep the Coriolis (gyroscopic) terms of a spin: a quadratic eigenproblem */
@@ -56,6 +64,8 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
   o->nvalues              = 1025;
   o->nexp                 = 65;
   o->rtol                 = 1e-6;
+  o->nzexp                = 65;
+  o->zrtol                = 1e-6;
   o->rmax                 = -1;
   o->fields_configuration = 0;
   o->nspins               = 1025;
@@ -72,8 +82,12 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
   PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] of the first configuration (self-check)", "PhlexSceneSolveLinearized", o->expected, &o->nexp, &o->has_exp));
   PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveLinearized", o->rtol, &o->rtol, NULL));
   PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveLinearized", o->rmax, &o->rmax, NULL));
+  PetscCall(PetscOptionsRealArray("-expect_damping_ratios", "Expected damping ratios [-] of the first configuration's modes (self-check of a damped assembly)", "PhlexSceneSolveLinearized", o->zexpected, &o->nzexp, &o->has_zexp));
+  PetscCall(PetscOptionsReal("-expect_damping_ratios_rtol", "Relative tolerance of -expect_damping_ratios", "PhlexSceneSolveLinearized", o->zrtol, &o->zrtol, NULL));
   PetscOptionsEnd();
   PetscCheck(o->nev >= 1, comm, PETSC_ERR_USER_INPUT, "-linearized_nev must be >= 1, got %" PetscInt_FMT, o->nev);
+  if (!o->has_zexp) o->nzexp = 0;
+  PetscCheck(o->nzexp <= 64, comm, PETSC_ERR_USER_INPUT, "-expect_damping_ratios: at most 64 values");
   PetscCheck(!(o->has_values && o->has_range), comm, PETSC_ERR_USER_INPUT, "give either -linearized_sweep or -linearized_sweep_range, not both");
   PetscCheck(!o->has_values || o->nvalues <= 1024, comm, PETSC_ERR_USER_INPUT, "-linearized_sweep: at most 1024 values (use -linearized_sweep_range)");
   if (!o->has_values) o->nvalues = 0;
@@ -203,24 +217,6 @@ static PetscErrorCode LinearizedRereadOptions(void *ctx)
   PetscFunctionReturn(0);
 }
 
-/* The pencil's pieces that do not change with the configuration, the index maps of the discrete unknowns, and the
-   per-configuration matrices. Q numbers the kept discrete unknowns: the velocities first, then the impulses. */
-typedef struct {
-  PhlexSystem sys;
-  Vec         X, Xdot;
-  PetscInt    nqv, nqi, nQ; /* discrete velocities, impulses, both */
-  PetscInt   *qmap;         /* discrete unknown -> Q index (-1: a configuration unknown, dropped) */
-  PetscInt   *Qq;           /* Q index -> discrete unknown */
-  PetscInt    ne;           /* elastic coordinates (eliminated: their stiffness goes onto their velocities) */
-  PetscInt   *Ee;           /* their discrete unknowns */
-  Mat         K, Mvv;       /* field stiffness (stress eliminated; with a stressed or spinning state's K_sigma + Cen) and mass */
-  Mat         Gyr;          /* the fields' gyroscopic (Coriolis) matrix about a spin, or NULL */
-  Mat         A, B, A1;     /* the saddle-point pencil (the same nonzero pattern in every configuration); A1 its Coriolis part */
-  IS          isV, isQ;     /* the velocity field and Q in the pencil's numbering */
-  PetscReal   scale;        /* |M| (the at-rest checks are relative to it) */
-  PetscBool   coriolis;     /* -linearized_coriolis: the Coriolis part kept (a quadratic eigenproblem) */
-} Pencil;
-
 /* the n values of a vector that lives on rank 0, on every rank */
 static PetscErrorCode RootValues(MPI_Comm comm, Vec x, PetscInt n, PetscReal *out)
 {
@@ -297,14 +293,15 @@ static PetscErrorCode BodiesOperator(PhlexSystem sys, PetscInt which, Mat *S)
    -geometric_stiffening and a stress), K gains the state's stiffness K_sigma + Cen (initial stress, spin softening)
    and G(u0) replaces G, and the Coriolis matrix is the pencil's gyroscopic part. Checks on a random vector that the
    velocity rows have no other term in v or u at the linearisation point (at rest: no other gyroscopic load, no
-   preload) and that the velocity block of the system's Jacobian is s M + Coriolis there. Rebuilt per configuration
-   of a spin sweep (the state and its stress change); built once otherwise. */
+   preload) and that the velocity block of the system's Jacobian is s M + Coriolis + R there (R: the structural
+   damping, the pencil's damping part). Rebuilt per configuration of a spin sweep (the state and its stress change);
+   built once otherwise. */
 static PetscErrorCode BuildFieldOperators(Pencil *p)
 {
   PhlexSystem sys = p->sys;
   Vec         x, y1, y2, yu1, yu2, xu = NULL, g = NULL;
   PetscReal   rel, dev, nm;
-  Mat         Kst = NULL, Gyr = NULL;
+  Mat         Kst = NULL, Gyr = NULL, Rd = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(sys->Jvv, &x, &y1));
@@ -326,6 +323,7 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
   PetscCall(MatDestroy(&p->Mvv));
   PetscCall(MatDestroy(&p->K));
   PetscCall(MatDestroy(&p->Gyr));
+  PetscCall(MatDestroy(&p->Rf));
   PetscCall(BodiesOperator(sys, 1, &p->Mvv));
   PetscCall(BodiesOperator(sys, 2, &p->K));
   PetscCall(PhlexSystemCondensedOperator(sys, 3, &Kst));
@@ -337,17 +335,21 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
     PetscCall(MatDestroy(&Ka));
   }
   if (Gyr) PetscCall(ToAIJ(Gyr, &p->Gyr));
+  PetscCall(PhlexSystemCondensedOperator(sys, 5, &Rd));
+  if (Rd) PetscCall(ToAIJ(Rd, &p->Rf));
   PetscCall(MatSetOption(p->K, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(MatNorm(p->Mvv, NORM_FROBENIUS, &nm));
   p->scale = nm;
-  /* at rest or in a steady spin: the velocity block of the Jacobian is s M + Coriolis, nothing else */
+  /* at rest or in a steady spin: the velocity block of the Jacobian is s M + Coriolis + R, nothing else */
   PetscCall(VecDuplicate(y1, &g));
   PetscCall(VecAXPBYPCZ(g, 2.0, -1.0, 0.0, y1, y2)); /* its A part */
-  if (Gyr) {
+  for (PetscInt k = 0; k < 2; k++) {
+    Mat O = k ? Rd : Gyr;
     Vec gx;
+    if (!O) continue;
     PetscCall(VecDuplicate(y1, &gx));
-    PetscCall(MatMult(Gyr, x, gx));
-    PetscCall(VecAXPY(g, -1.0, gx)); /* less the Coriolis term */
+    PetscCall(MatMult(O, x, gx));
+    PetscCall(VecAXPY(g, -1.0, gx)); /* less the Coriolis term, the damping */
     PetscCall(VecDestroy(&gx));
   }
   {
@@ -391,6 +393,7 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
   }
   PetscCall(MatDestroy(&Kst));
   PetscCall(MatDestroy(&Gyr));
+  PetscCall(MatDestroy(&Rd));
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&xu));
   PetscCall(VecDestroy(&y1));
@@ -417,6 +420,19 @@ static PetscErrorCode BuildDiscreteMap(Pencil *p)
   for (PetscInt k = 0; k < sys->nq; k++)
     if (sys->qkind[k] == PHLEX_DOF_IMPULSE) p->Qq[p->nQ] = k, p->qmap[k] = p->nQ++;
   p->nqi = p->nQ - p->nqv;
+  /* the force elements' rows, force impulse i and state i of each joint in turn (eliminated like the stress) */
+  for (PetscInt k = 0; k < sys->njoints; k++) p->nel += sys->joints[k]->ne;
+  PetscCall(PetscMalloc3(PetscMax(p->nel, 1), &p->elF, PetscMax(p->nel, 1), &p->elE, PetscMax(sys->nq, 1), &p->qdamped));
+  p->nel = 0;
+  for (PetscInt k = 0; k < sys->nq; k++)
+    if (sys->qkind[k] == PHLEX_DOF_ELEMENT_FORCE) p->elF[p->nel++] = k;
+  p->nel = 0;
+  for (PetscInt k = 0; k < sys->nq; k++)
+    if (sys->qkind[k] == PHLEX_DOF_ELEMENT) p->elE[p->nel++] = k;
+  for (PetscInt k = 0; k < sys->nq; k++) p->qdamped[k] = PETSC_FALSE;
+  for (PetscInt i = 0; i < sys->nparts; i++)
+    if (sys->parts[i]->ops.dissipation)
+      for (PetscInt m = 0; m < sys->parts[i]->nq; m++) p->qdamped[sys->parts[i]->qoff + m] = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
 
@@ -439,8 +455,75 @@ static PetscErrorCode SetRest(Pencil *p)
   PetscFunctionReturn(0);
 }
 
+/* The force elements' rows on the velocity field (A parts; at rest they have no rate of the field): from the power-
+   preserving interconnection, the state rows e' = S^T V give A_EV = B_VF^T and the force rows lambda = -(K e + C S^T V)
+   give A_FV = -C B_VF^T, with B_VF = the field rows' E part in the force impulses' columns (-S, the force distribution,
+   BE's columns). The discrete rows of the system (Cqv, a product only) are checked against them on a random vector. */
+static PetscErrorCode ElementFieldRows(Pencil *p, Mat BE)
+{
+  PhlexSystem        sys = p->sys;
+  const PetscInt     nel = p->nel;
+  PetscReal         *C, *yq, diff = 0, ref = 0;
+  const PetscScalar *be;
+  PetscInt           ld, nvl;
+  Vec                x, y;
+
+  PetscFunctionBeginUser;
+  /* the elements' dampers, joint by joint (non-dimensional, as the Jacobian's) */
+  PetscCall(PetscCalloc2(nel * nel, &C, PetscMax(sys->nq, 1), &yq));
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PhlexJoint j = sys->joints[k];
+    for (PetscInt i = 0; i < j->ne; i++)
+      for (PetscInt l = 0; l < j->ne; l++) {
+        PetscInt a = -1, b = -1;
+        for (PetscInt m = 0; m < nel; m++) {
+          if (p->elF[m] == j->qoff + j->nc + i) a = m;
+          if (p->elF[m] == j->qoff + j->nc + l) b = m;
+        }
+        C[a * nel + b] = j->C[j->ne * i + l];
+      }
+  }
+  PetscCall(MatDenseGetLDA(BE, &ld));
+  PetscCall(MatGetLocalSize(BE, &nvl, NULL));
+  PetscCall(MatDenseGetArrayRead(BE, &be));
+  for (PetscInt a = 0; a < 2 * nel; a++)
+    if (!p->elrows[a]) PetscCall(MatCreateVecs(sys->Cqv, &p->elrows[a], NULL));
+  for (PetscInt a = 0; a < nel; a++) {
+    PetscScalar *rf, *re;
+    PetscCall(VecGetArray(p->elrows[a], &rf));
+    PetscCall(VecGetArray(p->elrows[nel + a], &re));
+    for (PetscInt r = 0; r < nvl; r++) {
+      PetscReal f = 0;
+      for (PetscInt b = 0; b < nel; b++) f -= C[a * nel + b] * PetscRealPart(be[p->elF[b] * ld + r]);
+      re[r] = be[p->elF[a] * ld + r];
+      rf[r] = f;
+    }
+    PetscCall(VecRestoreArray(p->elrows[a], &rf));
+    PetscCall(VecRestoreArray(p->elrows[nel + a], &re));
+  }
+  PetscCall(MatDenseRestoreArrayRead(BE, &be));
+  /* the check: the system's element rows (at the last shift: no rate of the field in them) on a random field vector */
+  PetscCall(MatCreateVecs(sys->Cqv, &x, &y));
+  PetscCall(VecSetRandom(x, NULL));
+  PetscCall(MatMult(sys->Cqv, x, y));
+  PetscCall(RootValues(sys->comm, y, sys->nq, yq));
+  for (PetscInt a = 0; a < 2 * nel; a++) {
+    const PetscInt q = a < nel ? p->elF[a] : p->elE[a - nel];
+    PetscScalar    d;
+    PetscCall(VecDot(p->elrows[a], x, &d));
+    diff = PetscMax(diff, PetscAbsReal(PetscRealPart(d) - yq[q]));
+    ref  = PetscMax(ref, PetscAbsReal(yq[q]));
+  }
+  PetscCheck(diff <= 1e-9 * PetscMax(ref, 1e-300), sys->comm, PETSC_ERR_PLIB, "linearized analysis: the force elements' rows on the velocity field differ from their transposed force distribution by %g (relative): an element breaks the power-preserving interconnection", (double)(diff / PetscMax(ref, 1e-300)));
+  PetscCall(VecDestroy(&x));
+  PetscCall(VecDestroy(&y));
+  PetscCall(PetscFree2(C, yq));
+  PetscFunctionReturn(0);
+}
+
 /* The border between the velocity field and the discrete unknowns at the current configuration, E and A parts
-   (n_v x nq dense, from nq products with the Jacobian's border), and the dense discrete block's */
+   (n_v x nq dense, from nq products with the Jacobian's border), and the dense discrete block's; the force elements'
+   rows on the field (p->elrows, their A parts: at rest they have no rate of the field) */
 static PetscErrorCode Borders(Pencil *p, Mat *BE, Mat *BA, PetscReal *DE, PetscReal *DA)
 {
   PhlexSystem     sys = p->sys;
@@ -455,6 +538,10 @@ static PetscErrorCode Borders(Pencil *p, Mat *BE, Mat *BA, PetscReal *DE, PetscR
   if (sys->Bvq) {
     PetscCall(MatComputeOperator(sys->Bvq, MATDENSE, BE));
     PetscCall(SplitShift(*BA, *BE));
+  }
+  if (p->nel && *BE) {
+    if (!p->elrows) PetscCall(PetscCalloc1(2 * p->nel, &p->elrows));
+    PetscCall(ElementFieldRows(p, *BE));
   }
   for (PetscInt k = 0; k < nq2; k++) {
     const PetscReal j1 = DA[k], j2 = sys->D[k];
@@ -519,27 +606,34 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
   const PetscInt     nq = sys->nq, nQ = p->nQ, nqv = p->nqv;
   PetscMPIInt        rank;
   PetscInt           nvl = 0, Ql;
-  PetscReal         *DE, *DA, *Kq = NULL, dmax = 0, worst = 0;
-  Mat                BE = NULL, BA = NULL, AvQ = NULL, BvQ = NULL, AQv = NULL, BQv = NULL, AQQ, BQQ, N, blocks[4];
+  PetscReal         *DE, *DA, *Kq = NULL, *Rq = NULL, dmax = 0, worst = 0, rmax = 0, rasym = 0;
+  Mat                BE = NULL, BA = NULL, AvQ = NULL, BvQ = NULL, AQv = NULL, BQv = NULL, AQQ, BQQ, RQQ = NULL, N, blocks[4];
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(sys->comm, &rank));
   Ql = rank == 0 ? nQ : 0;
   PetscCall(PetscMalloc2(PetscMax(nq * nq, 1), &DE, PetscMax(nq * nq, 1), &DA));
   if (p->ne) PetscCall(PetscCalloc1(nqv * nqv, &Kq));
+  PetscCall(PetscCalloc1(PetscMax(nqv * nqv, 1), &Rq));
   PetscCall(Borders(p, &BE, &BA, DE, DA));
   for (PetscInt k = 0; k < nq * nq; k++) dmax = PetscMax(dmax, PetscAbsReal(DE[k]));
   dmax = PetscMax(dmax, p->scale);
-  /* at rest: no A part among the velocities, no coupling of the configuration into the kept rows (of the elastic
-     coordinates only their stiffness, the A part of the velocities' rows) */
+  /* at rest: no A part among the velocities but the damping of a part that dissipates (a reduced body's), no
+     coupling of the configuration into the kept rows (of the elastic coordinates only their stiffness, the A part of
+     the velocities' rows; of the force elements' force impulses only their force distribution, like a multiplier's) */
   for (PetscInt i = 0; i < nq; i++)
     for (PetscInt j = 0; j < nq; j++) {
       const PetscInt ii = p->qmap[i], jj = p->qmap[j];
       if (ii < 0) continue;
       if (jj < 0 && sys->qkind[j] == PHLEX_DOF_ELASTIC) worst = PetscMax(worst, PetscAbsReal(DE[i * nq + j]) + (ii < nqv ? 0.0 : PetscAbsReal(DA[i * nq + j])));
+      else if (jj < 0 && sys->qkind[j] == PHLEX_DOF_ELEMENT_FORCE && ii < nqv) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]));
       else if (jj < 0) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]) + PetscAbsReal(DE[i * nq + j]));
+      else if (ii < nqv && jj < nqv && p->qdamped[i] && p->qdamped[j]) Rq[ii * nqv + jj] = DA[i * nq + j], rmax = PetscMax(rmax, PetscAbsReal(DA[i * nq + j]));
       else if (ii < nqv && jj < nqv) worst = PetscMax(worst, PetscAbsReal(DA[i * nq + j]));
     }
+  for (PetscInt ii = 0; ii < nqv; ii++)
+    for (PetscInt jj = 0; jj < ii; jj++) rasym = PetscMax(rasym, PetscAbsReal(Rq[ii * nqv + jj] - Rq[jj * nqv + ii]));
+  PetscCheck(rasym <= 1e-10 * rmax, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the velocity terms of the discrete velocities' equations are not symmetric (relative deviation %g): not a damping, a motion (gyroscopic terms); linearise about rest", (double)(rasym / rmax));
   PetscCheck(worst <= 1e-10 * dmax, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration is not at rest or is loaded (a term of relative size %g couples the frames' positions or velocities into their equations: gravity, a preload, a spinning body); linearise about an unloaded configuration at rest", (double)(worst / dmax));
   /* the power-preserving structure: the impulse columns of the velocity rows are minus the transposed constraint
      rows; the frame couplings symmetric */
@@ -572,7 +666,7 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
         const PetscReal e = PetscRealPart(be[j * ld + r]), a = PetscRealPart(ba[j * ld + r]);
         PetscInt        row = rs + r;
         emax = PetscMax(emax, PetscAbsReal(e));
-        if (jj < 0 || jj < nqv) amax = PetscMax(amax, PetscAbsReal(a) + (jj < 0 ? PetscAbsReal(e) : 0.0));
+        if (jj < 0 || jj < nqv) amax = PetscMax(amax, PetscAbsReal(a) + (jj < 0 && sys->qkind[j] != PHLEX_DOF_ELEMENT_FORCE ? PetscAbsReal(e) : 0.0));
         if (jj < 0) continue;
         /* every entry, zeros included: the same pattern in every configuration (the factorisation's analysis is reused) */
         if (jj < nqv) {
@@ -625,9 +719,6 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       PetscCall(VecDestroy(&yQ));
     }
   }
-  PetscCall(MatDestroy(&BE));
-  PetscCall(MatDestroy(&BA));
-
   /* the discrete block (on rank 0), all entries of the kept pattern */
   PetscCall(MatCreateAIJ(sys->comm, Ql, Ql, nQ, nQ, nQ, NULL, 0, NULL, &AQQ));
   PetscCall(MatCreateAIJ(sys->comm, Ql, Ql, nQ, nQ, nQ, NULL, 0, NULL, &BQQ));
@@ -647,24 +738,43 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
   PetscCall(MatAssemblyBegin(BQQ, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(AQQ, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(BQQ, MAT_FINAL_ASSEMBLY));
+  if (p->damped) {
+    /* the discrete velocities' damping (a reduced body's modal or Rayleigh damping), on the same pattern */
+    PetscCall(MatCreateAIJ(sys->comm, Ql, Ql, nQ, nQ, nQ, NULL, 0, NULL, &RQQ));
+    if (rank == 0)
+      for (PetscInt ii = 0; ii < nQ; ii++)
+        for (PetscInt jj = 0; jj < nQ; jj++) PetscCall(MatSetValue(RQQ, ii, jj, ii < nqv && jj < nqv ? Rq[ii * nqv + jj] : 0.0, INSERT_VALUES));
+    PetscCall(MatAssemblyBegin(RQQ, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(RQQ, MAT_FINAL_ASSEMBLY));
+  }
 
-  /* mechanism modes: the frames' and points' velocities the constraints leave free, nf - rank(Cq) on them (their
-     field is zero: a frame patch clamps it, mean axes constrain its rigid content; elastic velocities have stiffness) */
+  /* mechanism modes: the frames' and points' velocities the constraints and the force elements' springs leave free,
+     nf - rank([Cq; K_el]) on them (their field is zero: a frame patch clamps it, mean axes constrain its rigid
+     content; elastic velocities have stiffness); each block scaled to its largest entry */
   {
-    PetscReal   *C, *s, work[1];
-    PetscInt     nf = 0, *fcol;
-    PetscBLASInt m = (PetscBLASInt)p->nqi, n, lwork = -1, info, one = 1;
+    PetscReal   *C, *s, work[1], *Kdd = NULL, cmax = 0, kmax = 0;
+    PetscInt     nf = 0, *fcol, mk = p->nel ? nqv : 0;
+    PetscBLASInt m = (PetscBLASInt)(p->nqi + mk), n, lwork = -1, info, one = 1;
     PetscInt     rnk = 0;
     PetscCall(PetscMalloc1(PetscMax(nqv, 1), &fcol));
     for (PetscInt jj = 0; jj < nqv; jj++)
       if (sys->qkind[p->Qq[jj]] == PHLEX_DOF_VELOCITY) fcol[nf++] = jj;
     n      = (PetscBLASInt)nf;
     *nmech = nf;
+    if (mk) {
+      PetscCall(PetscMalloc1(nqv * nqv, &Kdd));
+      PetscCall(PhlexLinearizedElementDiscreteStiffness(p, DE, DA, Kdd));
+      for (PetscInt k = 0; k < nqv * nqv; k++) kmax = PetscMax(kmax, PetscAbsReal(Kdd[k]));
+    }
     if (m && n) {
       PetscReal *w;
       PetscCall(PetscMalloc2(m * n, &C, PetscMin(m, n), &s));
-      for (PetscInt ii = 0; ii < m; ii++)
-        for (PetscInt jj = 0; jj < n; jj++) C[jj * m + ii] = DA[p->Qq[nqv + ii] * nq + p->Qq[fcol[jj]]]; /* column-major */
+      for (PetscInt ii = 0; ii < p->nqi; ii++)
+        for (PetscInt jj = 0; jj < n; jj++) cmax = PetscMax(cmax, PetscAbsReal(DA[p->Qq[nqv + ii] * nq + p->Qq[fcol[jj]]]));
+      for (PetscInt ii = 0; ii < p->nqi; ii++)
+        for (PetscInt jj = 0; jj < n; jj++) C[jj * m + ii] = DA[p->Qq[nqv + ii] * nq + p->Qq[fcol[jj]]] / (cmax > 0 ? cmax : 1.0); /* column-major */
+      for (PetscInt ii = 0; ii < mk; ii++)
+        for (PetscInt jj = 0; jj < n; jj++) C[jj * m + p->nqi + ii] = Kdd[ii * nqv + fcol[jj]] / (kmax > 0 ? kmax : 1.0);
       PetscCallBLAS("LAPACKgesvd", LAPACKgesvd_("N", "N", &m, &n, C, &m, s, NULL, &one, NULL, &one, work, &lwork, &info));
       lwork = (PetscBLASInt)work[0];
       PetscCall(PetscMalloc1(lwork, &w));
@@ -676,10 +786,9 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       PetscCall(PetscFree(w));
       PetscCall(PetscFree2(C, s));
     }
+    PetscCall(PetscFree(Kdd));
     PetscCall(PetscFree(fcol));
   }
-  PetscCall(PetscFree2(DE, DA));
-  PetscCall(PetscFree(Kq));
   /* a fixed body without a clamp moves rigidly inside its field: six more zero modes (joints on it are not counted) */
   for (PetscInt f = 0; f < sys->nfparts; f++) {
     PhlexPart part = sys->fparts[f];
@@ -690,9 +799,9 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
     if (nrig > 0) *nmech += nrig;
   }
 
-  /* the pencil: [[K, AvQ], [AQv, AQQ]] and [[M, BvQ], [BQv, BQQ]] */
+  /* the pencil: [[K, AvQ], [AQv, AQQ]] and [[M, BvQ], [BQv, BQQ]] (and the force elements' stiffness) */
   {
-    Mat A, B;
+    Mat A, B, Kel = NULL, Rel = NULL;
     blocks[0] = p->K, blocks[1] = AvQ, blocks[2] = AQv, blocks[3] = AQQ;
     PetscCall(MatCreateNest(sys->comm, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? blocks : &blocks[3], &N));
     if (!p->isV && sys->nfparts) {
@@ -711,7 +820,14 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
     PetscCall(MatCreateNest(sys->comm, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? 2 : 1, NULL, sys->nfparts ? blocks : &blocks[3], &N));
     PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &B));
     PetscCall(MatDestroy(&N));
-    if (!p->A) {
+    if (p->nel) {
+      PetscCall(PhlexLinearizedElementOperators(p, DE, DA, BE, &Kel, &Rel));
+      PetscCall(MatAXPY(A, 1.0, Kel, DIFFERENT_NONZERO_PATTERN));
+    }
+    if (!p->A || p->nel) {
+      /* with force elements the pattern follows their lines of action: new matrices (a new symbolic factorisation) */
+      PetscCall(MatDestroy(&p->A));
+      PetscCall(MatDestroy(&p->B));
       p->A = A, p->B = B;
       PetscCall(MatSetOption(p->A, MAT_SYMMETRIC, PETSC_TRUE));
       PetscCall(MatSetOption(p->B, MAT_SYMMETRIC, PETSC_TRUE));
@@ -722,19 +838,37 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
       PetscCall(MatDestroy(&A));
       PetscCall(MatDestroy(&B));
     }
-    if (p->Gyr && p->coriolis) {
-      /* the Coriolis part: [[Gyr, 0], [0, 0]] */
-      Mat G[4] = {p->Gyr, NULL, NULL, NULL}, A1;
+    if ((p->Gyr && p->coriolis) || p->damped) {
+      /* the part proportional to the rate: [[Gyr + R, 0], [0, R_QQ]] and the force elements' dampers */
+      Mat F = NULL, A1, G[4] = {NULL, NULL, NULL, RQQ};
       IS  is[2] = {p->isV, p->isQ};
-      PetscCall(MatCreateNest(sys->comm, 2, is, 2, is, G, &N));
+      if (sys->nfparts) {
+        PetscCall(MatDuplicate(p->Mvv, MAT_DO_NOT_COPY_VALUES, &F)); /* zero on M's pattern: a body with neither */
+        if (p->Gyr && p->coriolis) PetscCall(MatAXPY(F, 1.0, p->Gyr, DIFFERENT_NONZERO_PATTERN));
+        if (p->Rf) PetscCall(MatAXPY(F, 1.0, p->Rf, DIFFERENT_NONZERO_PATTERN));
+        G[0] = F;
+      }
+      if (!RQQ) {
+        PetscCall(MatCreateAIJ(sys->comm, Ql, Ql, nQ, nQ, 0, NULL, 0, NULL, &RQQ));
+        PetscCall(MatAssemblyBegin(RQQ, MAT_FINAL_ASSEMBLY));
+        PetscCall(MatAssemblyEnd(RQQ, MAT_FINAL_ASSEMBLY));
+        G[3] = RQQ;
+      }
+      PetscCall(MatCreateNest(sys->comm, sys->nfparts ? 2 : 1, sys->nfparts ? is : &is[1], sys->nfparts ? 2 : 1, sys->nfparts ? is : &is[1], sys->nfparts ? G : &G[3], &N));
       PetscCall(MatConvert(N, MATAIJ, MAT_INITIAL_MATRIX, &A1));
       PetscCall(MatDestroy(&N));
-      if (!p->A1) p->A1 = A1;
-      else {
+      PetscCall(MatDestroy(&F));
+      if (Rel) PetscCall(MatAXPY(A1, 1.0, Rel, DIFFERENT_NONZERO_PATTERN));
+      if (!p->A1 || p->nel) {
+        PetscCall(MatDestroy(&p->A1));
+        p->A1 = A1;
+      } else {
         PetscCall(MatCopy(A1, p->A1, SAME_NONZERO_PATTERN));
         PetscCall(MatDestroy(&A1));
       }
     }
+    PetscCall(MatDestroy(&Kel));
+    PetscCall(MatDestroy(&Rel));
   }
   PetscCall(MatDestroy(&AvQ));
   PetscCall(MatDestroy(&BvQ));
@@ -742,6 +876,12 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
   PetscCall(MatDestroy(&BQv));
   PetscCall(MatDestroy(&AQQ));
   PetscCall(MatDestroy(&BQQ));
+  PetscCall(MatDestroy(&RQQ));
+  PetscCall(MatDestroy(&BE));
+  PetscCall(MatDestroy(&BA));
+  PetscCall(PetscFree2(DE, DA));
+  PetscCall(PetscFree(Kq));
+  PetscCall(PetscFree(Rq));
   PetscFunctionReturn(0);
 }
 
@@ -818,19 +958,13 @@ static PetscErrorCode MoveTo(Pencil *p, PhlexJoint j, PetscReal from, PetscReal 
   PetscFunctionReturn(0);
 }
 
-typedef struct {
-  PetscInt   n, nmech;
-  PetscReal *theta, *resid; /* non-dimensional omega^2 (the oscillating part's), ascending; relative residuals */
-  PetscReal *growth;        /* non-dimensional growth rate of an unstable mode (0: stable) */
-  Vec       *x;             /* eigenvectors (pencil numbering), when asked */
-} Spectrum;
-
 static PetscErrorCode SpectrumDestroy(Spectrum *s)
 {
   PetscFunctionBeginUser;
   for (PetscInt i = 0; s->x && i < s->n; i++) PetscCall(VecDestroy(&s->x[i]));
   PetscCall(PetscFree(s->x));
   PetscCall(PetscFree3(s->theta, s->resid, s->growth));
+  PetscCall(PetscFree3(s->zeta, s->decay, s->wd));
   PetscCall(PetscMemzero(s, sizeof(*s)));
   PetscFunctionReturn(0);
 }
@@ -865,8 +999,9 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
   PetscCall(PetscCalloc3(want, &s->theta, want, &s->resid, want, &s->growth));
   if (vectors) PetscCall(PetscCalloc1(want, &s->x));
   {
-    /* ascending eigenvalues (a target given with -linearized_eps_target changes the solver's order); a zero one
-       (|omega^2| below 1e-8 of the largest computed) is a mechanism mode */
+    /* the want eigenvalues nearest the target (the solver's order; beyond them it may have converged spurious ones
+       of the infinite eigenvalues of the singular B), ascending; a zero one (|omega^2| below 1e-8 of the largest of
+       them) is a mechanism mode */
     PetscReal *th, thmax;
     PetscInt  *perm;
     PetscCall(PetscMalloc2(nconv, &th, nconv, &perm));
@@ -876,8 +1011,9 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
       th[i]   = PetscRealPart(kr);
       perm[i] = i;
     }
-    PetscCall(PetscSortRealWithPermutation(nconv, th, perm));
-    thmax = PetscAbsReal(th[want - 1]); /* zero: relative to the spectrum computed (the time scale is arbitrary) */
+    PetscCall(PetscSortRealWithPermutation(want, th, perm));
+    thmax = 0; /* zero: relative to the spectrum computed (the time scale is arbitrary) */
+    for (PetscInt i = 0; i < want; i++) thmax = PetscMax(thmax, PetscAbsReal(th[i]));
     PetscCall(MatCreateVecs(p->A, &x, NULL));
     for (PetscInt i = 0; i < want; i++) {
       const PetscInt e = perm[i];
@@ -901,6 +1037,59 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
   s->nmech = nzero;
   PetscCheck(nzero == nmech, p->sys->comm, PETSC_ERR_NOT_CONVERGED, "linearized analysis: %" PetscInt_FMT " zero-frequency modes found where the constraints leave %" PetscInt_FMT " mechanism modes: a body's rigid motion is free without a frame (a fixed body without a clamp), or the spectrum is badly scaled (-scale_length)", nzero, nmech);
   PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
+  PetscFunctionReturn(0);
+}
+
+/* A damped assembly whose mechanism moves: its nmech mechanism modes N (the undamped pencil's zero modes) are zero
+   eigenvalues of the quadratic pencil, semisimple where the damping acts on them and double (defective) where it does
+   not, nzero = 2 nmech - rank(N^T A1 N) in all. Those computed carry errors of sqrt(tolerance) (1e-6 of the spectrum)
+   and defective ones may not converge or come with spurious copies: the eigenvalues below 1e-3 of the undamped
+   pencil's lowest pulsation are taken for them (an overdamped motion slower than that is taken for a mechanism's). The shift goes to the undamped pencil's lowest
+   pulsation on the negative real axis (unless -linearized_pep_target is given): about 0 the defective eigenvalues
+   would take the Krylov space (modes to 1e-9). */
+static PetscErrorCode DampedMechanism(Pencil *p, EPS eps, PEP pep, PetscInt nmech, PetscInt *nzero, PetscReal *zero_tol)
+{
+  Spectrum     u;
+  PetscBool    given;
+  PetscReal   *G, *sv, work[1], *w, a1, gmax = 0;
+  PetscBLASInt n = (PetscBLASInt)nmech, lwork = -1, info, one = 1;
+  PetscInt     rank = 0;
+  Vec          y;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&u, sizeof(u)));
+  PetscCall(SolvePencil(p, eps, 1, nmech, PETSC_TRUE, &u));
+  PetscCall(PetscOptionsHasName(NULL, "linearized_", "-pep_target", &given));
+  if (!given) PetscCall(PEPSetTarget(pep, -PetscSqrtReal(PetscAbsReal(u.theta[nmech]))));
+  *zero_tol = 1e-3 * PetscSqrtReal(PetscAbsReal(u.theta[nmech]));
+  PetscCall(MatNorm(p->A1, NORM_FROBENIUS, &a1));
+  PetscCall(PetscMalloc2(nmech * nmech, &G, nmech, &sv));
+  PetscCall(VecDuplicate(u.x[0], &y));
+  for (PetscInt j = 0; j < nmech; j++) {
+    PetscReal nj;
+    PetscCall(MatMult(p->A1, u.x[j], y));
+    PetscCall(VecNorm(u.x[j], NORM_2, &nj));
+    for (PetscInt i = 0; i < nmech; i++) {
+      PetscScalar d;
+      PetscReal   ni;
+      PetscCall(VecDot(y, u.x[i], &d));
+      PetscCall(VecNorm(u.x[i], NORM_2, &ni));
+      G[j * nmech + i] = PetscRealPart(d) / (ni * nj * PetscMax(a1, PETSC_SMALL));
+    }
+  }
+  PetscCall(VecDestroy(&y));
+  PetscCallBLAS("LAPACKgesvd", LAPACKgesvd_("N", "N", &n, &n, G, &n, sv, NULL, &one, NULL, &one, work, &lwork, &info));
+  lwork = (PetscBLASInt)work[0];
+  PetscCall(PetscMalloc1(lwork, &w));
+  PetscCallBLAS("LAPACKgesvd", LAPACKgesvd_("N", "N", &n, &n, G, &n, sv, NULL, &one, NULL, &one, w, &lwork, &info));
+  PetscCheck(!info, p->sys->comm, PETSC_ERR_LIB, "LAPACK gesvd failed (%d)", (int)info);
+  for (PetscInt k = 0; k < nmech; k++) gmax = PetscMax(gmax, sv[k]);
+  for (PetscInt k = 0; k < nmech; k++)
+    if (sv[k] > 1e-10) rank++; /* relative to |A1|: a damper on a mechanism's motion, however light */
+  *nzero = 2 * nmech - rank;
+  PetscCall(PetscFree(w));
+  PetscCall(PetscFree2(G, sv));
+  PetscCall(SpectrumDestroy(&u));
   PetscFunctionReturn(0);
 }
 
@@ -1109,8 +1298,8 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PhlexPart         spun = NULL;
   PetscInt          nspun = 0;
   PetscViewer       csv, sweep;
-  PetscReal         here = 0, worst = 0, *fexp = NULL, unit = 1;
-  PetscInt          nconfig, nfexp = 0, Nd;
+  PetscReal         here = 0, worst = 0, *fexp = NULL, *zexp = NULL, unit = 1;
+  PetscInt          nconfig, nfexp = 0, nzexp = 0, Nd;
   const char       *uname = "";
   PetscLogDouble    t0, t1, tbuild = 0, tsolve = 0;
 
@@ -1118,8 +1307,12 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(LinearizedSetFromOptions(scene->comm, &o));
   PetscCall(LinearizedEPSCreate(scene->comm, &eps));
   if (PhlexHelpGetMode() != PHLEX_HELP_OPTIONS) PetscCall(EPSSetFromOptions(eps));
+  /* the quadratic eigensolver's options read before the check of unused options (it runs about a spin or with damping) */
+  PetscCall(LinearizedPEPCreate(scene->comm, &pep));
+  if (PhlexHelpGetMode() == PHLEX_HELP_NONE) PetscCall(PEPSetFromOptions(pep));
   if (PhlexHelpGetMode() != PHLEX_HELP_NONE) {
     PetscCall(EPSDestroy(&eps));
+    PetscCall(PEPDestroy(&pep));
     PetscFunctionReturn(0);
   }
   PetscCall(PhlexOptionsCheckUnused(scene->comm, LinearizedRereadOptions, &scene->comm));
@@ -1132,16 +1325,21 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscBool flexible = PETSC_FALSE;
     for (PetscInt k = 0; k < scene->nparts; k++)
       if (PhlexPartAnalysisOp(scene->parts[k], modes)) flexible = PETSC_TRUE;
-    PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body (nor a reduced one); rigid bodies and point masses on joints have no elastic modes about rest");
+    for (PetscInt k = 0; k < scene->njoints; k++)
+      if (scene->joints[k]->type == PHLEX_JOINT_SPRING_DAMPER || scene->joints[k]->type == PHLEX_JOINT_BUSHING || scene->joints[k]->rot_element) flexible = PETSC_TRUE;
+    PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body (nor a reduced one) and no force element; rigid bodies and point masses on joints alone have no modes about rest but their mechanism's");
   }
   PetscCall(PetscMemzero(&p, sizeof(p)));
   p.coriolis = o.coriolis;
   PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
   PetscCall(PetscTime(&t0));
   PetscCall(PhlexSystemCreateForScene(scene, &p.sys, &p.X));
-  /* its operators are the undamped ones at rest: a damper's R v would read as motion (refused, naming the options) */
-  for (PetscInt i = 0; i < p.sys->nparts; i++) PetscCheck(!p.sys->parts[i]->ops.dissipation, scene->comm, PETSC_ERR_SUP, "linearized analysis: body %s has structural damping (-%srayleigh_alpha, -%srayleigh_beta, -%sviscosity or -%smodal_damping_ratios); the linearised analysis gives undamped modes: run it without those options", p.sys->parts[i]->name, p.sys->parts[i]->prefix, p.sys->parts[i]->prefix, p.sys->parts[i]->prefix, p.sys->parts[i]->prefix);
-  for (PetscInt k = 0; k < p.sys->njoints; k++) PetscCheck(!p.sys->joints[k]->ne, scene->comm, PETSC_ERR_SUP, "linearized analysis: joint %s is a force element (%s); the linearised analysis does not take force elements yet (run a transient analysis)", p.sys->joints[k]->name, PhlexJointTypes[p.sys->joints[k]->type]);
+  /* a body's damping or an element's damper: the quadratic eigenproblem of the damped assembly */
+  for (PetscInt i = 0; i < p.sys->nparts; i++)
+    if (p.sys->parts[i]->ops.dissipation) p.damped = PETSC_TRUE;
+  for (PetscInt k = 0; k < p.sys->njoints; k++)
+    if (PhlexJointDamped(p.sys->joints[k])) p.damped = PETSC_TRUE;
+  PetscCheck(p.damped || !o.nzexp, scene->comm, PETSC_ERR_USER_INPUT, "-expect_damping_ratios: the assembly has no damping (no body's -rayleigh_alpha, -rayleigh_beta, -viscosity or -modal_damping_ratios, no force element's damper)");
   PetscCall(VecDuplicate(p.X, &p.Xdot));
   PetscCall(VecSet(p.Xdot, 0.0));
   PetscCall(BuildDiscreteMap(&p));
@@ -1157,10 +1355,10 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(CheckEquilibrium(&p));
   if (p.sys->nfparts) PetscCall(BuildFieldOperators(&p));
   else p.scale = 1.0;
-  if (p.Gyr && p.coriolis) {
-    PetscCall(LinearizedPEPCreate(scene->comm, &pep));
+  if ((p.Gyr && p.coriolis) || p.damped) {
+    if (p.damped) PetscCall(PEPSetProblemType(pep, PEP_GENERAL)); /* A1 = R (+ Coriolis): no pairs +-lambda */
     PetscCall(PEPSetFromOptions(pep));
-  }
+  } else PetscCall(PEPDestroy(&pep));
   PetscCall(PetscTime(&t1));
   tbuild += t1 - t0;
 
@@ -1198,7 +1396,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   if (p.ne) PetscCall(PetscPrintf(scene->comm, "  pencil: %" PetscInt_FMT " field velocities, %" PetscInt_FMT " discrete velocities (%" PetscInt_FMT " elastic), %" PetscInt_FMT " constraint rows (stress and elastic coordinates eliminated, positions at rest dropped)\n", Nd, p.nqv, p.ne, p.nqi));
   else PetscCall(PetscPrintf(scene->comm, "  pencil: %" PetscInt_FMT " field velocities, %" PetscInt_FMT " discrete velocities, %" PetscInt_FMT " constraint rows (stress eliminated, positions at rest dropped)\n", Nd, p.nqv, p.nqi));
 
-  PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_modes.csv", "configuration,position,mode,kind,frequency_hz,omega_rad_s,relative_residual,growth_rate_1_s", &csv));
+  PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_modes.csv", "configuration,position,mode,kind,frequency_hz,omega_rad_s,relative_residual,growth_rate_1_s,damping_ratio,damped_frequency_hz,decay_rate_1_s", &csv));
   PetscCall(PhlexOutputCSVOpen(scene->output, "linearized_sweep.csv", NULL, &sweep));
   PetscCall(PetscViewerASCIIPrintf(sweep, "configuration,position,mechanism_modes"));
   for (PetscInt m = 0; m < o.nev; m++) PetscCall(PetscViewerASCIIPrintf(sweep, ",omega%" PetscInt_FMT "_rad_s", m + 1));
@@ -1212,7 +1410,8 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscReal pos = o.nvalues ? o.values[c] : (o.nspins ? o.spins[c] : here / unit);
     const PetscBool shapes = (PetscBool)(c == o.fields_configuration && scene->output->fields);
     if (spun && !o.nspins && !joint) PetscCall((*spun->analysisops->spinrate)(spun, PETSC_FALSE, &pos)); /* the scene's spin rate */
-    PetscInt        nmech;
+    PetscInt        nmech, nzero = 0;
+    PetscReal       zero_tol = 0;
     Spectrum        s;
     PetscCall(PetscTime(&t0));
     if (joint && o.nvalues) {
@@ -1233,39 +1432,58 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     tbuild += t1 - t0;
     t0 = t1;
     PetscCall(PetscMemzero(&s, sizeof(s)));
-    if (pep) PetscCall(SolveGyroscopic(&p, pep, o.nev, nmech, shapes, &s));
+    if (p.damped && nmech) PetscCall(DampedMechanism(&p, eps, pep, nmech, &nzero, &zero_tol));
+    if (p.damped) PetscCall(PhlexLinearizedSolveDamped(&p, pep, o.nev, nmech, nzero, zero_tol, shapes, &s));
+    else if (pep) PetscCall(SolveGyroscopic(&p, pep, o.nev, nmech, shapes, &s));
     else PetscCall(SolvePencil(&p, eps, o.nev, nmech, shapes, &s));
     PetscCall(PetscTime(&t1));
     tsolve += t1 - t0;
+    /* a damped assembly's mechanism modes (zero eigenvalues, defective where nothing damps them) are counted, not listed */
+    const PetscInt nmech_shown = p.damped ? nmech : s.nmech;
     if (nconfig == 1) {
-      PetscCall(PetscPrintf(scene->comm, "  %" PetscInt_FMT " mechanism mode%s (zero frequency)\n  mode  frequency [Hz]       omega [rad/s]        kind       %s\n", s.nmech, s.nmech == 1 ? "" : "s", pep ? "backward err." : "rel. residual"));
-    } else PetscCall(PetscPrintf(scene->comm, "  %6" PetscInt_FMT " %12.6g  %4" PetscInt_FMT, c, (double)pos, s.nmech));
-    PetscCall(PetscViewerASCIIPrintf(sweep, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT, c, (double)pos, s.nmech));
+      if (p.damped) PetscCall(PetscPrintf(scene->comm, "  %" PetscInt_FMT " mechanism mode%s (zero eigenvalue, not listed); damped modes lambda = -zeta omega +- i omega_d\n  mode  frequency [Hz]       omega [rad/s]        damping ratio   damped freq. [Hz]    kind        backward err.\n", nmech_shown, nmech_shown == 1 ? "" : "s"));
+      else PetscCall(PetscPrintf(scene->comm, "  %" PetscInt_FMT " mechanism mode%s (zero frequency)\n  mode  frequency [Hz]       omega [rad/s]        kind       %s\n", s.nmech, s.nmech == 1 ? "" : "s", pep ? "backward err." : "rel. residual"));
+    } else PetscCall(PetscPrintf(scene->comm, "  %6" PetscInt_FMT " %12.6g  %4" PetscInt_FMT, c, (double)pos, nmech_shown));
+    PetscCall(PetscViewerASCIIPrintf(sweep, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT, c, (double)pos, nmech_shown));
     for (PetscInt i = 0; i < s.n; i++) {
       const PetscBool mech  = (PetscBool)(i < s.nmech);
-      const PetscReal omega = mech ? 0.0 : PetscSqrtReal(PetscAbsReal(s.theta[i])) / scene->units.time;
+      const PetscBool over  = (PetscBool)(s.zeta && PetscIsNanReal(s.zeta[i])); /* a real eigenvalue: no oscillation */
+      const PetscReal omega = mech || over ? 0.0 : PetscSqrtReal(PetscAbsReal(s.theta[i])) / scene->units.time;
       const PetscReal f     = omega / (2.0 * PETSC_PI);
       const PetscReal grow  = s.growth[i] / scene->units.time; /* 1/s */
-      const char     *kind  = mech ? "mechanism" : (grow > 0 ? "unstable" : "elastic");
-      if (nconfig == 1) {
+      const PetscReal zeta  = s.zeta ? s.zeta[i] : 0.0;
+      const PetscReal fd    = s.wd ? s.wd[i] / scene->units.time / (2.0 * PETSC_PI) : f;
+      const PetscReal decay = s.decay ? s.decay[i] / scene->units.time : 0.0;
+      const char     *kind  = mech ? "mechanism" : (grow > 0 ? "unstable" : (over ? "overdamped" : (p.damped ? "damped" : "elastic")));
+      if (nconfig == 1 && p.damped) {
+        PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-18.10g   %-14.8g  %-18.10g   %-10s  %.1e", i + 1, (double)f, (double)omega, (double)zeta, (double)fd, kind, (double)s.resid[i]));
+        if (grow > 0) PetscCall(PetscPrintf(scene->comm, "  (grows as exp(%.6g t))", (double)grow));
+        else if (over) PetscCall(PetscPrintf(scene->comm, "  (decays as exp(-%.10g t))", (double)decay));
+        PetscCall(PetscPrintf(scene->comm, "\n"));
+      } else if (nconfig == 1) {
         PetscCall(PetscPrintf(scene->comm, "  %4" PetscInt_FMT "  %-18.10g   %-18.10g   %-9s  %.1e", i + 1, (double)f, (double)omega, kind, (double)s.resid[i]));
         if (grow > 0) PetscCall(PetscPrintf(scene->comm, "  (grows as exp(%.6g t))", (double)grow));
         PetscCall(PetscPrintf(scene->comm, "\n"));
       } else if (!mech && i - s.nmech < o.nev) {
         if (grow > 0) PetscCall(PetscPrintf(scene->comm, "  %-14s", "unstable"));
+        else if (over) PetscCall(PetscPrintf(scene->comm, "  %-14s", "overdamped"));
         else PetscCall(PetscPrintf(scene->comm, "  %-14.8g", (double)f));
       }
-      PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT ",%s,%.12e,%.12e,%.3e,%.12e\n", c, (double)pos, i + 1, kind, (double)f, (double)omega, (double)s.resid[i], (double)grow));
+      PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT ",%s,%.12e,%.12e,%.3e,%.12e,%.12e,%.12e,%.12e\n", c, (double)pos, i + 1, kind, (double)f, (double)omega, (double)s.resid[i], (double)grow, (double)zeta, (double)fd, (double)decay));
       if (!mech && i - s.nmech < o.nev) PetscCall(PetscViewerASCIIPrintf(sweep, ",%.12e", (double)omega));
       if (!mech) worst = PetscMax(worst, s.resid[i]);
       if (c == 0 && o.nexp && !mech) {
         if (!fexp) PetscCall(PetscMalloc1(s.n, &fexp));
         fexp[nfexp++] = f;
       }
+      if (c == 0 && o.nzexp && !mech) {
+        if (!zexp) PetscCall(PetscMalloc1(s.n, &zexp));
+        zexp[nzexp++] = zeta;
+      }
     }
     if (nconfig > 1) PetscCall(PetscPrintf(scene->comm, "\n"));
     PetscCall(PetscViewerASCIIPrintf(sweep, "\n"));
-    if (shapes) PetscCall(WriteShapes(&p, scene->output, &s));
+    if (shapes && p.sys->nfparts) PetscCall(WriteShapes(&p, scene->output, &s)); /* (the shapes drawn are the fields') */
     PetscCall(SpectrumDestroy(&s));
     PetscCall(PhlexInterruptCheck(scene->comm, "linearized analysis"));
   }
@@ -1275,14 +1493,22 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(PetscViewerDestroy(&sweep));
   PetscCall(PhlexOutputCommit(scene->output));
   if (o.rmax > 0) PetscCall(PhlexExpectMax(scene->comm, "eigenpair residuals (max relative)", "-expect_residual_max", worst, o.rmax, PETSC_TRUE));
-  if (o.nexp) PetscCall(PhlexExpectValues(scene->comm, "elastic frequencies", "-expect_frequencies", nfexp, fexp, o.nexp, o.expected, o.rtol));
+  if (o.nexp) PetscCall(PhlexExpectValues(scene->comm, p.damped ? "undamped natural frequencies" : "elastic frequencies", "-expect_frequencies", nfexp, fexp, o.nexp, o.expected, o.rtol));
+  if (o.nzexp) {
+    PetscCall(PhlexExpectValues(scene->comm, "damping ratios", "-expect_damping_ratios", nzexp, zexp, o.nzexp, o.zexpected, o.zrtol));
+  }
   PetscCall(PetscFree(fexp));
+  PetscCall(PetscFree(zexp));
   PetscCall(EPSDestroy(&eps));
   PetscCall(PEPDestroy(&pep));
   PetscCall(MatDestroy(&p.A));
   PetscCall(MatDestroy(&p.B));
   PetscCall(MatDestroy(&p.A1));
   PetscCall(MatDestroy(&p.Gyr));
+  PetscCall(MatDestroy(&p.Rf));
+  for (PetscInt k = 0; p.elrows && k < 2 * p.nel; k++) PetscCall(VecDestroy(&p.elrows[k]));
+  PetscCall(PetscFree(p.elrows));
+  PetscCall(PetscFree3(p.elF, p.elE, p.qdamped));
   PetscCall(MatDestroy(&p.K));
   PetscCall(MatDestroy(&p.Mvv));
   PetscCall(ISDestroy(&p.isV));

@@ -187,7 +187,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     if (!PhlexPartAnalysisOp(part, modes)) continue;
     shapes = (PetscBool)(scene->output->fields && PhlexPartAnalysisOp(part, modesoutput));
     PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
-    if (part->ops.dissipation) PetscCall(PetscPrintf(scene->comm, "phlex: note: body %s has structural damping: these are its undamped modes (K and M; the damping ratio of a mode of pulsation w is alpha/(2 w) + (beta + eta/E) w/2 for Rayleigh and Kelvin-Voigt)\n", part->name));
+    if (part->ops.dissipation) PetscCall(PetscPrintf(scene->comm, "phlex: note: body %s has structural damping: these are its undamped modes (K and M; the damping ratio of a mode of pulsation w is alpha/(2 w) + (beta + eta/E) w/2 for Rayleigh and one Kelvin-Voigt viscosity); its damped modes (complex eigenvalues: frequency and damping ratio, any damping) come with -analysis linearized\n", part->name));
     PetscCall((*part->analysisops->modes)(part, nev, &nconv, &nrigid, &lambda, shapes ? &vecs : NULL, shapes ? &rigid : NULL, &resid));
     PetscCall(PetscLogStagePop());
     PetscCall(PetscMalloc1(nconv, &freq));

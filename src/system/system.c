@@ -755,8 +755,8 @@ PetscErrorCode PhlexSystemReducedResidual(PhlexSystem sys, PetscReal t, Vec X, V
 /*@C
   PhlexSystemCondensedOperator - block diagonal over the bodies of one of their velocity-space operators: which = 0
   the condensed operators shift Mv + K/shift (each part's Sv, at the shift last evaluated), 1 the masses Mv, 2 the
-  condensed stiffnesses K, 3 the state's stiffnesses K_sigma + Cen, 4 the gyroscopic (Coriolis) matrices; the part's
-  own matrix for one body, else a MATNEST of them; NULL when no body has one (3, 4)
+  condensed stiffnesses K, 3 the state's stiffnesses K_sigma + Cen, 4 the gyroscopic (Coriolis) matrices, 5 the
+  structural damping R; the part's own matrix for one body, else a MATNEST of them; NULL when no body has one (3-5)
 
   Collective
 @*/
@@ -769,7 +769,7 @@ PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, PetscInt which, Mat
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
     PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
-    m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : (which == 2 ? ops.K : (which == 3 ? ops.Kstate : ops.Gyro)));
+    m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : (which == 2 ? ops.K : (which == 3 ? ops.Kstate : (which == 4 ? ops.Gyro : ops.R))));
   }
   PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, N));
   PetscCall(PetscFree(m));
