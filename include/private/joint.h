@@ -40,7 +40,8 @@ PETSC_EXTERN const char *const PhlexJointTypes[];
 typedef enum {
   PHLEX_ROW_T1, PHLEX_ROW_T2, PHLEX_ROW_T3, /* translation of the joint point along e1, e2, e3 */
   PHLEX_ROW_R1, PHLEX_ROW_R2, PHLEX_ROW_R3, /* rotation about e1, e2, e3 */
-  PHLEX_ROW_CROSS                           /* universal: rotation about e_a x e_b (both axes rotate with their bodies) */
+  PHLEX_ROW_CROSS,                          /* universal: rotation about e_a x e_b (both axes rotate with their bodies) */
+  PHLEX_ROW_AXIS_B                          /* universal's torsion element: rotation about e_b (it turns with b) */
 } PhlexJointRow;
 
 #define PHLEX_JOINT_MAX_ROWS 13 /* 7 constraint rows and 6 element rows */

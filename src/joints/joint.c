@@ -126,6 +126,13 @@ static void TableStepForce(PhlexJoint j, PetscInt i, PetscReal e, PetscReal *f, 
   }
 }
 
+/* row k's direction turns with R_ab (the universal's cross row, its torsion element about b's axis) */
+static PetscBool RowTurns(PhlexJoint j, PetscInt k)
+{
+  const PhlexJointRow row = k < j->nc ? j->row[k] : j->erow[k - j->nc];
+  return (row == PHLEX_ROW_CROSS || row == PHLEX_ROW_AXIS_B) ? PETSC_TRUE : PETSC_FALSE;
+}
+
 /* the direction (6-vector, a's body frame) of row k (k >= nc: element row k - nc), and its change for a change dRab
    of R_ab (universal only) */
 static void RowDirection(PhlexJoint j, PetscInt k, const PetscReal Rab[9], const PetscReal *dRab, PetscReal s[6])
@@ -152,6 +159,10 @@ static void RowDirection(PhlexJoint j, PetscInt k, const PetscReal Rab[9], const
     PhlexMatVec3(dRab ? dRab : Rab, j->eb, eb);
     PhlexCross(j->dir + 6, eb, s + 3);
   } break;
+  case PHLEX_ROW_AXIS_B:
+    /* R_ab e_b: the universal's second axis turns with b */
+    PhlexMatVec3(dRab ? dRab : Rab, j->eb, s + 3);
+    break;
   }
 }
 
@@ -271,7 +282,7 @@ static PetscErrorCode ElementOptionsCheck(PhlexJoint j, PhlexJointType type, Pet
   }
   if (type == PHLEX_JOINT_SPRING_DAMPER && j->rest_length != -1.0) PetscCheck(j->rest_length >= 0 && !PetscIsInfOrNanReal(j->rest_length), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_length must be a finite length >= 0 [m], got %g", j->name, j->prefix, (double)j->rest_length);
   if (rot_opts) {
-    PetscCheck(type == PHLEX_JOINT_REVOLUTE || type == PHLEX_JOINT_CYLINDRICAL, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srotational_stiffness, -%srotational_damping and -%srest_angle act on a free rotation (a revolute or cylindrical joint); a %s joint has none", j->name, j->prefix, j->prefix, j->prefix, PhlexJointTypes[type]);
+    PetscCheck(type == PHLEX_JOINT_REVOLUTE || type == PHLEX_JOINT_CYLINDRICAL || type == PHLEX_JOINT_UNIVERSAL, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srotational_stiffness, -%srotational_damping and -%srest_angle act on a free rotation (a revolute, cylindrical or universal joint); a %s joint has none", j->name, j->prefix, j->prefix, j->prefix, PhlexJointTypes[type]);
     PetscCheck(!PetscIsInfOrNanReal(j->rest_angle), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle must be a finite angle [deg], got %g", j->name, j->prefix, (double)j->rest_angle);
     j->rot_element = PETSC_TRUE;
     j->rest_angle *= PETSC_PI / 180.0;
@@ -352,9 +363,9 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   PetscCall(PetscOptionsReal("-rest_length", "Spring-damper: length at zero spring force [m] (default: the drawn distance of the two port points)", "PhlexJointSetFromOptions", j->rest_length, &j->rest_length, &fl));
   /* -1 marks "as drawn" (set up later): a typed -1 is refused like any negative length */
   PetscCheck(!fl || (j->rest_length >= 0 && !PetscIsInfOrNanReal(j->rest_length)), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_length must be a finite length >= 0 [m], got %g", j->name, j->prefix, (double)j->rest_length);
-  PetscCall(PetscOptionsReal("-rotational_stiffness", "Revolute, cylindrical: torsion spring on the free rotation [N m/rad]", "PhlexJointSetFromOptions", j->stiffness, &j->stiffness, &frk));
-  PetscCall(PetscOptionsReal("-rotational_damping", "Revolute, cylindrical: viscous friction (a rotational damper) on the free rotation [N m s/rad]", "PhlexJointSetFromOptions", j->damping, &j->damping, &frc));
-  PetscCall(PetscOptionsReal("-rest_angle", "Revolute, cylindrical: the torsion spring's zero-moment angle relative to the drawn configuration [deg]", "PhlexJointSetFromOptions", j->rest_angle, &j->rest_angle, &fra));
+  PetscCall(PetscOptionsReal("-rotational_stiffness", "Revolute, cylindrical: torsion spring on the free rotation; universal: on each of its two [N m/rad]", "PhlexJointSetFromOptions", j->stiffness, &j->stiffness, &frk));
+  PetscCall(PetscOptionsReal("-rotational_damping", "Revolute, cylindrical: viscous friction (a rotational damper) on the free rotation; universal: on each of its two [N m s/rad]", "PhlexJointSetFromOptions", j->damping, &j->damping, &frc));
+  PetscCall(PetscOptionsReal("-rest_angle", "Revolute, cylindrical (universal: both angles): the torsion spring's zero-moment angle relative to the drawn configuration [deg]", "PhlexJointSetFromOptions", j->rest_angle, &j->rest_angle, &fra));
   {
     PetscReal tab[129];
     PetscInt  ntab = 129;
@@ -689,8 +700,8 @@ static void WrenchesRDerivative(PhlexJoint j, PetscInt t, PetscInt m, const Pets
   PetscReal dwJ[6] = {0, 0, 0, 0, 0, 0};
 
   RabDerivative(t, m, j->Ra, j->Rb, dRab, dG);
-  for (PetscInt k = 0; k < j->nc; k++) /* the cross direction is a constraint row's (no element row has one) */
-    if (j->row[k] == PHLEX_ROW_CROSS) {
+  for (PetscInt k = 0; k < NumRows(j); k++) /* the directions that turn with b: the cross row, b's axis */
+    if (RowTurns(j, k)) {
       PetscReal dsk[6];
       RowDirection(j, k, j->Rab, dRab, dsk);
       for (PetscInt c = 0; c < 6; c++) dwJ[c] += j->lambda[k] * dsk[c];
@@ -989,7 +1000,7 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
           PetscReal sk[6], dsk[6];
           RowDirection(j, k, j->Rab, NULL, sk);
           RowDirection(j, k, j->Rab, dRab, dsk);
-          dc[k] = Dot6(sk, r) + (k < j->nc && j->row[k] == PHLEX_ROW_CROSS ? Dot6(dsk, Dl) : 0.0);
+          dc[k] = Dot6(sk, r) + (RowTurns(j, k) ? Dot6(dsk, Dl) : 0.0);
         }
         AddRows(j, dc, D + col, ld);
       }
@@ -1249,6 +1260,24 @@ static PetscReal AngleAboutAxis(PhlexJoint j, const PetscReal E[9])
   return PetscAtan2Real(PhlexDot3(j->frame + 3, Ee1), PhlexDot3(j->frame, Ee1));
 }
 
+/* a universal's angles from the drawn configuration, E = Rot(e_a, t1) Rot(e_b0, t2) (a's joint frame; e_b0 = b's axis
+   as drawn): t1 = atan2(E e_b0 . (e_a x e_b0), E e_b0 . e_b0), t2 = atan2(E^T e_a . (e_a x e_b0), E^T e_a . e_a); the
+   rates of the torsion elements' rows (about e_a, and about b's axis as it turns) are their derivatives */
+static PetscReal UniversalAngle(PhlexJoint j, const PetscReal E[9], PetscBool second)
+{
+  const PetscReal *ea = j->frame + 6;
+  PetscReal        eb0[3], n[3], v[3];
+
+  PhlexMatVec3(j->Rrel0, j->axis_b, eb0);
+  PhlexCross(ea, eb0, n);
+  if (!second) {
+    PhlexMatVec3(E, eb0, v);
+    return PetscAtan2Real(PhlexDot3(v, n), PhlexDot3(v, eb0));
+  }
+  PhlexMatTVec3(E, ea, v);
+  return PetscAtan2Real(PhlexDot3(v, n), PhlexDot3(v, ea));
+}
+
 /*@C
   PhlexJointGap - the position-level violation of each row at the state of its parts (non-dimensional: lengths and
   radians), consistent with the velocity rows (d gap/dt = c at a satisfied configuration)
@@ -1439,6 +1468,7 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
       PetscCall(PetscStrlcat(header, col, sizeof(header)));
     }
     if (j->type == PHLEX_JOINT_SPRING_DAMPER) PetscCall(PetscStrlcat(header, ",length_minus_rest", sizeof(header)));
+    if (j->type == PHLEX_JOINT_UNIVERSAL) PetscCall(PetscStrlcat(header, ",angle_a_minus_rest,angle_b_minus_rest", sizeof(header)));
     PetscCall(PetscStrlcat(header, ",stored_energy,dissipated_power,dissipated_work", sizeof(header)));
   }
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_joint.csv", j->name));
@@ -1493,6 +1523,12 @@ PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *
       PetscCall(Placements(j, Xa, Xb, dx, E));
       PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(PhlexNorm3(dx) * u->length - j->rest_length)));
     }
+    if (j->type == PHLEX_JOINT_UNIVERSAL) {
+      /* the geometric angles of the universal, to compare with the torsion elements' states */
+      PetscReal dx[3], E[9];
+      PetscCall(Placements(j, Xa, Xb, dx, E));
+      PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e", (double)(UniversalAngle(j, E, PETSC_FALSE) - j->rest_angle), (double)(UniversalAngle(j, E, PETSC_TRUE) - j->rest_angle)));
+    }
     PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e,%.12e", (double)(V * u->energy), (double)(Dstep * u->power), (double)(j->dissipated_work * u->energy)));
   }
   PetscCall(PhlexCSVPrintf(j->csv, "\n"));
@@ -1517,6 +1553,7 @@ PetscErrorCode PhlexJointElementInitial(PhlexJoint j, const PhlexPartVec *Xa, co
   for (PetscInt i = 0; i < j->ne; i++) {
     const PhlexJointRow r = j->erow[i];
     if (j->type == PHLEX_JOINT_SPRING_DAMPER) e0[i] = PhlexNorm3(dx) - j->rest_length / j->units->length;
+    else if (j->rot_element && j->type == PHLEX_JOINT_UNIVERSAL) e0[i] = UniversalAngle(j, E, r == PHLEX_ROW_AXIS_B) - j->rest_angle;
     else if (j->rot_element) e0[i] = AngleAboutAxis(j, E) - j->rest_angle;
     else if (r <= PHLEX_ROW_T3) e0[i] = PhlexDot3(j->frame + 3 * (r - PHLEX_ROW_T1), dx);
     else e0[i] = PhlexDot3(j->frame + 3 * (r - PHLEX_ROW_R1), phi);

@@ -3,7 +3,7 @@
    on both ports: with a point mass on either side they are left out (a point transmits no moment). */
 #include <phlex_impl.h>
 
-static const char *const RowNames[] = {"t1", "t2", "t3", "r1", "r2", "r3", "cross"};
+static const char *const RowNames[] = {"t1", "t2", "t3", "r1", "r2", "r3", "cross", "rb"};
 
 /* The force elements' rows (after the constraint rows) and their non-dimensional stiffness and damping. Row i of K
    is a force (translation row, unit units->force) or a moment (rotation row, force x length); column l multiplies a
@@ -28,6 +28,8 @@ static PetscErrorCode SelectElementRows(PhlexJoint j)
     PetscCheck(j->side[0].rotation && j->side[1].rotation, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a rotational spring-damper (-%srotational_stiffness, -%srotational_damping) needs ports with an orientation; %s is a point", j->name, j->prefix, j->prefix, j->side[j->side[0].rotation ? 1 : 0].spec);
     j->erow[0] = PHLEX_ROW_R3, idx[0] = 5;
     j->ne      = 1;
+    /* a universal's second free rotation, about b's axis: the same spring and damper (uncoupled) */
+    if (j->type == PHLEX_JOINT_UNIVERSAL) j->erow[1] = PHLEX_ROW_AXIS_B, idx[1] = 5, j->ne = 2;
   }
   for (PetscInt i = 0; i < j->ntable; i++) {
     j->table_e[i] /= u->length;
@@ -40,7 +42,7 @@ static PetscErrorCode SelectElementRows(PhlexJoint j)
       const PetscReal cl = j->erow[l] <= PHLEX_ROW_T3 ? u->length : 1.0;
       PetscReal       k, c;
       if (j->type == PHLEX_JOINT_BUSHING) k = j->Ksi[6 * idx[i] + idx[l]], c = j->Csi[6 * idx[i] + idx[l]];
-      else k = j->stiffness, c = j->damping;
+      else k = i == l ? j->stiffness : 0.0, c = i == l ? j->damping : 0.0;
       j->K[j->ne * i + l] = k * ci * cl / (u->force * u->length);
       j->C[j->ne * i + l] = c * ci * cl / (u->force * u->length * u->time);
     }
