@@ -106,7 +106,9 @@ struct _p_PhlexJoint {
   PetscReal     Ksi[36], Csi[36];       /* bushing: the matrices as given (SI, rows/columns t1 t2 t3 r1 r2 r3) */
   PetscBool     Kgiven, Cgiven;
   PetscReal     stiffness, damping;     /* spring-damper (N/m, N s/m) or rotational (N m/rad, N m s/rad), SI */
-  PetscBool     rot_element;            /* revolute, cylindrical: the free rotation is a spring-damper */
+  PetscBool     rot_element;            /* revolute, cylindrical, universal: the free rotation(s) a spring-damper */
+  PetscBool     slide_element;          /* prismatic, cylindrical: the slide is a spring-damper */
+  PetscReal     slide_stiffness, slide_damping, rest_slide; /* its N/m, N s/m and zero-force slide [m], SI */
   PetscReal     rest_length, rest_angle; /* spring-damper [m] (<0: the drawn length); rotational [rad] */
   PetscReal     K[36], C[36];
   PetscReal     e[6], edot[6];          /* evaluated: states and their rates (non-dimensional time) */

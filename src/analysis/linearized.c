@@ -908,6 +908,15 @@ static PetscErrorCode CheckEquilibrium(Pencil *p)
   for (PetscInt k = 0; k < sys->nq; k++)
     if (sys->qkind[k] == PHLEX_DOF_VELOCITY || sys->qkind[k] == PHLEX_DOF_ELASTIC_VELOCITY) fq = PetscMax(fq, PetscAbsReal(sys->fq[k]));
   PetscCall(VecDestroy(&F));
+  /* a force element's spring at rest holds no force (its force row K e + f(e) = 0 with the rate zero): a preloaded
+     spring would be a load the linearisation drops */
+  for (PetscInt k = 0; k < sys->njoints; k++) {
+    PhlexJoint j = sys->joints[k];
+    for (PetscInt i = 0; i < j->ne; i++) {
+      const PetscReal f = PetscAbsReal(sys->fq[j->qoff + j->nc + i]);
+      PetscCheck(f <= 1e-12, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: joint %s: its force element (row %s) holds a force at the linearisation point (%g, non-dimensional): its spring is not at its rest (-%srest_length, -%srest_angle, -%srest_slide) there; the analysis linearises about an unloaded configuration at rest", j->name, j->erowname[i], (double)f, j->prefix, j->prefix, j->prefix);
+    }
+  }
   PetscCheck(fv <= 1e-12 && fq <= 1e-12, sys->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the configuration is not an equilibrium at rest (the momentum equations are off by %g in the fields, %g in the frames, points and elastic coordinates, non-dimensional): a load acts at t = 0 (a port, frame or body force) or the initial displacement or stress is not free of load; the analysis linearises about an unloaded configuration at rest", (double)fv, (double)fq);
   PetscFunctionReturn(0);
 }
@@ -1043,8 +1052,9 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
 /* A damped assembly whose mechanism moves: its nmech mechanism modes N (the undamped pencil's zero modes) are zero
    eigenvalues of the quadratic pencil, semisimple where the damping acts on them and double (defective) where it does
    not, nzero = 2 nmech - rank(N^T A1 N) in all. Those computed carry errors of sqrt(tolerance) (1e-6 of the spectrum)
-   and defective ones may not converge or come with spurious copies: the eigenvalues below 1e-3 of the undamped
-   pencil's lowest pulsation are taken for them (an overdamped motion slower than that is taken for a mechanism's). The shift goes to the undamped pencil's lowest
+   and defective ones may not converge or come with spurious copies: the eigenvalues below 1e-4 of the undamped
+   pencil's lowest pulsation (100 times their error at the tolerance 1e-12) are taken for them (an overdamped motion
+   slower than that is taken for a mechanism's). The shift goes to the undamped pencil's lowest
    pulsation on the negative real axis (unless -linearized_pep_target is given): about 0 the defective eigenvalues
    would take the Krylov space (modes to 1e-9). */
 static PetscErrorCode DampedMechanism(Pencil *p, EPS eps, PEP pep, PetscInt nmech, PetscInt *nzero, PetscReal *zero_tol)
@@ -1061,7 +1071,7 @@ static PetscErrorCode DampedMechanism(Pencil *p, EPS eps, PEP pep, PetscInt nmec
   PetscCall(SolvePencil(p, eps, 1, nmech, PETSC_TRUE, &u));
   PetscCall(PetscOptionsHasName(NULL, "linearized_", "-pep_target", &given));
   if (!given) PetscCall(PEPSetTarget(pep, -PetscSqrtReal(PetscAbsReal(u.theta[nmech]))));
-  *zero_tol = 1e-3 * PetscSqrtReal(PetscAbsReal(u.theta[nmech]));
+  *zero_tol = 1e-4 * PetscSqrtReal(PetscAbsReal(u.theta[nmech]));
   PetscCall(MatNorm(p->A1, NORM_FROBENIUS, &a1));
   PetscCall(PetscMalloc2(nmech * nmech, &G, nmech, &sv));
   PetscCall(VecDuplicate(u.x[0], &y));
@@ -1326,7 +1336,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     for (PetscInt k = 0; k < scene->nparts; k++)
       if (PhlexPartAnalysisOp(scene->parts[k], modes)) flexible = PETSC_TRUE;
     for (PetscInt k = 0; k < scene->njoints; k++)
-      if (scene->joints[k]->type == PHLEX_JOINT_SPRING_DAMPER || scene->joints[k]->type == PHLEX_JOINT_BUSHING || scene->joints[k]->rot_element) flexible = PETSC_TRUE;
+      if (scene->joints[k]->type == PHLEX_JOINT_SPRING_DAMPER || scene->joints[k]->type == PHLEX_JOINT_BUSHING || scene->joints[k]->rot_element || scene->joints[k]->slide_element) flexible = PETSC_TRUE;
     PetscCheck(flexible, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has no flexible body (nor a reduced one) and no force element; rigid bodies and point masses on joints alone have no modes about rest but their mechanism's");
   }
   PetscCall(PetscMemzero(&p, sizeof(p)));
@@ -1344,6 +1354,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   PetscCall(VecSet(p.Xdot, 0.0));
   PetscCall(BuildDiscreteMap(&p));
   if (p.sys->njoints) PetscCall(PhlexAssemblyClose(p.sys, 0.0, p.X, PETSC_TRUE, NULL));
+  PetscCall(PhlexSystemInitElements(p.sys, p.X)); /* the force elements' states from the placements (a preload is refused) */
   if (p.sys->njoints) PetscCall(PhlexSystemUpdateJoints(p.sys, p.X, 0.0));
   PetscCall(SetRest(&p));
   PetscCall(SpinningPart(p.sys, &spun, &nspun));
@@ -1416,6 +1427,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCall(PetscTime(&t0));
     if (joint && o.nvalues) {
       PetscCall(MoveTo(&p, joint, here, pos * unit));
+      PetscCall(PhlexSystemInitElements(p.sys, p.X)); /* a spring the move loads is refused below */
       here = pos * unit;
       PetscCall(SetRest(&p));
       PetscCall(CheckEquilibrium(&p));

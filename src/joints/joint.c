@@ -334,6 +334,7 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   PetscInt  nports, nalloc, type = PHLEX_JOINT_REVOLUTE, comp = 0;
   PetscBool ftype = PETSC_FALSE, fports = PETSC_FALSE, fdrive = PETSC_FALSE, fcomp = PETSC_FALSE, fdi = PETSC_FALSE;
   PetscBool fk = PETSC_FALSE, fc = PETSC_FALSE, fl = PETSC_FALSE, frk = PETSC_FALSE, frc = PETSC_FALSE, fra = PETSC_FALSE;
+  PetscBool fsk = PETSC_FALSE, fsc = PETSC_FALSE, frs = PETSC_FALSE;
   PetscReal Kbuf[37], Cbuf[37];
   PetscInt  nK = 37, nC = 37;
   char      who[PHLEX_NAME_LEN + 16];
@@ -366,6 +367,9 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   PetscCall(PetscOptionsReal("-rotational_stiffness", "Revolute, cylindrical: torsion spring on the free rotation; universal: on each of its two [N m/rad]", "PhlexJointSetFromOptions", j->stiffness, &j->stiffness, &frk));
   PetscCall(PetscOptionsReal("-rotational_damping", "Revolute, cylindrical: viscous friction (a rotational damper) on the free rotation; universal: on each of its two [N m s/rad]", "PhlexJointSetFromOptions", j->damping, &j->damping, &frc));
   PetscCall(PetscOptionsReal("-rest_angle", "Revolute, cylindrical (universal: both angles): the torsion spring's zero-moment angle relative to the drawn configuration [deg]", "PhlexJointSetFromOptions", j->rest_angle, &j->rest_angle, &fra));
+  PetscCall(PetscOptionsReal("-slide_stiffness", "Prismatic, cylindrical: a spring on the slide (force on the second port -k (slide - rest slide) along the axis) [N/m]", "PhlexJointSetFromOptions", j->slide_stiffness, &j->slide_stiffness, &fsk));
+  PetscCall(PetscOptionsReal("-slide_damping", "Prismatic, cylindrical: viscous friction on the slide [N s/m]", "PhlexJointSetFromOptions", j->slide_damping, &j->slide_damping, &fsc));
+  PetscCall(PetscOptionsReal("-rest_slide", "Prismatic, cylindrical: the slide spring's zero-force slide relative to the drawn configuration [m]", "PhlexJointSetFromOptions", j->rest_slide, &j->rest_slide, &frs));
   {
     PetscReal tab[129];
     PetscInt  ntab = 129;
@@ -382,6 +386,15 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
   /* a rest angle alone would make a torsion element of nothing */
   PetscCheck(!fra || frk || frc, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle %g is the zero-moment angle of a torsion spring: give -%srotational_stiffness (and/or -%srotational_damping) too", j->name, j->prefix, (double)j->rest_angle, j->prefix, j->prefix);
   if (ftype) PetscCall(ElementOptionsCheck(j, (PhlexJointType)type, fk || fc || fl, frk || frc || fra, Kbuf, j->Kgiven ? nK : -1, Cbuf, j->Cgiven ? nC : -1));
+  if (fsk || fsc || frs) {
+    /* a spring-damper on the slide of a prismatic or cylindrical joint */
+    PetscCheck(!ftype || type == PHLEX_JOINT_PRISMATIC || type == PHLEX_JOINT_CYLINDRICAL, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sslide_stiffness, -%sslide_damping and -%srest_slide act on a slide (a prismatic or cylindrical joint); a %s joint has none", j->name, j->prefix, j->prefix, j->prefix, ftype ? PhlexJointTypes[type] : "joint of no kind");
+    PetscCheck(j->slide_stiffness >= 0 && !PetscIsInfOrNanReal(j->slide_stiffness), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sslide_stiffness must be a finite number >= 0 [N/m], got %g", j->name, j->prefix, (double)j->slide_stiffness);
+    PetscCheck(j->slide_damping >= 0 && !PetscIsInfOrNanReal(j->slide_damping), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%sslide_damping must be a finite number >= 0 [N s/m], got %g", j->name, j->prefix, (double)j->slide_damping);
+    PetscCheck(!PetscIsInfOrNanReal(j->rest_slide), j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_slide must be a finite length [m], got %g", j->name, j->prefix, (double)j->rest_slide);
+    PetscCheck(j->slide_stiffness > 0 || j->slide_damping > 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: a slide spring-damper needs -%sslide_stiffness [N/m] > 0 and/or -%sslide_damping [N s/m] > 0 (-%srest_slide alone is the rest of nothing)", j->name, j->prefix, j->prefix, j->prefix);
+    j->slide_element = PETSC_TRUE;
+  }
   PetscCheck(ftype, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give its kind: -%stype fixed|revolute|spherical|prismatic|cylindrical|universal|planar|prescribed|spring_damper|bushing", j->name, j->prefix);
   j->type = (PhlexJointType)type;
   PetscCheck(fports, j->comm, PETSC_ERR_USER_INPUT, "joint %s: give its ports: -%sports body:port,body:port (or body:port,ground)", j->name, j->prefix);
@@ -427,6 +440,7 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
     j->drive_row = (j->type == PHLEX_JOINT_PRISMATIC || (j->type == PHLEX_JOINT_CYLINDRICAL && comp == 1)) ? PHLEX_ROW_T3 : PHLEX_ROW_R3;
     if (j->drive_row == PHLEX_ROW_R3) j->drive_initial *= PETSC_PI / 180.0;
   }
+  PetscCheck(!(j->slide_element && j->drive_row == PHLEX_ROW_T3), j->comm, PETSC_ERR_USER_INPUT, "joint %s: its slide is driven (-%sdrive_velocity): it cannot also carry a slide spring-damper (-%sslide_stiffness, -%sslide_damping)", j->name, j->prefix, j->prefix, j->prefix);
   PetscCheck(!(j->rot_element && j->drive_row == PHLEX_ROW_R3), j->comm, PETSC_ERR_USER_INPUT, "joint %s: its free rotation is driven (-%sdrive_velocity): it cannot also carry a rotational spring-damper (-%srotational_stiffness, -%srotational_damping)", j->name, j->prefix, j->prefix, j->prefix);
 
   if (j->type == PHLEX_JOINT_PRESCRIBED) {
@@ -1399,7 +1413,7 @@ PetscErrorCode PhlexJointView(PhlexJoint j, PetscViewer viewer)
   else PetscCall(PetscViewerASCIIPrintf(viewer, "joint %s: %s between %s and %s", j->name, PhlexJointTypes[j->type], j->side[0].spec, j->side[1].spec));
   PetscCall(PetscViewerASCIIUseTabs(viewer, PETSC_FALSE)); /* the rest of the line: no indentation before each piece */
   if (j->ne) {
-    char line[256] = "; force element on", more[160];
+    char line[384] = "; force element on", more[160];
     for (PetscInt i = 0; i < j->ne; i++) {
       PetscCall(PetscStrlcat(line, " ", sizeof(line)));
       PetscCall(PetscStrlcat(line, j->erowname[i], sizeof(line)));
@@ -1411,6 +1425,10 @@ PetscErrorCode PhlexJointView(PhlexJoint j, PetscViewer viewer)
     else if (j->type == PHLEX_JOINT_SPRING_DAMPER) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N/m, c %.6g N s/m, rest length as drawn)", (double)j->stiffness, (double)j->damping));
     else if (j->rot_element) PetscCall(PetscSNPrintf(more, sizeof(more), " (k %.6g N m/rad, c %.6g N m s/rad, rest angle %.6g deg)", (double)j->stiffness, (double)j->damping, (double)(j->rest_angle * 180.0 / PETSC_PI)));
     PetscCall(PetscStrlcat(line, more, sizeof(line)));
+    if (j->slide_element) {
+      PetscCall(PetscSNPrintf(more, sizeof(more), " (slide: k %.6g N/m, c %.6g N s/m, rest slide %.6g m)", (double)j->slide_stiffness, (double)j->slide_damping, (double)j->rest_slide));
+      PetscCall(PetscStrlcat(line, more, sizeof(line)));
+    }
     PetscCall(PetscViewerASCIIPrintf(viewer, "%s", line));
   }
   if (j->drive_row >= 0) PetscCall(PetscViewerASCIIPrintf(viewer, " (%s driven at %.15g %s)", j->rowname[j->nc - 1], (double)j->drive_velocity, j->row[j->nc - 1] == PHLEX_ROW_R3 ? "rad/s" : "m/s"));
@@ -1554,7 +1572,8 @@ PetscErrorCode PhlexJointElementInitial(PhlexJoint j, const PhlexPartVec *Xa, co
     const PhlexJointRow r = j->erow[i];
     if (j->type == PHLEX_JOINT_SPRING_DAMPER) e0[i] = PhlexNorm3(dx) - j->rest_length / j->units->length;
     else if (j->rot_element && j->type == PHLEX_JOINT_UNIVERSAL) e0[i] = UniversalAngle(j, E, r == PHLEX_ROW_AXIS_B) - j->rest_angle;
-    else if (j->rot_element) e0[i] = AngleAboutAxis(j, E) - j->rest_angle;
+    else if (j->rot_element && r == PHLEX_ROW_R3) e0[i] = AngleAboutAxis(j, E) - j->rest_angle;
+    else if (j->slide_element && j->type != PHLEX_JOINT_BUSHING && r == PHLEX_ROW_T3) e0[i] = PhlexDot3(j->frame + 6, dx) - j->rest_slide / j->units->length;
     else if (r <= PHLEX_ROW_T3) e0[i] = PhlexDot3(j->frame + 3 * (r - PHLEX_ROW_T1), dx);
     else e0[i] = PhlexDot3(j->frame + 3 * (r - PHLEX_ROW_R1), phi);
   }

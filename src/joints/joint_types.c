@@ -14,6 +14,7 @@ static PetscErrorCode SelectElementRows(PhlexJoint j)
 {
   const PhlexUnits *u = j->units;
   PetscInt          idx[6];
+  PetscReal         kd[6], cd[6]; /* the springs and dampers of uncoupled rows (SI) */
 
   PetscFunctionBeginUser;
   j->ne = 0;
@@ -31,6 +32,13 @@ static PetscErrorCode SelectElementRows(PhlexJoint j)
     /* a universal's second free rotation, about b's axis: the same spring and damper (uncoupled) */
     if (j->type == PHLEX_JOINT_UNIVERSAL) j->erow[1] = PHLEX_ROW_AXIS_B, idx[1] = 5, j->ne = 2;
   }
+  for (PetscInt i = 0; i < j->ne; i++) kd[i] = j->stiffness, cd[i] = j->damping;
+  if (j->slide_element) {
+    /* the slide along e3 (prismatic, cylindrical): its own spring and damper */
+    j->erow[j->ne] = PHLEX_ROW_T3, idx[j->ne] = 2;
+    kd[j->ne] = j->slide_stiffness, cd[j->ne] = j->slide_damping;
+    j->ne++;
+  }
   for (PetscInt i = 0; i < j->ntable; i++) {
     j->table_e[i] /= u->length;
     j->table_f[i] /= u->force;
@@ -42,7 +50,7 @@ static PetscErrorCode SelectElementRows(PhlexJoint j)
       const PetscReal cl = j->erow[l] <= PHLEX_ROW_T3 ? u->length : 1.0;
       PetscReal       k, c;
       if (j->type == PHLEX_JOINT_BUSHING) k = j->Ksi[6 * idx[i] + idx[l]], c = j->Csi[6 * idx[i] + idx[l]];
-      else k = i == l ? j->stiffness : 0.0, c = i == l ? j->damping : 0.0;
+      else k = i == l ? kd[i] : 0.0, c = i == l ? cd[i] : 0.0;
       j->K[j->ne * i + l] = k * ci * cl / (u->force * u->length);
       j->C[j->ne * i + l] = c * ci * cl / (u->force * u->length * u->time);
     }

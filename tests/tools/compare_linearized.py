@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Compares two linearised analyses (their linearized_modes.csv; a configuration of the first, the second's first) mode by mode: the frequencies of every mode and,
+"""Compares two linearised analyses (their linearized_modes.csv; a configuration of the first, the second's first) mode by mode: the frequencies of every mode (an overdamped motion's decay rate) and,
 for the modes listed with --ratios (1-based), the damping ratios, within a relative tolerance. Prints one verdict
 line (the label given) and fails (exit 1) beyond the tolerance or when the mode counts differ."""
 import argparse
@@ -22,7 +22,12 @@ def main():
     if len(ra) != len(rb) or not ra:
         print("%s: FAIL (%d modes against %d)" % (a.label, len(ra), len(rb)))
         return 1
-    df = max(abs(float(x["frequency_hz"]) / float(y["frequency_hz"]) - 1) for x, y in zip(ra, rb))
+    def size(r):
+        """a mode's frequency, or an overdamped motion's decay rate"""
+        f = float(r["frequency_hz"])
+        return f if f != 0 or "decay_rate_1_s" not in r else float(r["decay_rate_1_s"])
+
+    df = max(abs(size(x) / size(y) - 1) for x, y in zip(ra, rb))
     dz, zmin = 0.0, float("inf")
     for m in [int(k) for k in a.ratios.split(",") if k]:
         za, zb = float(ra[m - 1]["damping_ratio"]), float(rb[m - 1]["damping_ratio"])
