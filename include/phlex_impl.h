@@ -33,6 +33,7 @@ struct _p_PhlexOutput {
   char      dir[PETSC_MAX_PATH_LEN];
   PetscInt  interval; /* field output every n steps (0: initial and final only) */
   PetscBool fields;   /* write HDF5/XDMF */
+  PetscBool keep_failed; /* a numerical failure keeps the series so far in <dir>/failed/ */
   PetscInt  nfiles, maxfiles;
   char    (*tmp)[PETSC_MAX_PATH_LEN], (*final)[PETSC_MAX_PATH_LEN];
   PetscInt  ncommitted; /* files renamed to their final names so far */
@@ -114,6 +115,7 @@ PETSC_INTERN PetscErrorCode PhlexCSVPrintf(PetscViewer, const char[], ...) PETSC
 PETSC_INTERN PetscErrorCode PhlexOutputFlushSeries(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputCommit(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputAbort(PhlexOutput);
+PETSC_INTERN PetscErrorCode PhlexOutputKeepFailed(PhlexOutput);
 PETSC_INTERN PetscErrorCode PhlexOutputDestroy(PhlexOutput *);
 PETSC_INTERN PetscErrorCode PhlexOutputSaveState(PhlexOutput, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexOutputAddWriter(PhlexOutput, void *, PetscErrorCode (*)(void *, PetscViewer));

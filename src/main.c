@@ -106,6 +106,9 @@ int main(int argc, char **argv)
   if (ierr) {
     /* no half-written result: remove the run's temporary files (and its directory if the run made it and it is
        empty); the error was printed by the handler */
+    code = PhlexExitCode();
+    /* a numerical failure keeps the series so far, to show how it grew (in <dir>/failed/, apart from results) */
+    if (scene && code == PHLEX_EXIT_NUMERICAL) (void)PhlexOutputKeepFailed(scene->output);
     if (scene) (void)PhlexOutputAbort(scene->output);
     /* the options a failed run did not reach are not misspelt: no -options_left report */
     (void)PetscOptionsSetValue(NULL, "-options_left", "0");

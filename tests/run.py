@@ -847,6 +847,11 @@ def check_files(spec: Spec, absdir: str, chk: Checker) -> None:
         if item == "outdir-empty":
             if os.path.isdir(absdir) and os.listdir(absdir):
                 chk.fail("outdir not empty", ["  left behind: " + ", ".join(sorted(os.listdir(absdir)))])
+        elif item == "outdir-no-results":
+            # a numerical failure: nothing but the series so far, apart in failed/
+            left = sorted(set(os.listdir(absdir)) - {"failed"}) if os.path.isdir(absdir) else []
+            if left:
+                chk.fail("outdir holds results", ["  left behind: " + ", ".join(left)])
         elif os.path.lexists(os.path.join(absdir, item)):
             chk.fail(f"{item} exists but should not")
     for item in spec.files_present:

@@ -135,6 +135,7 @@ typedef struct {
   PetscErrorCode (*momenta)(PhlexPart, PetscReal[3], PetscReal[3]);         /* inertial linear and angular momentum (about the origin), evaluated state; NULL: held */
   PetscErrorCode (*inputpower)(PhlexPart, PetscReal *);                       /* power of its external inputs at the evaluated state */
   PetscErrorCode (*dissipation)(PhlexPart, PetscReal *);                      /* power its dampers dissipate at the evaluated state (>= 0); NULL: none */
+  PetscErrorCode (*deformation)(PhlexPart, const PhlexPartVec *, PetscReal *, PetscReal *, PetscBool *); /* largest elastic displacement and its size [m] at X, whether a spin would need -geometric_stiffening (the blow-up watchdog); NULL: none */
   PetscErrorCode (*rigidmass)(PhlexPart, PetscReal[36]);                      /* mass matrix of its frame motion (v_P, w), body frame; NULL: held */
   PetscErrorCode (*outputopen)(PhlexPart, PhlexOutput, PetscBool);
   PetscErrorCode (*outputstep)(PhlexPart, PetscInt, PetscReal, const PhlexPartVec *, PetscBool); /* series rows (step >= 0), fields if asked */

@@ -32,6 +32,8 @@ typedef struct {
   PetscInt    nprojections;
   /* watchdogs: stop a run whose numbers went wrong (0: off) */
   PetscReal   watch_balance, watch_gap, watch_orth;
+  PetscReal   watch_energy;    /* stop when the energy created (H - H0 - W + D) exceeds this times max(|H0|, the work) */
+  PetscReal   watch_deform;    /* stop when a body's elastic displacement exceeds this times its size */
   PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
   PhlexProgress progress;
   /* adaptive steps: a step that breaks a watchdog, or whose Newton fails, is retried with a smaller step */

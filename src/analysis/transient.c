@@ -17,6 +17,7 @@ static PetscErrorCode TransientProgress(TS, MonitorContext *, PetscInt, PetscRea
 static PetscErrorCode ReportRetry(TS, MonitorContext *, const char[]);
 static PetscErrorCode InputPower(MonitorContext *, PetscReal, Vec, PetscReal, PetscBool, PetscReal *, PetscReal *);
 static PetscErrorCode Watchdogs(MonitorContext *, PetscInt, PetscReal, PetscReal, PetscReal);
+static PetscErrorCode WatchDeformation(MonitorContext *, PetscInt, PetscReal, Vec);
 
 /* ---------------------------------------------------------------------------------------------------------- */
 /* Energy and power-balance monitor                                                                            */
@@ -341,6 +342,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   if (m->monitor && m->dissipative) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  dissipated %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(dissipated * u->power), (double)(residual * u->energy)));
   else if (m->monitor) PetscCall(PetscViewerASCIIPrintf(m->monitor, "%4" PetscInt_FMT " t %.6e H %.10e J  power %.6e W  balance residual %.3e J\n", step, (double)t, (double)(H * u->energy), (double)(power * u->power), (double)(residual * u->energy)));
   PetscCall(Watchdogs(m, step, t, H, residual - m->step_project_dH));
+  if (step > 0 && m->watch_deform > 0) PetscCall(WatchDeformation(m, step, t, X));
   m->step_project_dH = 0;
   if (m->Xprev) PetscCall(VecCopy(X, m->Xprev));
   PetscCall(PhlexSystemGather(sys, X, m->qprev));
@@ -357,6 +359,32 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     PetscCheck(!sig, m->scene->comm, PETSC_ERR_SIG, "interrupted by %s at step %" PetscInt_FMT ", t = %g s: checkpoint written to %s; continue the run with -restart %s", sig == 2 ? "SIGINT" : "SIGTERM", step, (double)t, m->ck_file, m->ck_file);
   }
   if (step > 0) PetscCall(TransientProgress(ts, m, step, t));
+  PetscFunctionReturn(0);
+}
+
+/* the deformation watchdog: a body whose elastic displacement exceeds -watchdog_deformation times its size has left
+   the range of its elastic model (a linear model spun past its first bending frequency diverges: spin softening) */
+static PetscErrorCode WatchDeformation(MonitorContext *m, PetscInt step, PetscReal t, Vec X)
+{
+  PhlexSystem sys = m->sys;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < sys->nparts; i++) {
+    PhlexPart    part = sys->parts[i];
+    PhlexPartVec pv;
+    PetscReal    umax, size;
+    PetscBool    stiffen;
+    if (!part->ops.deformation) continue;
+    PetscCall(PhlexSystemPartVec(sys, part, X, sys->q, &pv));
+    PetscCall((*part->ops.deformation)(part, &pv, &umax, &size, &stiffen));
+    PetscCall(PhlexSystemPartVecRestore(sys, part, X, &pv));
+    if (umax > m->watch_deform * size || PetscIsInfOrNanReal(umax)) {
+      char advice[256], f[32];
+      if (stiffen) PetscCall(PetscSNPrintf(advice, sizeof(advice), "its elastic model is linear: a fast rotation (a spin, a driven hub) softens it and past its first bending frequency it diverges; add -%sgeometric_stiffening (the centrifugal stiffening), or reduce the load or -ts_dt", part->prefix));
+      else PetscCall(PetscSNPrintf(advice, sizeof(advice), "reduce the loads or -ts_dt, or check the material's units"));
+      SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): body %s's elastic displacement reached %.4e m, more than -watchdog_deformation %s times its size %.4g m: the run blew up; %s (-watchdog_deformation 0 turns this check off); no result was written", step, (double)t, part->name, (double)umax, PhlexFormatReal(m->watch_deform, f, sizeof(f)), (double)size, advice);
+    }
+  }
   PetscFunctionReturn(0);
 }
 
@@ -384,6 +412,26 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
       if (m->sys->parts[i]->material_warned) PetscCall(PetscSNPrintf(material, sizeof(material), "; first check body %s's material, warned about at the start (its units, or near incompressibility): it conditions the solves badly", m->sys->parts[i]->name));
     PetscCheck(PetscAbsReal(residual) <= m->watch_balance * scale, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the power balance of the step is off by %.3e J, %.2e of the energy %.3e J (bound -watchdog_balance_rtol %g): the midpoint rule holds it to solver tolerance, so Newton or the linear solver failed silently%s; tighten %s or reduce -ts_dt (-watchdog_balance_rtol 0 turns this check off); no result was written",
                step, (double)t, (double)(residual * u->energy), (double)(PetscAbsReal(residual) / scale), (double)(scale * u->energy), (double)m->watch_balance, material, m->condensed ? "-condensed_ksp_rtol" : (m->reduced ? "-snes_rtol/-reduced_ksp_rtol" : "-snes_rtol/-ksp_rtol"));
+  }
+  if (step > 0 && m->watch_energy > 0) {
+    /* energy created from nothing: H_n - H0 - W_n + D_n (less the projections' removals) beyond its scale, the initial
+       energy or the work supplied or dissipated: an unstable scheme or a solver gone wrong; with the midpoint rule it
+       stays at solver tolerance (a spinning body's indefinite energy can also fall without bound: the deformation
+       watchdog catches that) */
+    const PetscReal created = H - m->H0 - m->work_total + m->dissipated_total - m->project_dH;
+    const PetscReal scale   = PetscMax(PetscAbsReal(m->H0), m->max_work);
+    if (scale > 0 && created > m->watch_energy * scale) {
+      char advice[256], f[32];
+      if (m->theta && m->theta_value < 0.5) PetscCall(PetscSNPrintf(advice, sizeof(advice), "-ts_theta_theta %g < 0.5 amplifies every mode the step does not resolve: use 0.5 (the implicit midpoint rule) or more", (double)m->theta_value));
+      else PetscCall(PetscSNPrintf(advice, sizeof(advice), "reduce -ts_dt, use the implicit midpoint rule, or tighten the solver's tolerances"));
+      for (PetscInt i = 0; i < m->sys->nparts; i++)
+        if (m->sys->parts[i]->material_warned) {
+          PetscCall(PetscSNPrintf(advice, sizeof(advice), "first check body %s's material, warned about at the start (its units, or near incompressibility)", m->sys->parts[i]->name));
+          break;
+        }
+      SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the energy is %.4e J, %.3e J more than the initial energy %.4e J plus the work supplied %.4e J less the work dissipated %.4e J, more than -watchdog_energy_factor %s times their scale %.3e J: the run blew up; %s (-watchdog_energy_factor 0 turns this check off); no result was written",
+              step, (double)t, (double)(H * u->energy), (double)(created * u->energy), (double)(m->H0 * u->energy), (double)(m->work_total * u->energy), (double)(m->dissipated_total * u->energy), PhlexFormatReal(m->watch_energy, f, sizeof(f)), (double)(scale * u->energy), advice);
+    }
   }
   /* a scheme whose rotations are not re-orthonormalised (BDF, alpha): R^T R - I drifts with the scheme's error */
   if (m->history && !m->orth_warned && m->max_orth > 1e-2 && (m->watch_orth <= 0 || m->max_orth <= m->watch_orth)) {
@@ -433,7 +481,7 @@ static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys, char fi
 /* the options of the transient analysis (the self-checks and the energy monitor; TS, SNES and KSP read theirs) */
 typedef struct {
   PetscReal   drift_max, drift_abs_max, balance_rtol, momentum_max, linear_max, angular_max, orth_max, gap_max;
-  PetscReal   watch_balance, watch_gap, watch_orth;
+  PetscReal   watch_balance, watch_gap, watch_orth, watch_energy, watch_deform;
   PetscReal   velocity_rtol; /* Newton on the whole state: the velocity rows' tolerance (scenes with discrete unknowns) */
   PetscBool   velocity_rtol_set;
   PetscViewer monitor;
@@ -449,6 +497,8 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   o->watch_balance                                                                                                       = 1e-6;
   o->watch_gap                                                                                                           = 1e-2;
   o->watch_orth                                                                                                          = 0.1;
+  o->watch_energy                                                                                                        = 1.0;
+  o->watch_deform                                                                                                        = 1.0;
   o->velocity_rtol                                                                                                       = 1e-10;
   PetscOptionsBegin(comm, NULL, "Transient analysis options", NULL);
   PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", o->drift_max, &o->drift_max, NULL));
@@ -462,10 +512,14 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCall(PetscOptionsReal("-watchdog_balance_rtol", "Watchdog (implicit midpoint rule): stop when a step's power-balance residual exceeds this share of the energy (0: off)", "PhlexSceneSolveTransient", o->watch_balance, &o->watch_balance, NULL));
   PetscCall(PetscOptionsReal("-watchdog_orthogonality", "Watchdog (BDF, alpha: rotations not re-orthonormalised): stop when ||R^T R - I||_F of a frame exceeds this (0: off; a warning past 1e-2)", "PhlexSceneSolveTransient", o->watch_orth, &o->watch_orth, NULL));
   PetscCall(PetscOptionsReal("-watchdog_joint_drift", "Watchdog: stop when a joint opens by more than this times min(L, 1 m) [m or rad] (0: off)", "PhlexSceneSolveTransient", o->watch_gap, &o->watch_gap, NULL));
+  PetscCall(PetscOptionsReal("-watchdog_energy_factor", "Watchdog: stop when the energy created, H - H0 - supplied + dissipated, exceeds this times the larger of |H0| and the work (0: off)", "PhlexSceneSolveTransient", o->watch_energy, &o->watch_energy, NULL));
+  PetscCall(PetscOptionsReal("-watchdog_deformation", "Watchdog: stop when a flexible body's elastic displacement exceeds this times its size (0: off)", "PhlexSceneSolveTransient", o->watch_deform, &o->watch_deform, NULL));
   PetscCall(PetscOptionsReal("-snes_velocity_rtol", "Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns converges when also the velocity rows' residual is below this share of its value at the stage's initial guess (0: off; not given: 1e-10 in a scene with joints, off without)", "PhlexSystemSNESConvergedStage", o->velocity_rtol, &o->velocity_rtol, &o->velocity_rtol_set));
   PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
   PetscOptionsEnd();
   PetscCheck(o->velocity_rtol >= 0 && o->velocity_rtol < 1, comm, PETSC_ERR_USER_INPUT, "-snes_velocity_rtol must be in [0, 1) (0: off), got %g", (double)o->velocity_rtol);
+  PetscCheck(o->watch_energy >= 0 && !PetscIsInfOrNanReal(o->watch_energy), comm, PETSC_ERR_USER_INPUT, "-watchdog_energy_factor must be a finite number >= 0 (0: off), got %g", (double)o->watch_energy);
+  PetscCheck(o->watch_deform >= 0 && !PetscIsInfOrNanReal(o->watch_deform), comm, PETSC_ERR_USER_INPUT, "-watchdog_deformation must be a finite number >= 0 (0: off), got %g", (double)o->watch_deform);
   PetscCheck(o->watch_balance >= 0 && o->watch_gap >= 0 && o->watch_orth >= 0, comm, PETSC_ERR_USER_INPUT, "-watchdog_balance_rtol, -watchdog_joint_drift and -watchdog_orthogonality must be >= 0 (0: off), got %g, %g and %g", (double)o->watch_balance, (double)o->watch_gap, (double)o->watch_orth);
   PetscFunctionReturn(0);
 }
@@ -939,6 +993,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   }
   m.watch_gap       = o.watch_gap;
   m.watch_orth      = o.watch_orth;
+  m.watch_energy    = o.watch_energy;
+  m.watch_deform    = o.watch_deform;
   if (restarting) {
     /* the checkpoint belongs to this run; the outputs continue its */
     PetscCall(PhlexCheckpointOpenRead(scene->comm, restart, &checkpoint));

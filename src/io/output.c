@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 #include <errno.h>
 #include <unistd.h>
+#include <dirent.h>
 
 /*@C
   PhlexOutputCreate - creates the output manager of a run
@@ -21,6 +22,7 @@ PetscErrorCode PhlexOutputCreate(MPI_Comm comm, PhlexOutput *out)
   (*out)->comm     = comm;
   (*out)->interval = 0;
   (*out)->fields   = PETSC_TRUE;
+  (*out)->keep_failed = PETSC_TRUE;
   PetscCall(PetscStrcpy((*out)->dir, "output"));
   PetscFunctionReturn(0);
 }
@@ -31,7 +33,8 @@ PetscErrorCode PhlexOutputCreate(MPI_Comm comm, PhlexOutput *out)
   Options Database Keys:
 + -output_dir <dir>        - directory of the run's results (created if missing)
 . -output_interval <n>     - write fields every n time steps (0: first and last step only)
-- -output_fields <bool>    - write HDF5/XDMF fields
+. -output_fields <bool>    - write HDF5/XDMF fields
+- -output_keep_failed <bool> - a run that fails numerically (exit 3) keeps its series so far in <dir>/failed/
 @*/
 PetscErrorCode PhlexOutputSetFromOptions(PhlexOutput out)
 {
@@ -40,6 +43,7 @@ PetscErrorCode PhlexOutputSetFromOptions(PhlexOutput out)
   PetscCall(PetscOptionsString("-output_dir", "Directory of the run's results (created if missing)", "PhlexOutputSetFromOptions", out->dir, out->dir, sizeof(out->dir), NULL));
   PetscCall(PetscOptionsInt("-output_interval", "Write fields every n time steps (0: first and last step only)", "PhlexOutputSetFromOptions", out->interval, &out->interval, NULL));
   PetscCall(PetscOptionsBool("-output_fields", "Write HDF5/XDMF fields for ParaView", "PhlexOutputSetFromOptions", out->fields, &out->fields, NULL));
+  PetscCall(PetscOptionsBool("-output_keep_failed", "A run that fails numerically (exit 3: a watchdog, Newton) keeps its CSV series up to the failed step in <output_dir>/failed/ (not results: how the failure grew)", "PhlexOutputSetFromOptions", out->keep_failed, &out->keep_failed, NULL));
   PetscOptionsEnd();
   PetscCheck(out->interval >= 0, out->comm, PETSC_ERR_USER_INPUT, "-output_interval must be >= 0, got %" PetscInt_FMT, out->interval);
   PetscCheck(out->dir[0], out->comm, PETSC_ERR_USER_INPUT, "-output_dir must not be empty");
@@ -232,6 +236,54 @@ PetscErrorCode PhlexOutputCommit(PhlexOutput out)
   out->nfiles   = 0;
   out->keep_tmp = PETSC_FALSE; /* nothing temporary is left */
   PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOutputKeepFailed - a run that failed numerically: its CSV series so far (their rows up to the failed step, the
+  last one the step that failed) moved to <dir>/failed/ under their names, any older ones there removed first; the
+  fields are not kept (PhlexOutputAbort removes them). Nothing when a checkpoint keeps the files for -restart.
+
+  Not collective: rank 0 moves the files; safe to call after an error
+@*/
+PetscErrorCode PhlexOutputKeepFailed(PhlexOutput out)
+{
+  PetscMPIInt rank;
+  char        failed[PETSC_MAX_PATH_LEN + 16];
+  PetscInt    nkept = 0;
+
+  if (!out || !out->keep_failed || out->keep_tmp) return 0;
+  MPI_Comm_rank(out->comm, &rank);
+  if (rank) return 0;
+  for (PetscInt k = 0; k < out->nfiles; k++)
+    if (out->csv[k]) nkept++;
+  if (!nkept) return 0;
+  (void)snprintf(failed, sizeof(failed), "%s/failed", out->dir);
+  if (mkdir(failed, 0777) && errno != EEXIST) return 0;
+  {
+    DIR *d = opendir(failed);
+    if (d) {
+      struct dirent *e;
+      while ((e = readdir(d))) {
+        char old[2 * PETSC_MAX_PATH_LEN];
+        if (e->d_name[0] == '.') continue;
+        (void)snprintf(old, sizeof(old), "%s/%s", failed, e->d_name);
+        (void)remove(old);
+      }
+      closedir(d);
+    }
+  }
+  nkept = 0;
+  for (PetscInt k = 0; k < out->nfiles; k++) {
+    FILE       *fp   = NULL;
+    const char *name = strrchr(out->final[k], '/');
+    char        dest[2 * PETSC_MAX_PATH_LEN];
+    if (!out->csv[k]) continue;
+    if (!PetscViewerASCIIGetPointer(out->csv[k], &fp) && fp) (void)fflush(fp);
+    (void)snprintf(dest, sizeof(dest), "%s/%s", failed, name ? name + 1 : out->final[k]);
+    if (!rename(out->tmp[k], dest)) nkept++;
+  }
+  if (nkept) fprintf(stderr, "phlex: the run's %d series up to the failed step are kept in '%s/' (not results: their last rows show how the failure grew; -output_keep_failed false keeps none)\n", (int)nkept, failed);
+  return 0;
 }
 
 /*@C

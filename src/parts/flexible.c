@@ -470,6 +470,32 @@ static PetscErrorCode FlexEnergyBegin(PhlexPart part, const PhlexPartVec *X)
   PetscFunctionReturn(0);
 }
 
+/* the largest elastic displacement |u| over the nodes at X and the body's size (its bounding box's largest side), for
+   the blow-up watchdog; whether a spin would need geometric stiffening (the linear model is used) */
+static PetscErrorCode FlexDeformation(PhlexPart part, const PhlexPartVec *X, PetscReal *umax, PetscReal *size, PetscBool *linear)
+{
+  PhlexFlexible      b = (PhlexFlexible)part->data;
+  const PetscScalar *a;
+  PetscInt           n, bs;
+  PetscReal          m2 = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(X->u, &n));
+  PetscCall(VecGetBlockSize(X->u, &bs));
+  PetscCall(VecGetArrayRead(X->u, &a));
+  if (bs == 3)
+    for (PetscInt i = 0; i + 2 < n; i += 3) m2 = PetscMax(m2, PetscRealPart(a[i] * a[i] + a[i + 1] * a[i + 1] + a[i + 2] * a[i + 2]));
+  else
+    for (PetscInt i = 0; i < n; i++) m2 = PetscMax(m2, PetscRealPart(a[i] * a[i])); /* a component's largest: a bound within sqrt(3) */
+  PetscCall(VecRestoreArrayRead(X->u, &a));
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &m2, 1, MPIU_REAL, MPIU_MAX, b->comm));
+  *umax = PetscSqrtReal(m2) * part->units->length;
+  *size = 0;
+  for (PetscInt d = 0; d < 3; d++) *size = PetscMax(*size, b->bbox_max[d] - b->bbox_min[d]);
+  *linear = (PetscBool)!b->stiffening;
+  PetscFunctionReturn(0);
+}
+
 /* kinetic 1/2 v^T Mv v (floating: the frame's, which holds it), strain 1/2 s^T Ms s, and the potential of gravity or
    of a spin's centrifugal field, at the evaluated state X (non-dimensional) */
 static PetscErrorCode FlexEnergy(PhlexPart part, const PhlexPartVec *X, PetscReal *kin, PetscReal *strain, PetscReal *pot)
@@ -678,6 +704,7 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   part->ops.prepareinitialstate = PhlexFlexiblePrepareInitialState;
   part->ops.initialstate        = PhlexFlexibleInitialState;
   part->ops.energy              = FlexEnergy;
+  part->ops.deformation         = FlexDeformation;
   part->ops.inputpower          = FlexInputPower;
   part->ops.momenta             = FlexMomenta;
   part->ops.rigidmass           = FlexRigidMass;
