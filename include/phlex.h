@@ -94,6 +94,11 @@ PETSC_EXTERN PetscErrorCode PhlexProfileEvaluate(PhlexProfile, PetscReal, PetscR
 PETSC_EXTERN PetscErrorCode PhlexProfileIntegrate(PhlexProfile, PetscReal, PetscReal *);
 PETSC_EXTERN PetscErrorCode PhlexProfileView(PhlexProfile, PetscViewer);
 PETSC_EXTERN PetscErrorCode PhlexProfileDescribe(PhlexProfile, char[], size_t);
+PETSC_EXTERN PetscErrorCode PhlexProfileDerivative(PhlexProfile, PetscReal, PetscReal *);
+PETSC_EXTERN PetscErrorCode PhlexProfileBounds(PhlexProfile, PetscReal *, PetscReal *);
+PETSC_EXTERN PetscErrorCode PhlexProfileGiven(const char[], PetscBool *);
+PETSC_EXTERN PetscErrorCode PhlexProfileCheckRange(PhlexProfile, PetscReal, PetscReal, const char[]);
+PETSC_EXTERN PetscErrorCode PhlexProfileCheckRangeAll(PetscReal, PetscReal, const char[]);
 PETSC_EXTERN PetscErrorCode PhlexProfileDestroy(PhlexProfile *);
 
 /* scene.c */

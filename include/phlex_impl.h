@@ -16,14 +16,26 @@ typedef enum {
 } PhlexProfileType;
 PETSC_EXTERN const char *const PhlexProfileTypes[];
 
+/* What a table profile is outside its points. */
+typedef enum {
+  PHLEX_EXTRAPOLATE_HOLD,  /* its first and last values */
+  PHLEX_EXTRAPOLATE_ZERO,  /* zero */
+  PHLEX_EXTRAPOLATE_ERROR  /* a run reaching outside is refused at set-up (PhlexProfileCheckRange) */
+} PhlexExtrapolation;
+PETSC_EXTERN const char *const PhlexExtrapolations[];
+
 struct _p_PhlexProfile {
-  MPI_Comm         comm;
-  char             prefix[256];
-  char             what[128]; /* used in messages: "body cantilever, port tip" */
-  PhlexProfileType type;
-  PetscReal        start_time, ramp_time, frequency, phase, scale;
-  PetscInt         ntable;
-  PetscReal       *table_t, *table_f;
+  MPI_Comm           comm;
+  char               prefix[256];
+  char               what[128]; /* used in messages: "body cantilever, port tip" */
+  PhlexProfileType   type;
+  PetscReal          start_time, ramp_time, frequency, phase, scale;
+  PetscInt           ntable;
+  PetscReal         *table_t, *table_f;
+  PhlexExtrapolation extrapolate;
+  char               file[PETSC_MAX_PATH_LEN]; /* the table's CSV file ("": given inline) */
+  char               column[160];              /* the file's column f follows, for messages: "2 ('force')" */
+  PetscBool          given;                    /* one of its options was given */
 };
 
 /* Output of one run: a directory with fields (HDF5 + XDMF per body) and CSV series, written under temporary names

@@ -26,6 +26,8 @@ restart|-options_file options/flexible_double_pendulum.yaml -body0_dm_plex_filen
 bordered_serial|-options_file options/flexible_double_pendulum.yaml -body0_dm_plex_filename meshes/bar_struct_n1.msh -body1_dm_plex_filename meshes/bar_struct_n1.msh -body0_petscspace_degree 1 -body1_petscspace_degree 1 -ts_max_steps 2 -output_fields 0 -solver_options_file options/solver/bordered_serial.opts|0
 bordered_lu_error|-options_file options/floating_tumbling.yaml -body0_dm_plex_filename meshes/bar_struct_n2.msh -ts_max_steps 2 -output_fields 0 -reduced_bordered_pc_factor_mat_solver_type cholmod|2
 adaptive_retry|-options_file options/pendulum.yaml -ts_dt 2.75 -ts_max_time 6 -ts_adapt_type basic|0
+series|-options_file tests/scenes/force_elements.yaml -ts_max_steps 6 -joint3_rest_length_profile_file tests/data/rest_length_ramp.csv -body0_port_tip_force 1,0,0 -body0_port_tip_profile_file tests/data/measured_load.csv -body0_port_tip_profile_column moment -output_ports block:q,arm:tip -output_ports_interval 0.0033 -checkpoint_interval 3|0
+bad_series_value|-options_file options/pendulum.yaml -ts_max_time 0.1 -body0_ports pivot,tip -body0_port_tip_position 0,-1.2,0 -body0_port_tip_force 0,0,2 -body0_port_tip_profile_file tests/data/bad_value.csv -body0_port_tip_profile_column force|2
 help|-help|0
 help_scene|-options_file options/cantilever.yaml -help|0
 misspelt_option|-options_file options/cantilever.yaml -ts_max_steps 2 -body0_petscspace_degree 1 -body0_densty 3 -ts_typ bdf|2

@@ -374,6 +374,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSpinDestroy(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexibleComputeModes(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
 PETSC_INTERN PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
 PETSC_INTERN PetscErrorCode PhlexFlexibleModesRequestCheck(PhlexPart, PetscInt, const char[], PetscInt);
+PETSC_INTERN PetscErrorCode PhlexFlexiblePortInput(PhlexPart, PhlexFlexible, PetscBool, const PhlexFrameState *, PetscInt, PetscReal, PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexFlexiblePortSeriesRow(PhlexPart, PhlexFlexible, PetscBool, const PhlexFrameState *, PetscReal (*)[6], PetscReal, const PhlexPartVec *, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexFlexibleModesOutput(PhlexPart, PhlexOutput, PetscInt, PetscInt, const PetscReal *, Vec *, const PetscReal *, const PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleRefine(PhlexPart, PetscInt, PhlexPart *);

@@ -18,7 +18,13 @@
    stored energy V = 1/2 e^T K e, dissipated power D = (S_e^T Delta)^T C (S_e^T Delta) >= 0 (K, C symmetric
    positive semi-definite). With the implicit midpoint rule V_{n+1} - V_n = dt e_mid^T K e' exactly, so the
    balance H_{n+1} - H_n = dt (P - D) holds to solver tolerance with V in H. The unknowns of a joint: nc constraint
-   impulses, ne force impulses, ne states (qoff, qoff + nc, qoff + nc + ne). */
+   impulses, ne force impulses, ne states (qoff, qoff + nc, qoff + nc + ne).
+
+   A moving rest (an actuator: a spring_damper's rest length or a torsion spring's rest angle following a profile,
+   rest(t) = rest f(t)): the spring acts on a = e - r(t), r(t) = rest(t) - rest, V = 1/2 K a^2, so the actuator supplies
+   the power -K a r'(t). With the midpoint rule the stage takes r's mean over the step, (r_n + r_{n+1})/2: then
+   V_{n+1} - V_n = K a_mid ((e_{n+1} - e_n) - (r_{n+1} - r_n)) exactly, the port power takes the first term and the
+   actuator's work over the step is -K a_mid (r_{n+1} - r_n), so the balance still holds to solver tolerance. */
 #ifndef PHLEX_PRIVATE_JOINT_H
 #define PHLEX_PRIVATE_JOINT_H
 
@@ -117,6 +123,14 @@ struct _p_PhlexJoint {
   PetscReal     table_e[64], table_f[64]; /* its points (SI as given; non-dimensional after set-up) */
   PetscBool     dg;                     /* the table's force is the discrete gradient over the step (implicit midpoint) */
   PetscReal     e_start[6];             /* the states at the step's start (the discrete gradient's e_n) */
+  PhlexProfile  rest_profile;           /* a moving rest: spring_damper L(t) = rest_length f(t), torsion spring
+                                           rest_angle f(t) (NULL: fixed); the state e stays relative to the nominal
+                                           rest, the spring acts on e - (rest(t) - rest) */
+  PetscBool     rest_step;              /* a midpoint step from rest_t0 is under way: its stage takes the mean of the
+                                           rest's change at the step's two ends (PhlexJointElementStepStart) */
+  PetscReal     rest_t0;
+  PetscReal     eshift;                 /* evaluated: the rest's change from the nominal (non-dimensional) */
+  PetscReal     actuator_work;          /* the work the moving rest did on the element so far (non-dimensional) */
 
   /* output */
   PetscViewer csv;
@@ -146,12 +160,14 @@ PETSC_INTERN PetscErrorCode PhlexJointRelativeMotion(PhlexJoint, const PhlexPart
 PETSC_INTERN PetscErrorCode PhlexJointRigidGradient(PhlexJoint, PetscReal *, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointDropRow(PhlexJoint, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointOutputOpen(PhlexJoint, PhlexOutput);
-PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, PetscReal, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
 PETSC_INTERN PetscInt       PhlexJointNumUnknowns(PhlexJoint);
 PETSC_INTERN PetscBool      PhlexJointDamped(PhlexJoint);
 PETSC_INTERN PetscErrorCode PhlexJointElementInitial(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *, PetscReal[6]);
-PETSC_INTERN PetscErrorCode PhlexJointElementEnergy(PhlexJoint, const PetscReal *, PetscReal *);
-PETSC_INTERN PetscErrorCode PhlexJointElementStepStart(PhlexJoint, const PetscReal *, PetscBool);
+PETSC_INTERN PetscErrorCode PhlexJointElementEnergy(PhlexJoint, PetscReal, const PetscReal *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointElementStepStart(PhlexJoint, PetscReal, const PetscReal *, PetscBool, PetscBool);
+PETSC_INTERN PetscErrorCode PhlexJointActuatorPower(PhlexJoint, PetscReal, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointPortWrench(PhlexJoint, const PetscReal *, PhlexPart, PetscInt, PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexJointPower(PhlexJoint, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointSourcePower(PhlexJoint, PetscReal, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointDissipation(PhlexJoint, const PetscReal *, PetscReal *);

@@ -127,6 +127,7 @@ typedef struct {
   PetscErrorCode (*poststep)(PhlexPart, PetscReal *, PetscReal *);         /* its discrete unknowns after a step; largest correction; NULL: none */
   /* ports */
   PetscErrorCode (*portoutput)(PhlexPart, PetscInt, PetscReal[6]);                           /* y at the evaluated state */
+  PetscErrorCode (*portinput)(PhlexPart, PetscInt, PetscReal, PetscReal[6]);                 /* u: the wrench its load applies at t, evaluated state (body frame); NULL: none */
   PetscErrorCode (*portlinear)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal *, PetscReal[6]); /* dy for (a du, dv, dq); NULL: zero */
   PetscErrorCode (*portforce)(PhlexPart, PetscInt, const PetscReal[6], Vec, PetscReal *);      /* += generalized force of w (fv may be NULL) */
   PetscErrorCode (*portplacement)(PhlexPart, PetscInt, const PhlexPartVec *, PetscReal[3], PetscReal[9]); /* inertial position, orientation */

@@ -14,7 +14,8 @@ typedef struct {
   PetscReal   H0, Hprev, tprev, work_total, max_drift, max_residual, max_work, Hmax, Emax; /* Emax: largest kinetic + strain energy */
   PetscReal   dissipated_total; /* the energy the dampers dissipated (>= 0); max_work: the largest of it and |work_total| */
   PetscBool   dissipative;      /* a part or joint has dampers (the summary and the monitor show the dissipation) */
-  PetscBool   element_tables;   /* a force element has a force table (its discrete gradient needs e_n) */
+  PetscBool   element_tables;   /* a force element has a force table (its discrete gradient needs e_n) or a moving rest (the step's start time) */
+  PetscBool   midpoint;         /* the implicit midpoint rule (a moving rest's change is its mean over each step) */
   PetscViewer energy_csv, monitor;
   PetscInt    interval, last_written;
   PetscBool   theta, endpoint;
@@ -24,6 +25,7 @@ typedef struct {
   PetscReal  *qprev, *lambda; /* discrete unknowns of the previous step, multipliers (step averages) */
   PetscReal  *jpower;         /* power through each joint over the step, with the scheme's quadrature */
   PetscReal  *jdiss;          /* power each joint's force elements dissipated over the step (the same quadrature) */
+  PetscReal  *jact;           /* power each joint's moving rest supplied over the step (the same quadrature) */
   /* momenta of a free system, rotations */
   PetscBool   free_system;
   PetscReal   P0[3], L0[3], Pscale, Lscale, max_dP, max_dL, max_orth, max_defect;
@@ -45,6 +47,18 @@ typedef struct {
   char        last_retry[256]; /* why the step being taken was retried (cleared when a step is accepted) */
   char        run_retry[256];  /* why the last retried step of the run was retried */
   PetscReal   dt_nominal;      /* -ts_dt */
+  PetscReal   profile_t0;          /* the run's start, for the inputs' series (PhlexProfileCheckRange) */
+  /* chosen port outputs at a rate (transient_ports.c): ports.csv */
+  PetscInt       nports_out;
+  PhlexPart     *out_part;
+  PetscInt      *out_port;
+  char         (*out_names)[2 * PHLEX_NAME_LEN + 2];
+  PetscReal      ports_every;     /* the sampling interval [s] (0: every step) */
+  PetscInt       ports_next;      /* the next sample, t = ports_next ports_every */
+  PetscReal     *out_prev, *out_row, ports_prev_t; /* the last monitored step's row and time, the current row */
+  PetscBool      ports_have_prev;
+  PetscViewer    ports_csv;
+  PetscBool   profile_check_steps; /* the run's end is not known in advance: each step is checked */
   /* checkpoints (transient_checkpoint.c) */
   PetscInt       first_step;   /* the step the run starts from (a restart's checkpoint; 0 otherwise) */
   PetscInt       last_step;    /* the last step monitored (-1: none) */
@@ -60,5 +74,11 @@ PETSC_INTERN PetscErrorCode PhlexTransientCheckpointDue(MonitorContext *, PetscI
 PETSC_INTERN PetscErrorCode PhlexTransientCheckpointWrite(TS, MonitorContext *, Vec);
 PETSC_INTERN PetscErrorCode PhlexTransientRestartCheck(TS, MonitorContext *, PetscViewer, const char[], Vec);
 PETSC_INTERN PetscErrorCode PhlexTransientRestart(TS, MonitorContext *, PetscViewer, const char[], Vec);
+PETSC_INTERN PetscErrorCode PhlexTransientPortsSetUp(MonitorContext *, PetscInt, char *[], PetscReal);
+PETSC_INTERN PetscErrorCode PhlexTransientPortsOpen(MonitorContext *);
+PETSC_INTERN PetscErrorCode PhlexTransientPortsStep(MonitorContext *, PetscReal, Vec);
+PETSC_INTERN PetscErrorCode PhlexTransientPortsSave(MonitorContext *, PetscViewer);
+PETSC_INTERN PetscErrorCode PhlexTransientPortsRestart(MonitorContext *, PetscViewer, const char[]);
+PETSC_INTERN PetscErrorCode PhlexTransientPortsDestroy(MonitorContext *);
 
 #endif

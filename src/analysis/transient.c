@@ -42,14 +42,16 @@ static PetscErrorCode InputPower(MonitorContext *m, PetscReal t, Vec X, PetscRea
     *D += d;
   }
   for (PetscInt k = 0; k < sys->njoints; k++) {
-    PetscReal p, d;
+    PetscReal p, d, a;
     if (stage) PetscCall(PhlexJointPower(sys->joints[k], m->lambda + sys->joints[k]->qoff, &p));
     else PetscCall(PhlexJointSourcePower(sys->joints[k], t, m->lambda + sys->joints[k]->qoff, &p));
     PetscCall(PhlexJointDissipation(sys->joints[k], m->lambda + sys->joints[k]->qoff, &d));
-    *P += p;
+    PetscCall(PhlexJointActuatorPower(sys->joints[k], t, &a)); /* a moving rest's */
+    *P += p + a;
     *D += d;
     m->jpower[k] += weight * p;
     m->jdiss[k] += weight * d;
+    m->jact[k] += weight * a;
   }
   PetscFunctionReturn(0);
 }
@@ -74,10 +76,11 @@ static PetscErrorCode EnergyAndOutputs(MonitorContext *m, PetscInt step, PetscRe
     PhlexPartVec pv[2];
     PetscReal    gmax;
     PetscCall(PhlexSystemJointSides(sys, j, X, sys->q, pv));
-    PetscCall(PhlexJointOutputStep(j, t, m->lambda + j->qoff, m->jpower[k], m->jdiss[k], &pv[0], &pv[1], &gmax));
+    PetscCall(PhlexJointOutputStep(j, t, m->lambda + j->qoff, m->jpower[k], m->jdiss[k], m->jact[k], &pv[0], &pv[1], &gmax));
     PetscCall(PhlexSystemJointSidesRestore(sys, j, X, pv));
     m->max_gap = PetscMax(m->max_gap, gmax);
   }
+  PetscCall(PhlexTransientPortsStep(m, t, X)); /* after the parts' outputs: every port's output is then computed */
   PetscCall(PhlexOutputFlushSeries(sys->scene->output));
   if (m->free_system) {
     PetscReal P[3] = {0, 0, 0}, L[3] = {0, 0, 0};
@@ -219,11 +222,20 @@ static PetscErrorCode PreStep(TS ts)
   PetscCall(TSGetSolution(ts, &X));
   PetscCall(TSGetTimeStep(ts, &dt));
   PetscCall(PhlexSystemUpdateJoints(m->sys, X, dt));
-  /* the force elements' states at the step's start (a table spring's discrete gradient; only a table needs them) */
+  if (m->profile_check_steps) {
+    /* adaptive steps with no end time: each step's end against the series */
+    PetscReal t;
+    PetscCall(TSGetTime(ts, &t));
+    PetscCall(PhlexProfileCheckRangeAll(m->profile_t0, t + dt, "adaptive steps bounded by -ts_max_steps alone: this step's end"));
+  }
+  /* the force elements' states at the step's start (a table spring's discrete gradient) and its time (a moving rest's
+     mean over a midpoint step); only these need them */
   {
     if (m->element_tables) {
+      PetscReal t0;
+      PetscCall(TSGetTime(ts, &t0));
       PetscCall(PhlexSystemGather(m->sys, X, m->sys->q));
-      for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], m->sys->q, m->lossless_scheme));
+      for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], t0, m->sys->q, m->lossless_scheme, m->midpoint));
     }
   }
   PetscFunctionReturn(0);
@@ -287,7 +299,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   m->last_retry[0] = 0;
   m->snes_failures = 0;
   PetscCall(PetscLogEventBegin(PHLEX_MonitorEnergy, 0, 0, 0, 0));
-  for (PetscInt k = 0; k < sys->njoints; k++) m->jpower[k] = m->jdiss[k] = 0.0;
+  for (PetscInt k = 0; k < sys->njoints; k++) m->jpower[k] = m->jdiss[k] = m->jact[k] = 0.0;
   if (step == 0 && sys->njoints) {
     /* the joints' power at the consistent start */
     PetscReal P0, D0;
@@ -320,7 +332,10 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     }
   }
   /* the work each joint's force elements dissipated (its series reports it with the step) */
-  for (PetscInt k = 0; k < sys->njoints && step > 0; k++) sys->joints[k]->dissipated_work += dt * m->jdiss[k];
+  for (PetscInt k = 0; k < sys->njoints && step > 0; k++) {
+    sys->joints[k]->dissipated_work += dt * m->jdiss[k];
+    sys->joints[k]->actuator_work += dt * m->jact[k]; /* and the work of a moving rest */
+  }
   fields = (step == 0 || (m->interval > 0 && step % m->interval == 0)) ? PETSC_TRUE : PETSC_FALSE;
   PetscCall(EnergyAndOutputs(m, step, t, X, fields, &kin, &strain, &pot));
   if (fields) m->last_written = step;
@@ -485,6 +500,9 @@ typedef struct {
   PetscReal   velocity_rtol; /* Newton on the whole state: the velocity rows' tolerance (scenes with discrete unknowns) */
   PetscBool   velocity_rtol_set;
   PetscViewer monitor;
+  char      **ports; /* -output_ports: body:port names (nports) */
+  PetscInt    nports;
+  PetscReal   ports_interval;
 } TransientOptions;
 
 static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o)
@@ -500,7 +518,13 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   o->watch_energy                                                                                                        = 1.0;
   o->watch_deform                                                                                                        = 1.0;
   o->velocity_rtol                                                                                                       = 1e-10;
+  o->ports_interval                                                                                                      = 0.0;
+  PetscCall(PhlexOptionsListLength(NULL, "-output_ports", &o->nports));
+  PetscCall(PetscCalloc1(o->nports, &o->ports));
   PetscOptionsBegin(comm, NULL, "Transient analysis options", NULL);
+  PetscCall(PetscOptionsStringArray("-output_ports", "Chosen ports body:port,... whose input wrench, output velocities, position and joint wrench go to ports.csv at -output_ports_interval (a controller's or a co-simulation's input)", "PhlexSceneSolveTransient", o->ports, &o->nports, &flg));
+  if (!flg) o->nports = 0;
+  PetscCall(PetscOptionsReal("-output_ports_interval", "Sampling interval of ports.csv [s]: samples at t = k h, linearly interpolated between the steps around them (0: every step)", "PhlexSceneSolveTransient", o->ports_interval, &o->ports_interval, NULL));
   PetscCall(PetscOptionsReal("-expect_energy_drift_max", "Self-check: bound on max |H - H0| / H0", "PhlexSceneSolveTransient", o->drift_max, &o->drift_max, NULL));
   PetscCall(PetscOptionsReal("-expect_energy_drift_abs_max", "Self-check: bound on max |H - H0| [J] (when H0 is no scale: a mechanism starting at rest)", "PhlexSceneSolveTransient", o->drift_abs_max, &o->drift_abs_max, NULL));
   PetscCall(PetscOptionsReal("-expect_power_balance_rtol", "Self-check: bound on max |H_{n+1} - H_n - W_step| / max |supplied work|", "PhlexSceneSolveTransient", o->balance_rtol, &o->balance_rtol, NULL));
@@ -521,6 +545,16 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCheck(o->watch_energy >= 0 && !PetscIsInfOrNanReal(o->watch_energy), comm, PETSC_ERR_USER_INPUT, "-watchdog_energy_factor must be a finite number >= 0 (0: off), got %g", (double)o->watch_energy);
   PetscCheck(o->watch_deform >= 0 && !PetscIsInfOrNanReal(o->watch_deform), comm, PETSC_ERR_USER_INPUT, "-watchdog_deformation must be a finite number >= 0 (0: off), got %g", (double)o->watch_deform);
   PetscCheck(o->watch_balance >= 0 && o->watch_gap >= 0 && o->watch_orth >= 0, comm, PETSC_ERR_USER_INPUT, "-watchdog_balance_rtol, -watchdog_joint_drift and -watchdog_orthogonality must be >= 0 (0: off), got %g, %g and %g", (double)o->watch_balance, (double)o->watch_gap, (double)o->watch_orth);
+  PetscFunctionReturn(0);
+}
+
+/* the option strings TransientSetFromOptions allocated */
+static PetscErrorCode TransientOptionsFree(TransientOptions *o)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < o->nports; k++) PetscCall(PetscFree(o->ports[k]));
+  PetscCall(PetscFree(o->ports));
+  o->nports = 0;
   PetscFunctionReturn(0);
 }
 
@@ -549,6 +583,7 @@ static PetscErrorCode TransientRereadOptions(void *ctx)
   PetscCall(PhlexSceneReadOptions(comm));
   PetscCall(TransientSetFromOptions(comm, &o));
   PetscCall(PetscViewerDestroy(&o.monitor));
+  PetscCall(TransientOptionsFree(&o));
   PetscCall(SolverPresetOption(comm, file));
   {
     PetscReal rate;
@@ -637,6 +672,48 @@ static PetscErrorCode CheckTimeOptions(MPI_Comm comm)
   PetscFunctionReturn(0);
 }
 
+/* The span of the run, [t0, tf], against every table profile that may not be extended (PhlexProfileCheckRange): t0 is
+   0, or a restart's checkpoint time; tf is -ts_max_time, or the -ts_max_steps steps of -ts_dt (fixed steps), whichever
+   comes first, and one step more where TS may step past -ts_max_time (-ts_exact_final_time interpolate or stepover).
+   Adaptive steps bounded by a step count alone have no end known in advance: PreStep then checks each step's end. */
+static PetscErrorCode CheckProfileRanges(TS ts, MonitorContext *m, const char restart[])
+{
+  PetscReal              t0 = 0.0, dt, tmax, tf = PETSC_MAX_REAL;
+  PetscInt               s0 = 0, smax;
+  TSExactFinalTimeOption eft;
+  char                   how[256] = "";
+
+  PetscFunctionBeginUser;
+  if (restart) {
+    PetscViewer v;
+    PetscCall(PhlexCheckpointOpenRead(m->scene->comm, restart, &v));
+    PetscCall(PhlexCheckpointReadReals(v, "/run", "time", 1, &t0));
+    PetscCall(PhlexCheckpointReadInt(v, "/run", "step", &s0));
+    PetscCall(PetscViewerDestroy(&v));
+  }
+  m->profile_t0 = t0;
+  PetscCall(TSGetTimeStep(ts, &dt));
+  PetscCall(TSGetMaxTime(ts, &tmax));
+  PetscCall(TSGetMaxSteps(ts, &smax));
+  PetscCall(TSGetExactFinalTime(ts, &eft));
+  if (tmax < PETSC_MAX_REAL) {
+    tf = tmax + (eft == TS_EXACTFINALTIME_MATCHSTEP ? 0.0 : dt);
+    PetscCall(PetscSNPrintf(how, sizeof(how), "-ts_max_time %g s%s", (double)tmax, eft == TS_EXACTFINALTIME_MATCHSTEP ? "" : " and a step past it"));
+  }
+  if (!m->adaptive && smax < PETSC_MAX_INT && t0 + (smax - s0) * dt < tf) {
+    tf = t0 + (smax - s0) * dt;
+    PetscCall(PetscSNPrintf(how, sizeof(how), "-ts_max_steps %" PetscInt_FMT " of -ts_dt %g s", smax, (double)dt));
+  }
+  if (restart) {
+    size_t len;
+    PetscCall(PetscStrlen(how, &len));
+    PetscCall(PetscSNPrintf(how + len, sizeof(how) - len, ", restarted at t = %g s", (double)t0));
+  }
+  m->profile_check_steps = tf == PETSC_MAX_REAL ? PETSC_TRUE : PETSC_FALSE;
+  if (!m->profile_check_steps) PetscCall(PhlexProfileCheckRangeAll(t0, tf, how));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexSceneSolveTransient - integrates the scene in time with TS and reports energy, power balance and joints
 
@@ -653,7 +730,13 @@ static PetscErrorCode CheckTimeOptions(MPI_Comm comm)
 . -expect_power_balance_rtol <r>    - self-check: max |H_{n+1} - H_n - W| / max |supplied work|
 . -expect_momentum_drift_max <r>    - self-check (free system): drift of the inertial momenta, relative to their scale
 . -expect_orthogonality_max <r>     - self-check: ||R^T R - I||_F of every frame, and the per-step defect
-- -expect_joint_drift_max <r>       - self-check: the largest position-level violation of the joints [m, rad]
+. -expect_joint_drift_max <r>       - self-check: the largest position-level violation of the joints [m, rad]
+. -output_ports body:port,...       - ports.csv: the chosen ports' inputs, outputs, positions and joint wrenches
+- -output_ports_interval <s>        - its sampling interval (0: every step)
+
+  Notes:
+  Before the first step every table profile that may not be extended (a series read from a file, by default) is
+  checked against the run's span (PhlexProfileCheckRange).
 @*/
 PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
 {
@@ -680,11 +763,14 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     char file[PETSC_MAX_PATH_LEN] = "";
     PetscCall(SolverPresetOption(scene->comm, file));
     PetscCall(PetscViewerDestroy(&m.monitor));
+    PetscCall(TransientOptionsFree(&o));
     PetscFunctionReturn(0);
   }
   if (PhlexHelpGetMode() == PHLEX_HELP_NONE) PetscCall(CheckTimeOptions(scene->comm));
 
   PetscCall(PhlexSystemCreateForScene(scene, &sys, &X));
+  m.scene = scene;
+  m.sys   = sys;
   /* a free system: every part has momenta, none is held, no joint to the ground, no gravity */
   m.free_system = (scene->gravity[0] == 0.0 && scene->gravity[1] == 0.0 && scene->gravity[2] == 0.0) ? PETSC_TRUE : PETSC_FALSE;
   for (PetscInt i = 0; i < sys->nparts; i++)
@@ -848,6 +934,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscBool set;
     PetscCall(JacobianReuseOption(scene->comm, &rate, &set)); /* the solver preset's Newton option, listed too */
     PetscCall(PetscViewerDestroy(&m.monitor));
+    PetscCall(TransientOptionsFree(&o));
     PetscCall(VecDestroy(&X));
     PetscCall(TSDestroy(&ts));
     PetscCall(PhlexSystemDestroy(&sys));
@@ -870,6 +957,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       else PetscCall(PetscOptionsGetInt(NULL, NULL, "-ts_max_snes_failures", &m.max_snes_failures, NULL));
     }
   }
+  /* the inputs' series cover the run (a file's, unless told what it is outside): refused before anything is solved */
+  PetscCall(CheckProfileRanges(ts, &m, restarting ? restart : NULL));
+  PetscCall(PhlexTransientPortsSetUp(&m, o.nports, o.ports, o.ports_interval)); /* -output_ports: the names checked */
   {
     /* PETSc 3.18's generalized-alpha keeps the rate V_{n+1} it computed in the last function evaluation of the step;
        SNES ksponly (the linear presets) evaluates the function only before its solve, so V_{n+1} would be the
@@ -929,7 +1019,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     /* with adaptive steps (BDF's default) the first step is shortened: then the run is not one step */
     if (!m.adaptive && tmax < PETSC_MAX_REAL && dt >= tmax && smax != 1) PetscCall(PetscFPrintf(scene->comm, PETSC_STDERR, "phlex: warning: -ts_dt %g s is not smaller than -ts_max_time %g s: the run is one step\n", (double)dt, (double)tmax));
   }
-  PetscCall(PetscMalloc4(PetscMax(sys->nq, 1), &m.qprev, PetscMax(sys->nq, 1), &m.lambda, PetscMax(sys->njoints, 1), &m.jpower, PetscMax(sys->njoints, 1), &m.jdiss));
+  PetscCall(PetscMalloc5(PetscMax(sys->nq, 1), &m.qprev, PetscMax(sys->nq, 1), &m.lambda, PetscMax(sys->njoints, 1), &m.jpower, PetscMax(sys->njoints, 1), &m.jdiss, PetscMax(sys->njoints, 1), &m.jact));
   for (PetscInt k = 0; k < sys->nq; k++) m.lambda[k] = 0.0;
   if (sys->use_aij) {
     /* the assembled operator from a first evaluation at the initial state */
@@ -977,9 +1067,11 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   /* a part with dampers: the summary and the monitor say what was dissipated */
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->ops.dissipation) m.dissipative = PETSC_TRUE;
+  m.midpoint = (m.theta && !m.endpoint && m.theta_value == 0.5) ? PETSC_TRUE : PETSC_FALSE;
   for (PetscInt k = 0; k < sys->njoints; k++) {
     if (PhlexJointDamped(sys->joints[k])) m.dissipative = PETSC_TRUE;
-    if (sys->joints[k]->ntable > 0) m.element_tables = PETSC_TRUE; /* PreStep keeps their states at a step's start */
+    /* PreStep keeps their states and time at a step's start */
+    if (sys->joints[k]->ntable > 0 || sys->joints[k]->rest_profile) m.element_tables = PETSC_TRUE;
   }
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->nonquadratic_energy) m.lossless_scheme = PETSC_FALSE;
@@ -1004,6 +1096,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(PhlexOutputCSVOpen(scene->output, "energy.csv", "step,time,kinetic,strain,potential,total,input_power,supplied_work,balance_residual,dissipated_power,dissipated_work", &m.energy_csv));
   for (PetscInt i = 0; i < sys->nparts; i++) PetscCall((*sys->parts[i]->ops.outputopen)(sys->parts[i], scene->output, scene->output->fields));
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputOpen(sys->joints[k], scene->output));
+  PetscCall(PhlexTransientPortsOpen(&m));
   PetscCall(TSMonitorSet(ts, MonitorEnergy, &m, NULL));
   PetscCall(TSSetApplicationContext(ts, &m));
   PetscCall(TSSetPreStep(ts, PreStep));
@@ -1089,6 +1182,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     }
   }
   PetscCall(PetscViewerDestroy(&m.energy_csv));
+  PetscCall(PhlexTransientPortsDestroy(&m));
   for (PetscInt i = 0; i < sys->nparts; i++) PetscCall((*sys->parts[i]->ops.outputclose)(sys->parts[i]));
   for (PetscInt k = 0; k < sys->njoints; k++) PetscCall(PhlexJointOutputClose(sys->joints[k]));
   PetscCall(PhlexOutputCommit(scene->output));
@@ -1116,10 +1210,11 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   if (o.gap_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "joint drift (max position-level violation, m or rad)", "-expect_joint_drift_max", m.max_gap, o.gap_max, PETSC_TRUE));
 
   PetscCall(PetscViewerDestroy(&m.monitor));
+  PetscCall(TransientOptionsFree(&o));
   PetscCall(VecDestroy(&m.Xmid));
   PetscCall(VecDestroy(&m.Xprev));
   PetscCall(VecDestroy(&m.Xstage));
-  PetscCall(PetscFree4(m.qprev, m.lambda, m.jpower, m.jdiss));
+  PetscCall(PetscFree5(m.qprev, m.lambda, m.jpower, m.jdiss, m.jact));
   PetscCall(VecDestroy(&X));
   PetscCall(TSDestroy(&ts));
   PetscCall(PhlexSystemDestroy(&sys));

@@ -282,6 +282,8 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
     PetscCall(PetscMalloc1(sys->njoints, &w));
     for (PetscInt k = 0; k < sys->njoints; k++) w[k] = sys->joints[k]->dissipated_work;
     PetscCall(PhlexCheckpointWriteReals(v, "/monitor", "joint_dissipated_work", sys->njoints, w));
+    for (PetscInt k = 0; k < sys->njoints; k++) w[k] = sys->joints[k]->actuator_work; /* and a moving rest's work */
+    PetscCall(PhlexCheckpointWriteReals(v, "/monitor", "joint_actuator_work", sys->njoints, w));
     PetscCall(PetscFree(w));
   }
   {
@@ -292,6 +294,7 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
     PetscCall(PhlexSNESReducedGetContractions(snes, rec));
     PetscCall(PhlexCheckpointWriteReals(v, "/solver", "newton_contractions", PHLEX_REDUCED_NCONTRACTIONS, rec));
   }
+  PetscCall(PhlexTransientPortsSave(m, v)); /* the sampler of ports.csv */
   PetscCall(PhlexOutputSaveState(m->scene->output, v));
   PetscCall(PhlexCheckpointCommit(comm, tmp, m->ck_file, &v));
   m->ck_step = step;
@@ -463,6 +466,14 @@ PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, co
       for (PetscInt k = 0; k < sys->njoints; k++) sys->joints[k]->dissipated_work = w[k];
       PetscCall(PetscFree(w));
     }
+    PetscCall(PetscViewerHDF5HasDataset(v, "/monitor/joint_actuator_work", &has));
+    if (has) {
+      PetscReal *w;
+      PetscCall(PetscMalloc1(sys->njoints, &w));
+      PetscCall(PhlexCheckpointReadReals(v, "/monitor", "joint_actuator_work", sys->njoints, w));
+      for (PetscInt k = 0; k < sys->njoints; k++) sys->joints[k]->actuator_work = w[k];
+      PetscCall(PetscFree(w));
+    }
   }
   {
     /* absent from the checkpoints of earlier versions: the first stage then solves every Newton step to the linear
@@ -477,6 +488,7 @@ PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, co
       PetscCall(PhlexSNESReducedSetContractions(snes, rec));
     }
   }
+  PetscCall(PhlexTransientPortsRestart(m, v, file));
   PetscCall(TSSetTime(ts, t));
   PetscCall(TSSetStepNumber(ts, step));
   if (m->adaptive) PetscCall(TSSetTimeStep(ts, dt)); /* the controller's next step */

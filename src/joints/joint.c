@@ -133,6 +133,32 @@ static PetscBool RowTurns(PhlexJoint j, PetscInt k)
   return (row == PHLEX_ROW_CROSS || row == PHLEX_ROW_AXIS_B) ? PETSC_TRUE : PETSC_FALSE;
 }
 
+/* the nominal rest of a joint's moving element (non-dimensional): the spring_damper's rest length, the torsion spring's
+   rest angle */
+static PetscReal RestNominal(PhlexJoint j)
+{
+  return j->type == PHLEX_JOINT_SPRING_DAMPER ? j->rest_length / j->units->length : j->rest_angle;
+}
+
+/* r(t) = rest(t) - rest = rest (f(t) - 1), the moving rest's change from the nominal (non-dimensional; 0: none) */
+static PetscErrorCode RestShift(PhlexJoint j, PetscReal t, PetscReal *r)
+{
+  PetscReal f;
+
+  PetscFunctionBeginUser;
+  *r = 0.0;
+  if (!j->rest_profile) PetscFunctionReturn(0);
+  PetscCall(PhlexProfileEvaluate(j->rest_profile, t, &f));
+  *r = RestNominal(j) * (f - 1.0);
+  PetscFunctionReturn(0);
+}
+
+/* what the spring of element row i acts on at the evaluated state: its state less the moving rest's change */
+static inline PetscReal ElementArg(PhlexJoint j, PetscInt i)
+{
+  return j->e[i] - (i == 0 ? j->eshift : 0.0);
+}
+
 /* the direction (6-vector, a's body frame) of row k (k >= nc: element row k - nc), and its change for a change dRab
    of R_ab (universal only) */
 static void RowDirection(PhlexJoint j, PetscInt k, const PetscReal Rab[9], const PetscReal *dRab, PetscReal s[6])
@@ -299,6 +325,33 @@ static PetscErrorCode ElementOptionsCheck(PhlexJoint j, PhlexJointType type, Pet
   PetscFunctionReturn(0);
 }
 
+/* A moving rest (an actuator a controller commands): -rest_length_profile_* of a spring_damper, L(t) = rest_length f(t);
+   -rest_angle_profile_* of a torsion spring, rest_angle f(t). Refused on an element that has no such rest. */
+static PetscErrorCode RestProfileSetFromOptions(PhlexJoint j)
+{
+  char      lprefix[256], aprefix[256], what[256];
+  PetscBool lgiven, agiven;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(lprefix, sizeof(lprefix), "%srest_length_", j->prefix));
+  PetscCall(PetscSNPrintf(aprefix, sizeof(aprefix), "%srest_angle_", j->prefix));
+  PetscCall(PhlexProfileGiven(lprefix, &lgiven));
+  PetscCall(PhlexProfileGiven(aprefix, &agiven));
+  PetscCheck(!lgiven || j->type == PHLEX_JOINT_SPRING_DAMPER, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_length_profile_* moves the rest length of a spring_damper; a %s joint has none%s", j->name, j->prefix, PhlexJointTypes[j->type], j->rot_element ? " (its torsion spring's rest angle moves with -rest_angle_profile_*)" : "");
+  PetscCheck(!agiven || j->rot_element, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle_profile_* moves the rest angle of a torsion spring (-%srotational_stiffness on a revolute or cylindrical joint); this %s joint has none", j->name, j->prefix, j->prefix, PhlexJointTypes[j->type]);
+  PetscCheck(!agiven || j->type != PHLEX_JOINT_UNIVERSAL, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle_profile_* moves one torsion spring's rest angle; a universal joint has two (not implemented: use a revolute or cylindrical joint's)", j->name, j->prefix);
+  if (j->type != PHLEX_JOINT_SPRING_DAMPER && !j->rot_element) PetscFunctionReturn(0);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "joint %s, %s", j->name, j->rot_element ? "rest angle" : "rest length"));
+  PetscCall(PhlexProfileCreate(j->comm, j->rot_element ? aprefix : lprefix, what, &j->rest_profile));
+  PetscCall(PhlexProfileSetFromOptions(j->rest_profile)); /* listed by -help on every such element */
+  if (!j->rest_profile->given) {
+    PetscCall(PhlexProfileDestroy(&j->rest_profile));
+    PetscFunctionReturn(0);
+  }
+  PetscCheck(!j->rot_element || j->rest_angle != 0.0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle_profile_* multiplies the rest angle, which is 0: give the angle it scales with -%srest_angle (-%srest_angle 1 reads the profile in degrees)", j->name, j->prefix, j->prefix, j->prefix);
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexJointSetFromOptions - reads a joint
 
@@ -325,6 +378,8 @@ static PetscErrorCode ElementOptionsCheck(PhlexJoint j, PhlexJointType type, Pet
 . -rotational_stiffness k     - revolute, cylindrical: a torsion spring on the free rotation [N m/rad]
 . -rotational_damping c       - revolute, cylindrical: viscous friction on the free rotation [N m s/rad]
 . -rest_angle a               - revolute, cylindrical: the torsion spring's zero-moment angle [deg] (default 0: drawn)
+. -rest_length_profile_*      - spring_damper: a moving rest length L(t) = rest_length f(t) (an actuator)
+. -rest_angle_profile_*       - torsion spring: a moving rest angle rest_angle f(t)
 . -stiffness_matrix k11,...   - bushing: 6 x 6 stiffness, row-major, rows/columns t1 t2 t3 r1 r2 r3 of the joint frame
 - -damping_matrix c11,...     - bushing: 6 x 6 damping, the same layout (SI: N/m, N/rad, N m/m, N m/rad; N s/m, ...)
 @*/
@@ -450,6 +505,7 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
     PetscCall(PhlexProfileSetFromOptions(j->drive_profile));
     (void)prefix;
   }
+  PetscCall(RestProfileSetFromOptions(j));
   PetscFunctionReturn(0);
 }
 
@@ -592,6 +648,12 @@ PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const Phlex
     len = PhlexNorm3(dx);
     PetscCheck(len > 1e-12, j->comm, PETSC_ERR_USER_INPUT, "joint %s: the ends of the spring_damper (%s and %s) coincide as drawn: its line of action has no direction", j->name, j->side[0].spec, j->side[1].spec);
     if (j->rest_length < 0) j->rest_length = len * u->length;
+    if (j->rest_profile) {
+      /* L(t) = rest_length f(t) must stay a length */
+      PetscReal fmin, fmax;
+      PetscCall(PhlexProfileBounds(j->rest_profile, &fmin, &fmax));
+      PetscCheck(fmin >= 0, j->comm, PETSC_ERR_USER_INPUT, "joint %s: the rest length %g m times its profile (-%srest_length_profile_*) would be negative: the profile's least value is %g; a rest length is rest_length x f(t) >= 0", j->name, (double)j->rest_length, j->prefix, (double)fmin);
+    }
   }
   PetscCall(PhlexJointUpdateGeometry(j, Xa, Xb));
   PetscFunctionReturn(0);
@@ -670,6 +732,14 @@ PetscErrorCode PhlexJointEvaluate(PhlexJoint j, PetscReal t, const PetscReal *q,
     j->e[i]    = q[j->qoff + NumRows(j) + i];
     j->edot[i] = qd ? T * qd[j->qoff + NumRows(j) + i] : 0.0;
   }
+  j->eshift = 0.0;
+  if (j->rest_profile && j->rest_step && t > j->rest_t0) {
+    /* a midpoint stage at t: the mean of r at the step's ends t0 and 2 t - t0 (a retried step keeps t0) */
+    PetscReal r0, r1;
+    PetscCall(RestShift(j, j->rest_t0, &r0));
+    PetscCall(RestShift(j, 2.0 * t - j->rest_t0, &r1));
+    j->eshift = 0.5 * (r0 + r1);
+  } else PetscCall(RestShift(j, t, &j->eshift));
   PetscFunctionReturn(0);
 }
 
@@ -798,10 +868,10 @@ PetscErrorCode PhlexJointResidual(PhlexJoint j, PetscReal t, PetscReal *f)
     }
     for (PetscInt i = 0; i < j->ne; i++) {
       PetscReal F = j->lambda[j->nc + i];
-      for (PetscInt l = 0; l < j->ne; l++) F += j->K[j->ne * i + l] * j->e[l] + j->C[j->ne * i + l] * sD[l];
+      for (PetscInt l = 0; l < j->ne; l++) F += j->K[j->ne * i + l] * ElementArg(j, l) + j->C[j->ne * i + l] * sD[l];
       if (j->ntable) {
         PetscReal ft;
-        TableStepForce(j, i, j->e[i], &ft, NULL);
+        TableStepForce(j, i, ElementArg(j, i), &ft, NULL);
         F += ft;
       }
       f[j->qoff + j->nc + i]     = F;                 /* lambda = -(K e + C s.Delta) */
@@ -874,15 +944,17 @@ PetscBool PhlexJointDamped(PhlexJoint j)
 }
 
 /*@C
-  PhlexJointElementEnergy - the energy stored in the joint's force elements, 1/2 e^T K e (non-dimensional), at the
-  discrete unknowns q (replicated)
+  PhlexJointElementEnergy - the energy stored in the joint's force elements, 1/2 a^T K a (non-dimensional), at the
+  discrete unknowns q (replicated) and the time t: a = e, less a moving rest's change r(t)
 @*/
-PetscErrorCode PhlexJointElementEnergy(PhlexJoint j, const PetscReal *q, PetscReal *V)
+PetscErrorCode PhlexJointElementEnergy(PhlexJoint j, PetscReal t, const PetscReal *q, PetscReal *V)
 {
-  const PetscReal *e = q + j->qoff + NumRows(j);
+  PetscReal e[6], r;
 
   PetscFunctionBeginUser;
   *V = 0.0;
+  PetscCall(RestShift(j, t, &r)); /* a moving rest: the spring's length at t less the rest at t */
+  for (PetscInt i = 0; i < j->ne; i++) e[i] = q[j->qoff + NumRows(j) + i] - (i == 0 ? r : 0.0);
   for (PetscInt i = 0; i < j->ne; i++)
     for (PetscInt l = 0; l < j->ne; l++) *V += 0.5 * e[i] * j->K[j->ne * i + l] * e[l];
   if (j->ntable) *V += TablePotential(j, e[0]);
@@ -890,14 +962,76 @@ PetscErrorCode PhlexJointElementEnergy(PhlexJoint j, const PetscReal *q, PetscRe
 }
 
 /*@C
-  PhlexJointElementStepStart - before a step: the force elements' states at its start (q: replicated) and whether the
-  scheme is the implicit midpoint rule, whose stage takes a table spring's force as the discrete gradient over the step
+  PhlexJointElementStepStart - before a step from t0: the force elements' states at its start (q: replicated; the
+  argument of their springs, less a moving rest's change at t0), whether the scheme keeps the power balance (lossless:
+  a table spring's force is then the discrete gradient over the step) and whether it is the implicit midpoint rule (a
+  moving rest's change is then the mean of its values at the step's ends)
 @*/
-PetscErrorCode PhlexJointElementStepStart(PhlexJoint j, const PetscReal *q, PetscBool midpoint)
+PetscErrorCode PhlexJointElementStepStart(PhlexJoint j, PetscReal t0, const PetscReal *q, PetscBool lossless, PetscBool midpoint)
 {
+  PetscReal r0;
+
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < j->ne; i++) j->e_start[i] = q[j->qoff + NumRows(j) + i];
-  j->dg = (PetscBool)(midpoint && j->ntable > 0);
+  PetscCall(RestShift(j, t0, &r0));
+  for (PetscInt i = 0; i < j->ne; i++) j->e_start[i] = q[j->qoff + NumRows(j) + i] - (i == 0 ? r0 : 0.0);
+  j->dg        = (PetscBool)(lossless && j->ntable > 0);
+  j->rest_step = (PetscBool)(midpoint && j->rest_profile);
+  j->rest_t0   = t0;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointActuatorPower - the power a moving rest supplies to the element at the evaluated state (t: the evaluation's
+  time; non-dimensional): -F r'(t), F the spring's tension (K a, or a table's force); at a midpoint stage the step's
+  exact work over the step's length, -F (r_{n+1} - r_n) / dt
+
+  Not collective
+@*/
+PetscErrorCode PhlexJointActuatorPower(PhlexJoint j, PetscReal t, PetscReal *P)
+{
+  PetscReal F = 0.0, rate;
+
+  PetscFunctionBeginUser;
+  *P = 0.0;
+  if (!j->rest_profile) PetscFunctionReturn(0);
+  for (PetscInt l = 0; l < j->ne; l++) F += j->K[l] * ElementArg(j, l); /* row 0: the moving one */
+  if (j->ntable) {
+    PetscReal ft;
+    TableStepForce(j, 0, ElementArg(j, 0), &ft, NULL);
+    F += ft;
+  }
+  if (j->rest_step && t > j->rest_t0) {
+    const PetscReal dt = 2.0 * (t - j->rest_t0);
+    PetscReal       r0, r1;
+    PetscCall(RestShift(j, j->rest_t0, &r0));
+    PetscCall(RestShift(j, j->rest_t0 + dt, &r1));
+    rate = (r1 - r0) / (dt / j->units->time);
+  } else {
+    PetscReal df;
+    PetscCall(PhlexProfileDerivative(j->rest_profile, t, &df));
+    rate = RestNominal(j) * df * j->units->time;
+  }
+  *P = -F * rate;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointPortWrench - the wrench (body frame, non-dimensional, at the port point) the joint applies to port `port`
+  of `part` with the multipliers lambda, at the evaluated state; zero if it does not act there
+
+  Not collective
+@*/
+PetscErrorCode PhlexJointPortWrench(PhlexJoint j, const PetscReal *lambda, PhlexPart part, PetscInt port, PetscReal w[6])
+{
+  PetscReal wJ[6], ws[2][6];
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < 6; c++) w[c] = 0.0;
+  JointWrench(j, lambda, NULL, wJ);
+  PortWrenches(j, wJ, NULL, NULL, NULL, ws[0], ws[1]);
+  for (PetscInt s = 0; s < 2; s++)
+    if (j->side[s].part == part && j->side[s].port == port)
+      for (PetscInt c = 0; c < 6; c++) w[c] += ws[s][c];
   PetscFunctionReturn(0);
 }
 
@@ -1035,7 +1169,7 @@ PetscErrorCode PhlexJointJacobian(PhlexJoint j, PetscReal shift, PetscReal *D, P
     for (PetscInt l = 0; l < j->ne; l++) D[ld * fi + j->qoff + NumRows(j) + l] += j->K[j->ne * i + l];
     if (j->ntable) {
       PetscReal ft, dft;
-      TableStepForce(j, i, j->e[i], &ft, &dft);
+      TableStepForce(j, i, ElementArg(j, i), &ft, &dft);
       D[ld * fi + ei] += dft;
     }
   }
@@ -1430,6 +1564,11 @@ PetscErrorCode PhlexJointView(PhlexJoint j, PetscViewer viewer)
       PetscCall(PetscStrlcat(line, more, sizeof(line)));
     }
     PetscCall(PetscViewerASCIIPrintf(viewer, "%s", line));
+    if (j->rest_profile) {
+      char prof[PETSC_MAX_PATH_LEN + 512];
+      PetscCall(PhlexProfileDescribe(j->rest_profile, prof, sizeof(prof)));
+      PetscCall(PetscViewerASCIIPrintf(viewer, "; the rest %s times the profile %s", j->rot_element ? "angle" : "length", prof));
+    }
   }
   if (j->drive_row >= 0) PetscCall(PetscViewerASCIIPrintf(viewer, " (%s driven at %.15g %s)", j->rowname[j->nc - 1], (double)j->drive_velocity, j->row[j->nc - 1] == PHLEX_ROW_R3 ? "rad/s" : "m/s"));
   if (j->rot_dropped) PetscCall(PetscViewerASCIIPrintf(viewer, "; rotations free (a point mass has no orientation)"));
@@ -1488,6 +1627,7 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
     if (j->type == PHLEX_JOINT_SPRING_DAMPER) PetscCall(PetscStrlcat(header, ",length_minus_rest", sizeof(header)));
     if (j->type == PHLEX_JOINT_UNIVERSAL) PetscCall(PetscStrlcat(header, ",angle_a_minus_rest,angle_b_minus_rest", sizeof(header)));
     PetscCall(PetscStrlcat(header, ",stored_energy,dissipated_power,dissipated_work", sizeof(header)));
+    if (j->rest_profile) PetscCall(PetscStrlcat(header, j->rot_element ? ",rest_angle,actuator_power,actuator_work" : ",rest_length,actuator_power,actuator_work", sizeof(header)));
   }
   PetscCall(PetscSNPrintf(name, sizeof(name), "%s_joint.csv", j->name));
   PetscCall(PhlexOutputCSVOpen(out, name, header, &j->csv));
@@ -1503,10 +1643,10 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
 
   Collective
 @*/
-PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, PetscReal Dstep, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
+PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, PetscReal Dstep, PetscReal Astep, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
 {
   const PhlexUnits *u = j->units;
-  PetscReal         wJ[6], mo[6], gap[7];
+  PetscReal         wJ[6], mo[6], gap[7], r;
   PetscInt          nm;
 
   PetscFunctionBeginUser;
@@ -1529,17 +1669,19 @@ PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *
   }
   PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(P * u->power)));
   if (j->ne) {
-    PetscReal V = 0.0;
+    PetscReal V = 0.0, a[6];
+    PetscCall(RestShift(j, t, &r)); /* the states are relative to the nominal rest; the spring acts on a = e - r(t) */
+    for (PetscInt i = 0; i < j->ne; i++) a[i] = j->e[i] - (i == 0 ? r : 0.0);
     for (PetscInt i = 0; i < j->ne; i++) {
       const PetscBool length = j->erow[i] <= PHLEX_ROW_T3 ? PETSC_TRUE : PETSC_FALSE;
       PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e", (double)(length ? j->e[i] * u->length : j->e[i]), (double)(lambda[j->nc + i] * u->force * (length ? 1.0 : u->length))));
-      for (PetscInt l = 0; l < j->ne; l++) V += 0.5 * j->e[i] * j->K[j->ne * i + l] * j->e[l];
+      for (PetscInt l = 0; l < j->ne; l++) V += 0.5 * a[i] * j->K[j->ne * i + l] * a[l];
     }
-    if (j->ntable) V += TablePotential(j, j->e[0]);
+    if (j->ntable) V += TablePotential(j, a[0]);
     if (j->type == PHLEX_JOINT_SPRING_DAMPER) {
       PetscReal dx[3], E[9];
       PetscCall(Placements(j, Xa, Xb, dx, E));
-      PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(PhlexNorm3(dx) * u->length - j->rest_length)));
+      PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)((PhlexNorm3(dx) - r) * u->length - j->rest_length)));
     }
     if (j->type == PHLEX_JOINT_UNIVERSAL) {
       /* the geometric angles of the universal, to compare with the torsion elements' states */
@@ -1548,6 +1690,7 @@ PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *
       PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e", (double)(UniversalAngle(j, E, PETSC_FALSE) - j->rest_angle), (double)(UniversalAngle(j, E, PETSC_TRUE) - j->rest_angle)));
     }
     PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e,%.12e", (double)(V * u->energy), (double)(Dstep * u->power), (double)(j->dissipated_work * u->energy)));
+    if (j->rest_profile) PetscCall(PhlexCSVPrintf(j->csv, ",%.12e,%.12e,%.12e", (double)(j->rot_element ? j->rest_angle + r : (RestNominal(j) + r) * u->length), (double)(Astep * u->power), (double)(j->actuator_work * u->energy)));
   }
   PetscCall(PhlexCSVPrintf(j->csv, "\n"));
   PetscFunctionReturn(0);
@@ -1595,6 +1738,7 @@ PetscErrorCode PhlexJointDestroy(PhlexJoint *joint)
   PetscFunctionBeginUser;
   if (!*joint) PetscFunctionReturn(0);
   PetscCall(PhlexProfileDestroy(&(*joint)->drive_profile));
+  PetscCall(PhlexProfileDestroy(&(*joint)->rest_profile));
   PetscCall(PetscViewerDestroy(&(*joint)->csv));
   PetscCall(PetscFree(*joint));
   PetscFunctionReturn(0);

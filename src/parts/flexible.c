@@ -573,6 +573,30 @@ static PetscErrorCode FlexOutputOpen(PhlexPart part, PhlexOutput out, PetscBool 
 PETSC_INTERN PetscErrorCode PhlexFlexiblePortOutputsAll(PhlexPart, const PhlexPartVec *);
 
 /*@C
+  PhlexFlexiblePortInput - the wrench input of port q of a flexible body or of the reduced body wrapping it (part is the
+  body's own part) at t: its load (body frame, non-dimensional); the frame patch's port: the frame wrench
+
+  Not collective
+@*/
+PetscErrorCode PhlexFlexiblePortInput(PhlexPart part, PhlexFlexible b, PetscBool floating, const PhlexFrameState *fs, PetscInt q, PetscReal t, PetscReal w[6])
+{
+  const PhlexUnits *u = part->units;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 6; k++) w[k] = 0.0;
+  if (q < b->nports) PetscCall(PhlexPortLoadEvaluate(&b->ports[q].load, t, u, floating ? fs->R : NULL, w));
+  else if (b->frame_loaded) {
+    PetscReal fr;
+    PetscCall(PhlexProfileEvaluate(b->frame_profile, t, &fr));
+    for (PetscInt k = 0; k < 3; k++) {
+      w[k]     = fr * b->frame_force[k] / u->force;
+      w[3 + k] = fr * b->frame_moment[k] / (u->force * u->length);
+    }
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexFlexiblePortSeriesRow - one row of <body>_ports.csv of a flexible body or of the reduced body wrapping it (part
   is the body's own part, which places its ports): time; a floating frame's wrench and motion; each port's input
   wrench (body frame) and output port_y; the frame origin's and each port's inertial position

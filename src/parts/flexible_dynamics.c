@@ -178,6 +178,15 @@ PetscErrorCode PhlexFlexiblePortOutputsAll(PhlexPart part, const PhlexPartVec *X
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode FlexPortInput(PhlexPart part, PetscInt q, PetscReal t, PetscReal w[6])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFlexiblePortInput(part, b, b->floating, &b->fs, q, t, w));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode FlexPortOutput(PhlexPart part, PetscInt q, PetscReal y[6])
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
@@ -1164,6 +1173,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->ops.jacobian      = FlexJacobian;
   part->ops.poststep      = FlexPostStep;
   part->ops.portoutput    = FlexPortOutput;
+  part->ops.portinput     = FlexPortInput;
   part->ops.portlinear    = FlexPortLinear;
   part->ops.portforce     = FlexPortForce;
   part->ops.portplacement = FlexPortPlacement;

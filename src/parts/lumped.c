@@ -144,6 +144,13 @@ static PetscErrorCode LumpedJacobian(PhlexPart part, PetscReal shift, const Phle
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode LumpedPortInput(PhlexPart part, PetscInt p, PetscReal t, PetscReal w[6])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexPortLoadEvaluate(&((Lumped *)part->data)->load, t, part->units, NULL, w));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode LumpedPortOutput(PhlexPart part, PetscInt p, PetscReal y[6])
 {
   Lumped *m = (Lumped *)part->data;
@@ -276,6 +283,7 @@ PetscErrorCode PhlexPartCreate_Lumped(PhlexPart part)
   part->ops.residual       = LumpedResidual;
   part->ops.jacobian       = LumpedJacobian;
   part->ops.portoutput     = LumpedPortOutput;
+  part->ops.portinput      = LumpedPortInput;
   part->ops.portlinear     = LumpedPortLinear;
   part->ops.portforce      = LumpedPortForce;
   part->ops.portplacement  = LumpedPortPlacement;

@@ -815,6 +815,15 @@ static PetscErrorCode ReducedPostStep(PhlexPart part, PetscReal *q, PetscReal *d
 /* ------------------------------------------------------------------------------------------------------------ */
 /* Ports                                                                                                          */
 
+static PetscErrorCode ReducedPortInput(PhlexPart part, PetscInt q, PetscReal t, PetscReal w[6])
+{
+  Reduced *r = (Reduced *)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFlexiblePortInput(part, r->fb, r->floating, &r->fs, q, t, w));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode ReducedPortOutput(PhlexPart part, PetscInt q, PetscReal y[6])
 {
   PetscFunctionBeginUser;
@@ -1267,6 +1276,7 @@ PetscErrorCode PhlexPartCreate_Reduced(PhlexPart part)
   part->ops.jacobian       = ReducedJacobian;
   part->ops.poststep       = ReducedPostStep;
   part->ops.portoutput     = ReducedPortOutput;
+  part->ops.portinput      = ReducedPortInput;
   part->ops.portlinear     = ReducedPortLinear;
   part->ops.portforce      = ReducedPortForce;
   part->ops.portplacement  = ReducedPortPlacement;

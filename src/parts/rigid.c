@@ -273,6 +273,15 @@ static PetscErrorCode RigidPostStep(PhlexPart part, PetscReal *q, PetscReal *def
 }
 
 /* port p: y = (v + w x c, w); its wrench (F, T at c) acts as (F, c x F + T) on (v, w) */
+static PetscErrorCode RigidPortInput(PhlexPart part, PetscInt p, PetscReal t, PetscReal w[6])
+{
+  Rigid *r = (Rigid *)part->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PhlexPortLoadEvaluate(&r->load[p], t, part->units, r->fs.R, w)); /* body frame */
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode RigidPortOutput(PhlexPart part, PetscInt p, PetscReal y[6])
 {
   Rigid    *r = (Rigid *)part->data;
@@ -434,6 +443,7 @@ PetscErrorCode PhlexPartCreate_Rigid(PhlexPart part)
   part->ops.jacobian       = RigidJacobian;
   part->ops.poststep       = RigidPostStep;
   part->ops.portoutput     = RigidPortOutput;
+  part->ops.portinput      = RigidPortInput;
   part->ops.portlinear     = RigidPortLinear;
   part->ops.portforce      = RigidPortForce;
   part->ops.portplacement  = RigidPortPlacement;

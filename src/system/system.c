@@ -938,7 +938,7 @@ PetscErrorCode PhlexSystemEnergy(PhlexSystem sys, PetscReal t, Vec X, PetscReal 
   /* the energy stored in the joints' force elements (springs) counts as strain energy */
   for (PetscInt k = 0; k < sys->njoints; k++) {
     PetscReal V;
-    PetscCall(PhlexJointElementEnergy(sys->joints[k], sys->q, &V));
+    PetscCall(PhlexJointElementEnergy(sys->joints[k], t, sys->q, &V));
     *strain += V;
   }
   for (PetscInt i = 0; i < sys->nparts; i++) PetscCall(PhlexPartRestoreVec(sys->parts[i], X, &pv[i]));
