@@ -19,7 +19,7 @@ the flap, and flap1 stays below lag2; at rest the square section makes the pairs
 
 Prints one line per rate and the largest deviations; exit status 1 if a check fails.
 
-  tools/rotating_cantilever.py output/rotating_cantilever/linearized_modes.csv REF.csv --omega-ref 29.95567
+  tools/rotating_cantilever.py output/rotating_cantilever/linearized_modes.csv REF.csv --omega-ref 29.95723
       [--model stiffened|linear] [--rtol 0.01] [--ratio-rtol 0.01] [--out comparison.csv]
 """
 import argparse
