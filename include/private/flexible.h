@@ -215,6 +215,7 @@ struct _p_PhlexFlexible {
   PhlexElementReferenceIntegrals ref;
   PetscReal *cell_geom;      /* per local cell: detJ, invJ[9] (non-dimensional) */
   PetscReal  bbox_min[3], bbox_max[3];
+  PetscReal  modes_budget; /* -modes_budget: the largest eigensolve started [flops] (0: no limit) */
 
   /* constant body-frame operators (non-dimensional), assembled once */
   Mat Mv;      /* velocity mass int rho phi.phi (SBAIJ) */

@@ -109,7 +109,10 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
   PetscCall(PetscOptionsBool("-phlex_check_condensation", "Compare the element-wise stress elimination G^T Ms^-1 G with the stiffness, every cell", "PhlexFlexibleSetFromOptions", b->check_condensation, &b->check_condensation, NULL));
   PetscCall(PetscOptionsBool("-phlex_check_stress_maps", "Compare the cell-by-cell products B = Ms^-1 G, G^T and G^T Ms^-1 G with the assembled G and Ms, for random fields (transient and linearised analyses)", "PhlexFlexibleSetFromOptions", b->check_stress_maps, &b->check_stress_maps, NULL));
+  b->modes_budget = 1e13;
+  PetscCall(PetscOptionsReal("-modes_budget", "The largest eigensolve of a body's modes a run starts (modal analysis, a mode as initial condition, a reduced body's basis), estimated as 20 (N ncv^2 + 25 ncv^3) flops with ncv twice the modes asked (1e13: about an hour on one core; 0: no limit)", "PhlexFlexibleModesRequestCheck", b->modes_budget, &b->modes_budget, NULL));
   PetscOptionsEnd();
+  PetscCheck(b->modes_budget >= 0 && !PetscIsInfOrNanReal(b->modes_budget), b->comm, PETSC_ERR_USER_INPUT, "-modes_budget must be a number of flops >= 0 (0: no limit), got %g", (double)b->modes_budget);
   b->spinning = (PetscBool)(spin_given && (b->spin[0] != 0 || b->spin[1] != 0 || b->spin[2] != 0));
   if (b->spinning) {
     const PetscReal w = PetscSqrtReal(b->spin[0] * b->spin[0] + b->spin[1] * b->spin[1] + b->spin[2] * b->spin[2]);

@@ -276,9 +276,13 @@ static PetscErrorCode EigenpairResiduals(EPS eps, PetscInt n, PetscReal rigid_be
 
 /*@C
   PhlexFlexibleModesRequestCheck - refuses, before any work, a request of more eigenpairs than the body's eigensolver
-  can give: nev elastic modes (plus a free body's six rigid ones) and the subspace of about twice as many vectors the
-  solver builds must fit in the body's velocity unknowns. option and value name what asked (-modes_nev 100000,
-  -body0_ic_velocity_mode 1000, -body0_reduction_modes 5000)
+  can give in reason: nev elastic modes (plus a free body's six rigid ones) and the subspace of about twice as many
+  vectors the solver builds must fit in the body's velocity unknowns with room (at most a quarter of them asked:
+  beyond, the Krylov solver's dense projected problem, of the subspace's size cubed, makes each iteration minutes long
+  and deaf to an interrupt: -body0_ic_velocity_mode 1000 on the 2889 unknowns of the cantilever ran 13 minutes), and
+  its estimated work, 20 restarts of N ncv^2 + 25 ncv^3 flops (ncv = 2 (nev + rigid)), must stay within -modes_budget
+  (1e13 flops: about an hour on one core of these machines; 0: no limit). option and value name what asked
+  (-modes_nev 100000, -body0_ic_velocity_mode 1000, -body0_reduction_modes 5000)
 
   Collective
 @*/
@@ -286,11 +290,17 @@ PetscErrorCode PhlexFlexibleModesRequestCheck(PhlexPart part, PetscInt nev, cons
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
   PetscInt      N, want;
+  const PetscReal budget = b->modes_budget;
+  PetscReal     ncv, work;
 
   PetscFunctionBeginUser;
   PetscCall(MatGetSize(b->Mv, &N, NULL));
   want = nev + ((!b->frame_patch[0] || b->floating) ? 6 : 0);
   PetscCheck(2 * want <= N, b->comm, PETSC_ERR_USER_INPUT, "body %s: %s %" PetscInt_FMT ": more modes than the body's %" PetscInt_FMT " velocity unknowns allow, at most %" PetscInt_FMT " on this mesh (the eigensolver's subspace holds about twice the pairs asked%s); ask for fewer, or refine the mesh", part->name, option, value, N, PetscMax(N / 2 - (want - nev), 0), want > nev ? ", the six rigid-body modes of a free body among them" : "");
+  PetscCheck(4 * want <= N, b->comm, PETSC_ERR_USER_INPUT, "body %s: %s %" PetscInt_FMT ": asks for %.0f %% of the body's %" PetscInt_FMT " velocity unknowns' modes, more than a quarter (at most %" PetscInt_FMT " on this mesh): the eigensolver's subspace, about twice the pairs asked, would be more than half the problem, and its dense projected problem would take minutes per iteration; ask for fewer, or refine the mesh", part->name, option, value, (double)(100.0 * want / N), N, PetscMax(N / 4 - (want - nev), 0));
+  ncv  = 2.0 * want;
+  work = 20.0 * ((PetscReal)N * ncv * ncv + 25.0 * ncv * ncv * ncv);
+  PetscCheck(budget == 0 || work <= budget, b->comm, PETSC_ERR_USER_INPUT, "body %s: %s %" PetscInt_FMT ": the eigensolve of %" PetscInt_FMT " modes on %" PetscInt_FMT " velocity unknowns would take about %.1e flops, more than -modes_budget %g flops (its default 1e13 is about an hour on one core at the 2.5 Gflop/s measured here); ask for fewer modes, or raise -modes_budget (0: no limit) for a long batch run", part->name, option, value, want, N, (double)work, (double)budget);
   PetscFunctionReturn(0);
 }
 
