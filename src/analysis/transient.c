@@ -867,6 +867,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
       if (applicable || typed) PetscCall(PhlexSNESCondensedSetSystem(snes, sys, ts));
       else {
         KSP ksp;
+        /* the field split of the presets for fixed bodies (exact, iterative, ...) splits the fields only: with frames,
+           joints or other parts it has no split for their unknowns (PETSc failed with "Could not find index set") */
+        PetscCheck(!sys->nq, scene->comm, PETSC_ERR_USER_INPUT, "the solver preset %s is for fixed flexible bodies alone (SNES phlexcondensed, and a field split of their fields only): this scene also has %" PetscInt_FMT " discrete unknowns (frames, rigid bodies, point masses, joints or force elements); use options/solver/bordered.opts (bordered_iterative.opts, bordered_serial.opts), or no -solver_options_file: the default chooses", m.preset[0] ? m.preset : "(-snes_type phlexcondensed)", sys->nq);
         PetscCall(SNESSetType(snes, (sys->nonlinear || sys->inexact_schur) ? SNESNEWTONLS : SNESKSPONLY));
         PetscCall(SNESGetKSP(snes, &ksp));
         PetscCall(KSPSetFromOptions(ksp));
