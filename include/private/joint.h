@@ -129,6 +129,9 @@ struct _p_PhlexJoint {
   PetscBool     rest_step;              /* a midpoint step from rest_t0 is under way: its stage takes the mean of the
                                            rest's change at the step's two ends (PhlexJointElementStepStart) */
   PetscReal     rest_t0;
+  PetscBool     drive_step;             /* a midpoint step from drive_t0 is under way: a drive's (or a prescribed
+                                           motion's) rate at its stage makes the step's increment the prescribed one */
+  PetscReal     drive_t0;
   PetscReal     eshift;                 /* evaluated: the rest's change from the nominal (non-dimensional) */
   PetscReal     actuator_work;          /* the work the moving rest did on the element so far (non-dimensional) */
 
@@ -160,12 +163,13 @@ PETSC_INTERN PetscErrorCode PhlexJointRelativeMotion(PhlexJoint, const PhlexPart
 PETSC_INTERN PetscErrorCode PhlexJointRigidGradient(PhlexJoint, PetscReal *, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointDropRow(PhlexJoint, PetscInt);
 PETSC_INTERN PetscErrorCode PhlexJointOutputOpen(PhlexJoint, PhlexOutput);
-PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, PetscReal, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexJointOutputStep(PhlexJoint, PetscReal, const PetscReal *, PetscReal, PetscReal, PetscReal, const PhlexPartVec *, const PhlexPartVec *, PetscReal *, PetscReal *);
 PETSC_INTERN PetscInt       PhlexJointNumUnknowns(PhlexJoint);
 PETSC_INTERN PetscBool      PhlexJointDamped(PhlexJoint);
 PETSC_INTERN PetscErrorCode PhlexJointElementInitial(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *, PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexJointElementEnergy(PhlexJoint, PetscReal, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointElementStepStart(PhlexJoint, PetscReal, const PetscReal *, PetscBool, PetscBool);
+PETSC_INTERN PetscErrorCode PhlexJointDriveStepStart(PhlexJoint, PetscReal, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexJointActuatorPower(PhlexJoint, PetscReal, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointPortWrench(PhlexJoint, const PetscReal *, PhlexPart, PetscInt, PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexJointPower(PhlexJoint, const PetscReal *, PetscReal *);

@@ -31,10 +31,13 @@ typedef struct {
   PetscReal   P0[3], L0[3], Pscale, Lscale, max_dP, max_dL, max_orth, max_defect;
   /* joints */
   PetscReal   max_gap, project_dH, step_project_dH;
+  PetscReal   max_drive; /* the largest error of a drive or prescribed motion against its profile (m or rad) */
+  PetscBool   has_drives;
   PetscInt    nprojections;
   /* watchdogs: stop a run whose numbers went wrong (0: off) */
   PetscReal   watch_balance, watch_gap, watch_orth;
-  PetscReal   watch_energy;    /* stop when the energy created (H - H0 - W + D) exceeds this times max(|H0|, the work) */
+  PetscReal   watch_energy;    /* stop when the energy created (H - H0 - W + D) exceeds this times max(E0, the work) */
+  PetscReal   E0abs;           /* |kinetic| + |strain| + |potential| at the start: the energy's scale (H0 may cancel to 0) */
   PetscReal   watch_deform;    /* stop when a body's elastic displacement exceeds this times its size */
   PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
   PhlexProgress progress;

@@ -74,11 +74,12 @@ static PetscErrorCode EnergyAndOutputs(MonitorContext *m, PetscInt step, PetscRe
   for (PetscInt k = 0; k < sys->njoints; k++) {
     PhlexJoint   j = sys->joints[k];
     PhlexPartVec pv[2];
-    PetscReal    gmax;
+    PetscReal    gmax, dmax;
     PetscCall(PhlexSystemJointSides(sys, j, X, sys->q, pv));
-    PetscCall(PhlexJointOutputStep(j, t, m->lambda + j->qoff, m->jpower[k], m->jdiss[k], m->jact[k], &pv[0], &pv[1], &gmax));
+    PetscCall(PhlexJointOutputStep(j, t, m->lambda + j->qoff, m->jpower[k], m->jdiss[k], m->jact[k], &pv[0], &pv[1], &gmax, &dmax));
     PetscCall(PhlexSystemJointSidesRestore(sys, j, X, pv));
-    m->max_gap = PetscMax(m->max_gap, gmax);
+    m->max_gap   = PetscMax(m->max_gap, gmax);
+    m->max_drive = PetscMax(m->max_drive, dmax);
   }
   PetscCall(PhlexTransientPortsStep(m, t, X)); /* after the parts' outputs: every port's output is then computed */
   PetscCall(PhlexOutputFlushSeries(sys->scene->output));
@@ -231,12 +232,14 @@ static PetscErrorCode PreStep(TS ts)
   /* the force elements' states at the step's start (a table spring's discrete gradient) and its time (a moving rest's
      mean over a midpoint step); only these need them */
   {
+    PetscReal t0;
+    PetscCall(TSGetTime(ts, &t0));
     if (m->element_tables) {
-      PetscReal t0;
-      PetscCall(TSGetTime(ts, &t0));
       PetscCall(PhlexSystemGather(m->sys, X, m->sys->q));
       for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], t0, m->sys->q, m->lossless_scheme, m->midpoint));
     }
+    /* drives and prescribed motions: the step's start (a midpoint step's increment is the prescribed one) */
+    for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointDriveStepStart(m->sys->joints[k], t0, m->midpoint));
   }
   PetscFunctionReturn(0);
 }
@@ -343,6 +346,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   m->Emax = PetscMax(m->Emax, kin + strain);
   if (step == 0) {
     m->H0 = m->Hprev = m->Hmax = H;
+    m->E0abs = PetscAbsReal(kin) + PetscAbsReal(strain) + PetscAbsReal(pot);
   } else {
     m->work_total += dt * power;
     m->dissipated_total += dt * dissipated;
@@ -434,8 +438,9 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
        stays at solver tolerance (a spinning body's indefinite energy can also fall without bound: the deformation
        watchdog catches that) */
     const PetscReal created = H - m->H0 - m->work_total + m->dissipated_total - m->project_dH;
-    const PetscReal scale   = PetscMax(PetscAbsReal(m->H0), m->max_work);
-    if (scale > 0 && created > m->watch_energy * scale) {
+    /* (a floor of 1e-12 of the scene's energy unit: a scene at rest starts with round-off for its energy) */
+    const PetscReal scale   = PetscMax(PetscMax(m->E0abs, m->max_work), 1e-12);
+    if (created > m->watch_energy * scale) {
       char advice[256], f[32];
       if (m->theta && m->theta_value < 0.5) PetscCall(PetscSNPrintf(advice, sizeof(advice), "-ts_theta_theta %g < 0.5 amplifies every mode the step does not resolve: use 0.5 (the implicit midpoint rule) or more", (double)m->theta_value));
       else PetscCall(PetscSNPrintf(advice, sizeof(advice), "reduce -ts_dt, use the implicit midpoint rule, or tighten the solver's tolerances"));
@@ -444,7 +449,7 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
           PetscCall(PetscSNPrintf(advice, sizeof(advice), "first check body %s's material, warned about at the start (its units, or near incompressibility)", m->sys->parts[i]->name));
           break;
         }
-      SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the energy is %.4e J, %.3e J more than the initial energy %.4e J plus the work supplied %.4e J less the work dissipated %.4e J, more than -watchdog_energy_factor %s times their scale %.3e J: the run blew up; %s (-watchdog_energy_factor 0 turns this check off); no result was written",
+      SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the energy is %.4e J, %.3e J more than the initial energy %.4e J plus the work supplied %.4e J less the work dissipated %.4e J, more than -watchdog_energy_factor %s times the energy's scale %.3e J (the larger of the initial energies' magnitudes summed and the work): the run blew up; %s (-watchdog_energy_factor 0 turns this check off); no result was written",
               step, (double)t, (double)(H * u->energy), (double)(created * u->energy), (double)(m->H0 * u->energy), (double)(m->work_total * u->energy), (double)(m->dissipated_total * u->energy), PhlexFormatReal(m->watch_energy, f, sizeof(f)), (double)(scale * u->energy), advice);
     }
   }
@@ -458,6 +463,8 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
     const PetscReal bound = m->watch_gap * PetscMin(u->length, 1.0);
     PetscCheck(m->max_gap <= bound, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): a joint is open by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m)): the constraints drift (a dissipative scheme with large steps?); use the implicit midpoint rule, smaller steps or -joints_project_interval (-watchdog_joint_drift 0 turns this check off); no result was written",
                step, (double)t, (double)m->max_gap, (double)bound, (double)m->watch_gap);
+    PetscCheck(m->max_drive <= bound, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): a drive or prescribed motion is off its profile by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m)); the joints' other rows are closed to %.3e: %s (-watchdog_joint_drift 0 turns this check off); no result was written",
+               step, (double)t, (double)m->max_drive, (double)bound, (double)m->watch_gap, (double)m->max_gap, m->midpoint ? "the implicit midpoint rule follows a drive's profile to round-off, so Newton or the linear solver failed silently; tighten their tolerances" : "this scheme follows a drive only to its error (a rotation's: the midpoint rule's Cayley factor is exact only with the increments it is given); use the implicit midpoint rule (the default) or smaller steps");
   }
   PetscFunctionReturn(0);
 }
@@ -536,7 +543,7 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCall(PetscOptionsReal("-watchdog_balance_rtol", "Watchdog (implicit midpoint rule): stop when a step's power-balance residual exceeds this share of the energy (0: off)", "PhlexSceneSolveTransient", o->watch_balance, &o->watch_balance, NULL));
   PetscCall(PetscOptionsReal("-watchdog_orthogonality", "Watchdog (BDF, alpha: rotations not re-orthonormalised): stop when ||R^T R - I||_F of a frame exceeds this (0: off; a warning past 1e-2)", "PhlexSceneSolveTransient", o->watch_orth, &o->watch_orth, NULL));
   PetscCall(PetscOptionsReal("-watchdog_joint_drift", "Watchdog: stop when a joint opens by more than this times min(L, 1 m) [m or rad] (0: off)", "PhlexSceneSolveTransient", o->watch_gap, &o->watch_gap, NULL));
-  PetscCall(PetscOptionsReal("-watchdog_energy_factor", "Watchdog: stop when the energy created, H - H0 - supplied + dissipated, exceeds this times the larger of |H0| and the work (0: off)", "PhlexSceneSolveTransient", o->watch_energy, &o->watch_energy, NULL));
+  PetscCall(PetscOptionsReal("-watchdog_energy_factor", "Watchdog: stop when the energy created, H - H0 - supplied + dissipated, exceeds this times the energy's scale: the larger of |kinetic| + |strain| + |potential| at the start and the work (0: off)", "PhlexSceneSolveTransient", o->watch_energy, &o->watch_energy, NULL));
   PetscCall(PetscOptionsReal("-watchdog_deformation", "Watchdog: stop when a flexible body's elastic displacement exceeds this times its size (0: off)", "PhlexSceneSolveTransient", o->watch_deform, &o->watch_deform, NULL));
   PetscCall(PetscOptionsReal("-snes_velocity_rtol", "Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns converges when also the velocity rows' residual is below this share of its value at the stage's initial guess (0: off; not given: 1e-10 in a scene with joints, off without)", "PhlexSystemSNESConvergedStage", o->velocity_rtol, &o->velocity_rtol, &o->velocity_rtol_set));
   PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
@@ -1071,6 +1078,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   for (PetscInt i = 0; i < sys->nparts; i++)
     if (sys->parts[i]->ops.dissipation) m.dissipative = PETSC_TRUE;
   m.midpoint = (m.theta && !m.endpoint && m.theta_value == 0.5) ? PETSC_TRUE : PETSC_FALSE;
+  for (PetscInt k = 0; k < sys->njoints; k++)
+    if (sys->joints[k]->drive_row >= 0 || sys->joints[k]->type == PHLEX_JOINT_PRESCRIBED) m.has_drives = PETSC_TRUE;
   for (PetscInt k = 0; k < sys->njoints; k++) {
     if (PhlexJointDamped(sys->joints[k])) m.dissipative = PETSC_TRUE;
     /* PreStep keeps their states and time at a step's start */
@@ -1180,6 +1189,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     if (m.first_step) PetscCall(PetscPrintf(scene->comm, "  restarted at step %" PetscInt_FMT "\n", m.first_step));
     if (sys->njoints) {
       PetscCall(PetscPrintf(scene->comm, "  joints: max position-level violation %.3e (m or rad)", (double)m.max_gap));
+      if (m.has_drives) PetscCall(PetscPrintf(scene->comm, "; drives: max error against their profiles %.3e (m or rad)", (double)m.max_drive));
       if (m.nprojections) PetscCall(PetscPrintf(scene->comm, "; %" PetscInt_FMT " projections changed the energy by %.3e J", m.nprojections, (double)(m.project_dH * u->energy)));
       PetscCall(PetscPrintf(scene->comm, "\n"));
     }

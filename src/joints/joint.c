@@ -832,6 +832,27 @@ static PetscErrorCode Source(PhlexJoint j, PetscInt k, PetscReal t, PetscReal *g
 
   PetscFunctionBeginUser;
   *g = 0.0;
+  if (j->drive_step && t > j->drive_t0 && (j->type == PHLEX_JOINT_PRESCRIBED || (j->drive_row >= 0 && k == j->nc - 1))) {
+    /* at the stage of a midpoint step: the rate whose step the scheme maps onto the prescribed increment. A position
+       moves by dt v_m (exact for the step's mean rate); a rotation by the Cayley factor of dt w_m, an angle
+       2 atan(|w_m| dt/2): w_m = 2 tan(phi/2)/dt along the increment phi (the mean rate alone lags by n (w dt -
+       2 atan(w dt/2)) after n steps: 1e-2 rad in 100 steps of w dt = 0.5). The work is still exactly lambda . c. */
+    const PetscReal dt = 2.0 * (t - j->drive_t0), dtn = dt / u->time;
+    PetscReal       F0, F1, dF;
+    PetscCall(PhlexProfileIntegrate(j->drive_profile, j->drive_t0, &F0));
+    PetscCall(PhlexProfileIntegrate(j->drive_profile, j->drive_t0 + dt, &F1));
+    dF = F1 - F0; /* [s] times the profile */
+    if (j->type == PHLEX_JOINT_PRESCRIBED) {
+      if (j->row[k] <= PHLEX_ROW_T3) *g = j->presc_velocity[j->row[k] - PHLEX_ROW_T1] * dF / dt / u->velocity;
+      else {
+        const PetscReal phi = PhlexNorm3(j->presc_angular) * PetscAbsReal(dF);
+        const PetscReal scale = phi > 0 ? 2.0 * PetscTanReal(0.5 * phi) / phi : 1.0;
+        *g = j->presc_angular[j->row[k] - PHLEX_ROW_R1] * dF * scale / dtn;
+      }
+    } else if (j->row[k] == PHLEX_ROW_R3) *g = 2.0 * PetscTanReal(0.5 * j->drive_velocity * dF) / dtn;
+    else *g = j->drive_velocity * dF / dt / u->velocity;
+    PetscFunctionReturn(0);
+  }
   if (j->type == PHLEX_JOINT_PRESCRIBED) {
     PetscCall(PhlexProfileEvaluate(j->drive_profile, t, &f));
     if (j->row[k] <= PHLEX_ROW_T3) *g = f * j->presc_velocity[j->row[k] - PHLEX_ROW_T1] / u->velocity;
@@ -977,6 +998,20 @@ PetscErrorCode PhlexJointElementStepStart(PhlexJoint j, PetscReal t0, const Pets
   j->dg        = (PetscBool)(lossless && j->ntable > 0);
   j->rest_step = (PetscBool)(midpoint && j->rest_profile);
   j->rest_t0   = t0;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexJointDriveStepStart - before a step from t0: whether it is a midpoint step, whose stage then takes the rate of
+  a drive or a prescribed motion that makes the step's increment the prescribed one (Source)
+
+  Not collective
+@*/
+PetscErrorCode PhlexJointDriveStepStart(PhlexJoint j, PetscReal t0, PetscBool midpoint)
+{
+  PetscFunctionBeginUser;
+  j->drive_step = (PetscBool)(midpoint && (j->drive_row >= 0 || j->type == PHLEX_JOINT_PRESCRIBED) && j->drive_profile);
+  j->drive_t0   = t0;
   PetscFunctionReturn(0);
 }
 
@@ -1639,11 +1674,12 @@ PetscErrorCode PhlexJointOutputOpen(PhlexJoint j, PhlexOutput out)
   through the joint over the step (non-dimensional, from the monitor: at the state where the scheme enforces the
   constraints), the relative motion and the violations at the state X; with force elements their states and forces, the
   stored energy at X (the joint evaluated at X), the power Dstep its dampers dissipated over the step and their work so
-  far; returns the largest violation (SI: m or rad)
+  far; returns the largest violation of the constraint rows and the largest error of the driven ones against their
+  profiles (a drive's row, a prescribed motion's; SI: m or rad)
 
   Collective
 @*/
-PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, PetscReal Dstep, PetscReal Astep, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax)
+PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *lambda, PetscReal P, PetscReal Dstep, PetscReal Astep, const PhlexPartVec *Xa, const PhlexPartVec *Xb, PetscReal *gapmax, PetscReal *drivemax)
 {
   const PhlexUnits *u = j->units;
   PetscReal         wJ[6], mo[6], gap[7], r;
@@ -1653,8 +1689,13 @@ PetscErrorCode PhlexJointOutputStep(PhlexJoint j, PetscReal t, const PetscReal *
   JointWrench(j, lambda, NULL, wJ);
   PetscCall(PhlexJointRelativeMotion(j, Xa, Xb, mo, &nm));
   PetscCall(PhlexJointGap(j, t, Xa, Xb, gap));
-  *gapmax = 0.0;
-  for (PetscInt k = 0; k < j->nc; k++) *gapmax = PetscMax(*gapmax, PetscAbsReal(gap[k]) * (j->row[k] <= PHLEX_ROW_T3 ? u->length : 1.0));
+  *gapmax = *drivemax = 0.0;
+  for (PetscInt k = 0; k < j->nc; k++) {
+    const PetscReal g     = PetscAbsReal(gap[k]) * (j->row[k] <= PHLEX_ROW_T3 ? u->length : 1.0);
+    const PetscBool drive = (PetscBool)(j->type == PHLEX_JOINT_PRESCRIBED || (j->drive_row >= 0 && k == j->nc - 1));
+    if (drive) *drivemax = PetscMax(*drivemax, g);
+    else *gapmax = PetscMax(*gapmax, g);
+  }
   if (!j->csv) PetscFunctionReturn(0);
   PetscCall(PhlexCSVPrintf(j->csv, "%.12e", (double)t));
   for (PetscInt r = 0; r < 3; r++) PetscCall(PhlexCSVPrintf(j->csv, ",%.12e", (double)(PhlexDot3(j->dir + 3 * r, wJ) * u->force)));
