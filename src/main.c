@@ -90,7 +90,10 @@ int main(int argc, char **argv)
   }
   (void)PhlexHelpParseArgs(&argc, argv);
   code = PhlexSceneFilesCheck(argc, argv);
-  if (code) return code;
+  if (code) {
+    PhlexOptionsOriginFree();
+    return code;
+  }
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(PhlexHelpActivate(PETSC_COMM_WORLD));
   PetscCall(PhlexErrorHandlerPush());
@@ -115,10 +118,12 @@ int main(int argc, char **argv)
     if (size > 1) MPI_Abort(PETSC_COMM_WORLD, code);
     (void)PhlexSceneDestroy(&scene);
     (void)SlepcFinalize();
+    PhlexOptionsOriginFree();
     return code;
   }
   PetscCall(PhlexSceneDestroy(&scene));
   PetscCall(PhlexErrorHandlerPop());
   PetscCall(SlepcFinalize());
+  PhlexOptionsOriginFree();
   return 0;
 }

@@ -182,7 +182,9 @@ static PetscErrorCode LinearizedPEPCreate(MPI_Comm comm, PEP *pep)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode LinearizedRereadOptions(void *ctx)
+/* every option of a linearised run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
+   the analysis', the eigensolvers' */
+PetscErrorCode PhlexLinearizedRereadOptions(void *ctx)
 {
   MPI_Comm          comm = *(MPI_Comm *)ctx;
   LinearizedOptions o;
@@ -1122,7 +1124,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCall(EPSDestroy(&eps));
     PetscFunctionReturn(0);
   }
-  PetscCall(PhlexOptionsCheckUnused(scene->comm, LinearizedRereadOptions, &scene->comm));
+  PetscCall(PhlexOptionsCheckUnused(scene->comm, PhlexLinearizedRereadOptions, &scene->comm));
   if (scene->gravity[0] != 0 || scene->gravity[1] != 0 || scene->gravity[2] != 0) {
     char g[3][32];
     for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(scene->gravity[k], g[k], sizeof(g[k]));

@@ -47,7 +47,7 @@ static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
 
 /* every option of a modal run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's, the
    analysis', the eigensolver's */
-static PetscErrorCode ModesRereadOptions(void *ctx)
+PetscErrorCode PhlexModesRereadOptions(void *ctx)
 {
   MPI_Comm     comm = *(MPI_Comm *)ctx;
   ModesOptions o;
@@ -152,7 +152,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     PetscCall(EPSDestroy(&eps));
   }
   if (PhlexHelpGetMode() != PHLEX_HELP_NONE) PetscFunctionReturn(0);
-  PetscCall(PhlexOptionsCheckUnused(scene->comm, ModesRereadOptions, &scene->comm));
+  PetscCall(PhlexOptionsCheckUnused(scene->comm, PhlexModesRereadOptions, &scene->comm));
   {
     /* read with the bodies' options (so that -help lists it), but the stress maps belong to the mixed operators */
     PetscBool check = PETSC_FALSE;

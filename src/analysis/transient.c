@@ -425,6 +425,7 @@ static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys, char fi
   PetscCall(PetscTestFile(file, 'r', &exists));
   PetscCheck(exists, comm, PETSC_ERR_FILE_OPEN, "cannot read the solver preset '%s' (option -solver_options_file; presets are in options/solver/)", file);
   PetscCall(PetscOptionsInsertFile(comm, NULL, file, PETSC_TRUE));
+  PetscCall(PhlexOptionsOriginAddFile(file)); /* its options' file and line, for the messages about them */
   PetscCall(PetscGetArgs(&argc, &argv));
   PetscCall(PetscOptionsInsert(NULL, &argc, &argv, NULL));
   PetscFunctionReturn(0);
@@ -470,8 +471,6 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscFunctionReturn(0);
 }
 
-/* every option of a transient run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
-   the analysis', the solver preset's, and those of TS, SNES, KSP and PC */
 /* Newton's Jacobian reuse within a step (PhlexSystemSNESConverged): read after the solver preset, which sets it */
 static PetscErrorCode JacobianReuseOption(MPI_Comm comm, PetscReal *rate, PetscBool *set)
 {
@@ -484,7 +483,9 @@ static PetscErrorCode JacobianReuseOption(MPI_Comm comm, PetscReal *rate, PetscB
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode TransientRereadOptions(void *ctx)
+/* every option of a transient run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
+   the analysis', the solver preset's, and those of TS, SNES, KSP and PC */
+PetscErrorCode PhlexTransientRereadOptions(void *ctx)
 {
   MPI_Comm         comm = *(MPI_Comm *)ctx;
   TransientOptions o;
@@ -540,7 +541,7 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
       PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexreduced (Newton on the velocities and discrete unknowns, theta method; a mechanism's consistent start too): its linear solve reads -reduced_ksp_*, -reduced_pc_* and -reduced_bordered_*; -snes_type newtonls takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
     if (m->reduced || m->condensed) PetscCall(PhlexOptionsSetPathRenames(split_solve, stage_solve));
     else PetscCall(PhlexOptionsSetPathRenames(stage_solve, split_solve));
-    PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
+    PetscCall(PhlexOptionsCheckUnused(m->scene->comm, PhlexTransientRereadOptions, &m->scene->comm));
     PetscCall(PhlexOptionsSetPathRenames(NULL, NULL));
   }
   PetscCall(TSGetMaxTime(ts, &tmax));
