@@ -66,7 +66,7 @@ PETSC_EXTERN const char     PhlexUsage[];
 PETSC_EXTERN PhlexHelpMode  PhlexHelpParseArgs(int *, char **);
 PETSC_EXTERN PhlexHelpMode  PhlexHelpGetMode(void);
 PETSC_EXTERN PetscErrorCode PhlexHelpActivate(MPI_Comm);
-PETSC_EXTERN PetscErrorCode PhlexHelpEnd(MPI_Comm, PetscBool);
+PETSC_EXTERN PetscErrorCode PhlexHelpEnd(MPI_Comm, PetscBool, const char[]);
 PETSC_EXTERN PetscErrorCode PhlexHelpCaptureBegin(void);
 PETSC_EXTERN PetscErrorCode PhlexHelpCaptureEnd(PetscInt *, char ***);
 

@@ -66,12 +66,12 @@ static PetscErrorCode Run(PhlexScene *scene)
   }
   PetscCall(PetscLogStagePop());
   PetscCall(PhlexSceneGetAnalysis(*scene, &analysis));
-  /* -help: the options of both analyses (each returns once it has read them) */
-  if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_MODES) PetscCall(PhlexSceneSolveModes(*scene));
-  if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_TRANSIENT) PetscCall(PhlexSceneSolveTransient(*scene));
-  if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_LINEARIZED) PetscCall(PhlexSceneSolveLinearized(*scene));
+  /* -help: the options of the scene's analysis (it returns once it has read them); without a scene, of every analysis */
+  if (catalogue || analysis == PHLEX_ANALYSIS_MODES) PetscCall(PhlexSceneSolveModes(*scene));
+  if (catalogue || analysis == PHLEX_ANALYSIS_TRANSIENT) PetscCall(PhlexSceneSolveTransient(*scene));
+  if (catalogue || analysis == PHLEX_ANALYSIS_LINEARIZED) PetscCall(PhlexSceneSolveLinearized(*scene));
   if (help_mode == PHLEX_HELP_NONE && analysis == PHLEX_ANALYSIS_REDUCE) PetscCall(PhlexSceneReduce(*scene));
-  if (help_mode != PHLEX_HELP_NONE) PetscCall(PhlexHelpEnd(PETSC_COMM_WORLD, catalogue));
+  if (help_mode != PHLEX_HELP_NONE) PetscCall(PhlexHelpEnd(PETSC_COMM_WORLD, catalogue, PhlexAnalysisTypes[analysis]));
   else PetscCall(PhlexOptionsWarnUnused(PETSC_COMM_WORLD));
   PetscFunctionReturn(0);
 }

@@ -63,13 +63,13 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
   PetscOptionsBegin(comm, NULL, "Linearised analysis of the assembly options", NULL);
   PetscCall(PetscOptionsInt("-linearized_nev", "Number of elastic (non-zero) frequencies wanted per configuration", "PhlexSceneSolveLinearized", o->nev, &o->nev, NULL));
   PetscCall(PetscOptionsString("-linearized_sweep_joint", "Driven joint whose position is swept (default: the scene's only driven joint)", "PhlexSceneSolveLinearized", o->joint, o->joint, sizeof(o->joint), NULL));
-  PetscCall(PetscOptionsRealArray("-linearized_sweep", "Drive positions of the configurations, as -drive_initial: angles [deg] or slides [m] relative to the drawn configuration", "PhlexSceneSolveLinearized", o->values, &o->nvalues, &o->has_values));
-  PetscCall(PetscOptionsRealArray("-linearized_sweep_range", "Drive positions start,stop,step (stop included) [deg or m]", "PhlexSceneSolveLinearized", o->range, &nrange, &o->has_range));
-  PetscCall(PetscOptionsRealArray("-linearized_spin_sweep", "Spin rates of the configurations, for the body with -spin (its axis kept) [rad/s]", "PhlexSceneSolveLinearized", o->spins, &o->nspins, &has_spins));
-  PetscCall(PetscOptionsRealArray("-linearized_spin_sweep_range", "Spin rates start,stop,step (stop included) [rad/s]", "PhlexSceneSolveLinearized", srange, &nsrange, &has_srange));
+  PetscCall(PhlexOptionsRealList("-linearized_sweep", "Drive positions of the configurations, as -drive_initial: angles [deg] or slides [m] relative to the drawn configuration", "PhlexSceneSolveLinearized", o->values, &o->nvalues, &o->has_values, 0));
+  PetscCall(PhlexOptionsRealList("-linearized_sweep_range", "Drive positions start,stop,step (stop included) [deg or m]", "PhlexSceneSolveLinearized", o->range, &nrange, &o->has_range, 0));
+  PetscCall(PhlexOptionsRealList("-linearized_spin_sweep", "Spin rates of the configurations, for the body with -spin (its axis kept) [rad/s]", "PhlexSceneSolveLinearized", o->spins, &o->nspins, &has_spins, 0));
+  PetscCall(PhlexOptionsRealList("-linearized_spin_sweep_range", "Spin rates start,stop,step (stop included) [rad/s]", "PhlexSceneSolveLinearized", srange, &nsrange, &has_srange, 0));
   PetscCall(PetscOptionsBool("-linearized_coriolis", "About a spin: keep the Coriolis (gyroscopic) coupling, a quadratic eigenproblem (false: the symmetric problem of the stiffness and the spin softening alone, as beam tables do)", "PhlexSceneSolveLinearized", o->coriolis, &o->coriolis, NULL));
   PetscCall(PetscOptionsInt("-linearized_fields_configuration", "Write the mode shapes of this configuration (0-based index; -1: none)", "PhlexSceneSolveLinearized", o->fields_configuration, &o->fields_configuration, NULL));
-  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] of the first configuration (self-check)", "PhlexSceneSolveLinearized", o->expected, &o->nexp, &o->has_exp));
+  PetscCall(PhlexOptionsRealList("-expect_frequencies", "Expected elastic frequencies [Hz] of the first configuration (self-check)", "PhlexSceneSolveLinearized", o->expected, &o->nexp, &o->has_exp, 0));
   PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveLinearized", o->rtol, &o->rtol, NULL));
   PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveLinearized", o->rmax, &o->rmax, NULL));
   PetscOptionsEnd();

@@ -117,7 +117,7 @@ PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile p)
   PetscCall(PetscOptionsReal("-profile_frequency", "Sine profile: frequency [Hz]", "PhlexProfileSetFromOptions", p->frequency, &p->frequency, NULL));
   PetscCall(PetscOptionsReal("-profile_phase", "Sine profile: phase [rad]", "PhlexProfileSetFromOptions", p->phase, &p->phase, NULL));
   PetscCall(PetscOptionsReal("-profile_scale", "Factor applied to the profile [-]", "PhlexProfileSetFromOptions", p->scale, &p->scale, NULL));
-  PetscCall(PetscOptionsRealArray("-profile_table", "Table profile: points t0,f0,t1,f1,... (t in s)", "PhlexProfileSetFromOptions", table, &ntable, &flg_table));
+  PetscCall(PhlexOptionsRealList("-profile_table", "Table profile: points t0,f0,t1,f1,... (t in s)", "PhlexProfileSetFromOptions", table, &ntable, &flg_table, 0));
   PetscCall(PetscOptionsString("-profile_file", "Table profile: two-column CSV file t,f (t in s)", "PhlexProfileSetFromOptions", file, file, sizeof(file), &flg_file));
   PetscOptionsEnd();
 
