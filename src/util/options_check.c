@@ -28,6 +28,17 @@ static PetscBool ReadAtFinalize(const char name[])
   return PETSC_FALSE;
 }
 
+/* PETSc's own options of the whole program that a run may well not read (its graphics, the citations written at the
+   end, the MPI solver server): never judged, neither here nor at the end (the others PETSc reads at initialisation,
+   or are judged at the end: ReadLate) */
+static PetscBool PetscGlobal(const char name[])
+{
+  static const char *const global[] = {"citations", "nox", "display", "x_virtual", "geometry", "draw_", "mpi_linear_solver_server", "viewfromoptions", "version", "help", NULL};
+  for (PetscInt i = 0; global[i]; i++)
+    if (!strncasecmp(name, global[i], strlen(global[i]))) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
 /* edit distance, for the suggestion */
 static PetscInt Distance(const char *a, const char *b)
 {
@@ -717,7 +728,7 @@ PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm comm, PetscErrorCode (*reread)(v
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
   for (PetscInt i = 0; i < n; i++)
-    if (!ReadLate(names[i])) nunused++;
+    if (!ReadLate(names[i]) && !PetscGlobal(names[i])) nunused++;
   if (nunused) {
     if (reread) {
       PetscErrorCode ierr;
@@ -734,7 +745,7 @@ PetscErrorCode PhlexOptionsCheckUnused(MPI_Comm comm, PetscErrorCode (*reread)(v
     char        near[256] = "", origin[PETSC_MAX_PATH_LEN + 64] = "", option[256];
     PetscBool   given, set;
     Belonging   b;
-    if (ReadLate(names[i])) continue;
+    if (ReadLate(names[i]) || PetscGlobal(names[i])) continue;
     for (PetscInt k = 0; rename_from && rename_from[k] && !near[0]; k++) {
       /* the same option on the path the run takes, if it reads it */
       const size_t nf = strlen(rename_from[k]);
@@ -929,7 +940,7 @@ PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm comm)
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
   for (PetscInt i = 0; i < n; i++)
-    if (!ReadAtFinalize(names[i])) PetscCall(PetscFPrintf(comm, PETSC_STDERR, "phlex: warning: option -%s %s was never used (misspelt?)\n", names[i], values[i] ? values[i] : ""));
+    if (!ReadAtFinalize(names[i]) && !PetscGlobal(names[i])) PetscCall(PetscFPrintf(comm, PETSC_STDERR, "phlex: warning: option -%s %s was never used (misspelt?)\n", names[i], values[i] ? values[i] : ""));
   PetscCall(PetscOptionsLeftRestore(NULL, &n, &names, &values));
   PetscFunctionReturn(0);
 }
