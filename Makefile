@@ -1,6 +1,6 @@
 # phlex: GNU make build for Debian's PETSc 3.18 / SLEPc 3.18.
 #   make            build bin/phlex
-#   make run        build (installing missing packages first) and run the default scene
+#   make run        build (installing missing packages first; every core, JOBS=n to choose) and run the default scene
 #   make check      build (installing missing packages first) and run the regression suite
 #   make deps       install the Debian packages phlex needs (only those missing)
 #   make meshes     regenerate the committed meshes from their .geo sources
@@ -12,6 +12,9 @@ SCENE     ?= options/cantilever.yaml
 MPIEXEC   ?= mpiexec
 NP        ?= 1
 RUN_ARGS  ?=
+# the build under run, check and validate uses every core (JOBS=n to choose), unless make itself was given -j
+JOBS      ?= $(shell nproc 2>/dev/null || echo 1)
+PARALLEL   = $(if $(findstring -j,$(MAKEFLAGS))$(findstring jobserver,$(MAKEFLAGS)),,-j$(JOBS))
 
 # Flags are looked up lazily, so that 'make check' on a machine without PETSc can first install it.
 CC        = $(shell pkg-config --variable=ccompiler petsc 2>/dev/null || echo mpicc)
@@ -26,7 +29,7 @@ OBJ       := $(patsubst src/%.c,build/%.o,$(SRC))
 BIN       := bin/phlex
 
 # The dependency probe: PETSc, SLEPc and gmsh present means nothing has to be installed.
-HAVE_DEPS = $(shell pkg-config --exists $(PKGS) 2>/dev/null && command -v gmsh >/dev/null 2>&1 && command -v $(MPIEXEC) >/dev/null 2>&1 && echo yes)
+HAVE_DEPS = $(shell pkg-config --exists $(PKGS) 2>/dev/null && command -v gmsh >/dev/null 2>&1 && command -v $(firstword $(MPIEXEC)) >/dev/null 2>&1 && echo yes)
 
 .PHONY: all run check check-update deps deps-if-missing meshes format clean print bench memcheck validate
 
@@ -54,11 +57,11 @@ deps-if-missing:
 	@$(if $(HAVE_DEPS),true,tools/install-deps.sh)
 
 run: deps-if-missing
-	@$(MAKE) --no-print-directory $(BIN)
+	@$(MAKE) --no-print-directory $(PARALLEL) $(BIN)
 	$(MPIEXEC) -n $(NP) $(BIN) -options_file $(SCENE) $(RUN_ARGS)
 
 check: deps-if-missing
-	@$(MAKE) --no-print-directory $(BIN)
+	@$(MAKE) --no-print-directory $(PARALLEL) $(BIN)
 	python3 tests/run.py $(TEST_ARGS)
 
 check-update: $(BIN)
@@ -71,7 +74,7 @@ memcheck: $(BIN)
 	tests/memcheck.sh
 
 validate: deps-if-missing
-	@$(MAKE) --no-print-directory $(BIN)
+	@$(MAKE) --no-print-directory $(PARALLEL) $(BIN)
 	python3 tools/validate.py $(VALIDATE_ARGS)
 
 bench: $(BIN)

@@ -66,7 +66,7 @@ PETSC_EXTERN const char     PhlexUsage[];
 PETSC_EXTERN PhlexHelpMode  PhlexHelpParseArgs(int *, char **);
 PETSC_EXTERN PhlexHelpMode  PhlexHelpGetMode(void);
 PETSC_EXTERN PetscErrorCode PhlexHelpActivate(MPI_Comm);
-PETSC_EXTERN PetscErrorCode PhlexHelpEnd(MPI_Comm, PetscBool);
+PETSC_EXTERN PetscErrorCode PhlexHelpEnd(MPI_Comm, PetscBool, const char[]);
 PETSC_EXTERN PetscErrorCode PhlexHelpCaptureBegin(void);
 PETSC_EXTERN PetscErrorCode PhlexHelpCaptureEnd(PetscInt *, char ***);
 
@@ -78,8 +78,11 @@ PETSC_EXTERN PetscErrorCode PhlexOptionsSetUsedOverridden(const char[]);
 PETSC_EXTERN PetscErrorCode PhlexOptionsCommandLineHasPrefix(const char *const[], PetscBool *);
 PETSC_EXTERN PetscErrorCode PhlexOptionsSetPathRenames(const char *const[], const char *const[]);
 
-/* scene_file.c: the YAML syntax of the scene files, before PETSc reads them */
-PETSC_EXTERN int PhlexSceneFilesCheck(int, char **);
+/* scene_file.c: the YAML syntax of the scene files, before PETSc reads them; where each option of a file comes from */
+PETSC_EXTERN int            PhlexSceneFilesCheck(int, char **);
+PETSC_EXTERN PetscErrorCode PhlexOptionsOriginAddFile(const char[]);
+PETSC_EXTERN PetscErrorCode PhlexOptionsOrigin(const char[], const char **, int *, const char **, PetscBool *);
+PETSC_EXTERN void           PhlexOptionsOriginFree(void);
 
 /* interrupt.c: SIGINT/SIGTERM end the run at the next step */
 PETSC_EXTERN PetscErrorCode PhlexInterruptPush(void);

@@ -157,7 +157,14 @@ PETSC_INTERN PetscErrorCode PhlexCheckpointReadInt(PetscViewer, const char[], co
 PETSC_INTERN PetscErrorCode PhlexCheckpointWriteString(PetscViewer, const char[], const char[], const char[]);
 PETSC_INTERN PetscErrorCode PhlexCheckpointReadString(PetscViewer, const char[], const char[], char[], size_t);
 
+/* the options of each analysis read once more, for the unused-option check (ctx: the MPI_Comm) */
+PETSC_INTERN PetscErrorCode PhlexTransientRereadOptions(void *); /* transient.c */
+PETSC_INTERN PetscErrorCode PhlexModesRereadOptions(void *);     /* modes.c */
+PETSC_INTERN PetscErrorCode PhlexLinearizedRereadOptions(void *); /* linearized.c */
+
 /* error.c: option input with checked length */
+PETSC_INTERN PetscErrorCode PhlexOptionsRealList_Private(PetscOptionItems *, const char[], const char[], const char[], PetscReal[], PetscInt *, PetscBool *, PetscInt);
+#define PhlexOptionsRealList(opt, text, man, value, n, set, ndefault) PhlexOptionsRealList_Private(PetscOptionsObject, opt, text, man, value, n, set, ndefault)
 PETSC_INTERN PetscErrorCode PhlexOptionsRealN(PetscOptionItems *, MPI_Comm, const char[], const char[], const char[], const char[], const char[], PetscInt, PetscReal[], PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexOptionsListLength(const char[], const char[], PetscInt *);
 

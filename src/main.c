@@ -66,12 +66,12 @@ static PetscErrorCode Run(PhlexScene *scene)
   }
   PetscCall(PetscLogStagePop());
   PetscCall(PhlexSceneGetAnalysis(*scene, &analysis));
-  /* -help: the options of both analyses (each returns once it has read them) */
-  if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_MODES) PetscCall(PhlexSceneSolveModes(*scene));
-  if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_TRANSIENT) PetscCall(PhlexSceneSolveTransient(*scene));
-  if (help_mode == PHLEX_HELP_OPTIONS || analysis == PHLEX_ANALYSIS_LINEARIZED) PetscCall(PhlexSceneSolveLinearized(*scene));
+  /* -help: the options of the scene's analysis (it returns once it has read them); without a scene, of every analysis */
+  if (catalogue || analysis == PHLEX_ANALYSIS_MODES) PetscCall(PhlexSceneSolveModes(*scene));
+  if (catalogue || analysis == PHLEX_ANALYSIS_TRANSIENT) PetscCall(PhlexSceneSolveTransient(*scene));
+  if (catalogue || analysis == PHLEX_ANALYSIS_LINEARIZED) PetscCall(PhlexSceneSolveLinearized(*scene));
   if (help_mode == PHLEX_HELP_NONE && analysis == PHLEX_ANALYSIS_REDUCE) PetscCall(PhlexSceneReduce(*scene));
-  if (help_mode != PHLEX_HELP_NONE) PetscCall(PhlexHelpEnd(PETSC_COMM_WORLD, catalogue));
+  if (help_mode != PHLEX_HELP_NONE) PetscCall(PhlexHelpEnd(PETSC_COMM_WORLD, catalogue, PhlexAnalysisTypes[analysis]));
   else PetscCall(PhlexOptionsWarnUnused(PETSC_COMM_WORLD));
   PetscFunctionReturn(0);
 }
@@ -90,7 +90,10 @@ int main(int argc, char **argv)
   }
   (void)PhlexHelpParseArgs(&argc, argv);
   code = PhlexSceneFilesCheck(argc, argv);
-  if (code) return code;
+  if (code) {
+    PhlexOptionsOriginFree();
+    return code;
+  }
   PetscCall(SlepcInitialize(&argc, &argv, NULL, help));
   PetscCall(PhlexHelpActivate(PETSC_COMM_WORLD));
   PetscCall(PhlexErrorHandlerPush());
@@ -118,10 +121,12 @@ int main(int argc, char **argv)
     if (size > 1) MPI_Abort(PETSC_COMM_WORLD, code);
     (void)PhlexSceneDestroy(&scene);
     (void)SlepcFinalize();
+    PhlexOptionsOriginFree();
     return code;
   }
   PetscCall(PhlexSceneDestroy(&scene));
   PetscCall(PhlexErrorHandlerPop());
   PetscCall(SlepcFinalize());
+  PhlexOptionsOriginFree();
   return 0;
 }

@@ -73,16 +73,16 @@ static PetscErrorCode LinearizedSetFromOptions(MPI_Comm comm, LinearizedOptions 
   PetscOptionsBegin(comm, NULL, "Linearised analysis of the assembly options", NULL);
   PetscCall(PetscOptionsInt("-linearized_nev", "Number of elastic (non-zero) frequencies wanted per configuration", "PhlexSceneSolveLinearized", o->nev, &o->nev, NULL));
   PetscCall(PetscOptionsString("-linearized_sweep_joint", "Driven joint whose position is swept (default: the scene's only driven joint)", "PhlexSceneSolveLinearized", o->joint, o->joint, sizeof(o->joint), NULL));
-  PetscCall(PetscOptionsRealArray("-linearized_sweep", "Drive positions of the configurations, as -drive_initial: angles [deg] or slides [m] relative to the drawn configuration", "PhlexSceneSolveLinearized", o->values, &o->nvalues, &o->has_values));
-  PetscCall(PetscOptionsRealArray("-linearized_sweep_range", "Drive positions start,stop,step (stop included) [deg or m]", "PhlexSceneSolveLinearized", o->range, &nrange, &o->has_range));
-  PetscCall(PetscOptionsRealArray("-linearized_spin_sweep", "Spin rates of the configurations, for the body with -spin (its axis kept) [rad/s]", "PhlexSceneSolveLinearized", o->spins, &o->nspins, &has_spins));
-  PetscCall(PetscOptionsRealArray("-linearized_spin_sweep_range", "Spin rates start,stop,step (stop included) [rad/s]", "PhlexSceneSolveLinearized", srange, &nsrange, &has_srange));
+  PetscCall(PhlexOptionsRealList("-linearized_sweep", "Drive positions of the configurations, as -drive_initial: angles [deg] or slides [m] relative to the drawn configuration", "PhlexSceneSolveLinearized", o->values, &o->nvalues, &o->has_values, 0));
+  PetscCall(PhlexOptionsRealList("-linearized_sweep_range", "Drive positions start,stop,step (stop included) [deg or m]", "PhlexSceneSolveLinearized", o->range, &nrange, &o->has_range, 0));
+  PetscCall(PhlexOptionsRealList("-linearized_spin_sweep", "Spin rates of the configurations, for the body with -spin (its axis kept) [rad/s]", "PhlexSceneSolveLinearized", o->spins, &o->nspins, &has_spins, 0));
+  PetscCall(PhlexOptionsRealList("-linearized_spin_sweep_range", "Spin rates start,stop,step (stop included) [rad/s]", "PhlexSceneSolveLinearized", srange, &nsrange, &has_srange, 0));
   PetscCall(PetscOptionsBool("-linearized_coriolis", "About a spin: keep the Coriolis (gyroscopic) coupling, a quadratic eigenproblem (false: the symmetric problem of the stiffness and the spin softening alone, as beam tables do)", "PhlexSceneSolveLinearized", o->coriolis, &o->coriolis, NULL));
   PetscCall(PetscOptionsInt("-linearized_fields_configuration", "Write the mode shapes of this configuration (0-based index; -1: none)", "PhlexSceneSolveLinearized", o->fields_configuration, &o->fields_configuration, NULL));
-  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] of the first configuration (self-check)", "PhlexSceneSolveLinearized", o->expected, &o->nexp, &o->has_exp));
+  PetscCall(PhlexOptionsRealList("-expect_frequencies", "Expected elastic frequencies [Hz] of the first configuration (self-check)", "PhlexSceneSolveLinearized", o->expected, &o->nexp, &o->has_exp, 0));
   PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveLinearized", o->rtol, &o->rtol, NULL));
   PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveLinearized", o->rmax, &o->rmax, NULL));
-  PetscCall(PetscOptionsRealArray("-expect_damping_ratios", "Expected damping ratios [-] of the first configuration's modes (self-check of a damped assembly)", "PhlexSceneSolveLinearized", o->zexpected, &o->nzexp, &o->has_zexp));
+  PetscCall(PhlexOptionsRealList("-expect_damping_ratios", "Expected damping ratios [-] of the first configuration's modes (self-check of a damped assembly)", "PhlexSceneSolveLinearized", o->zexpected, &o->nzexp, &o->has_zexp, 0));
   PetscCall(PetscOptionsReal("-expect_damping_ratios_rtol", "Relative tolerance of -expect_damping_ratios", "PhlexSceneSolveLinearized", o->zrtol, &o->zrtol, NULL));
   PetscOptionsEnd();
   PetscCheck(o->nev >= 1, comm, PETSC_ERR_USER_INPUT, "-linearized_nev must be >= 1, got %" PetscInt_FMT, o->nev);
@@ -196,7 +196,9 @@ static PetscErrorCode LinearizedPEPCreate(MPI_Comm comm, PEP *pep)
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode LinearizedRereadOptions(void *ctx)
+/* every option of a linearised run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
+   the analysis', the eigensolvers' */
+PetscErrorCode PhlexLinearizedRereadOptions(void *ctx)
 {
   MPI_Comm          comm = *(MPI_Comm *)ctx;
   LinearizedOptions o;
@@ -1325,7 +1327,7 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
     PetscCall(PEPDestroy(&pep));
     PetscFunctionReturn(0);
   }
-  PetscCall(PhlexOptionsCheckUnused(scene->comm, LinearizedRereadOptions, &scene->comm));
+  PetscCall(PhlexOptionsCheckUnused(scene->comm, PhlexLinearizedRereadOptions, &scene->comm));
   if (scene->gravity[0] != 0 || scene->gravity[1] != 0 || scene->gravity[2] != 0) {
     char g[3][32];
     for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(scene->gravity[k], g[k], sizeof(g[k]));

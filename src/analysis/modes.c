@@ -32,7 +32,7 @@ static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
   PetscCall(PetscArrayzero(o->expected, 65));
   PetscOptionsBegin(comm, NULL, "Modal analysis options", NULL);
   PetscCall(PetscOptionsInt("-modes_nev", "Number of elastic modes wanted", "PhlexSceneSolveModes", o->nev, &o->nev, NULL));
-  PetscCall(PetscOptionsRealArray("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", o->expected, &o->nexp, &o->has_exp));
+  PetscCall(PhlexOptionsRealList("-expect_frequencies", "Expected elastic frequencies [Hz] (self-check)", "PhlexSceneSolveModes", o->expected, &o->nexp, &o->has_exp, 0));
   PetscCall(PetscOptionsReal("-expect_frequencies_rtol", "Relative tolerance of -expect_frequencies", "PhlexSceneSolveModes", o->rtol, &o->rtol, NULL));
   PetscCall(PetscOptionsReal("-expect_residual_max", "Bound on the relative eigenpair residuals (self-check)", "PhlexSceneSolveModes", o->rmax, &o->rmax, NULL));
   PetscCall(PetscOptionsInt("-modes_convergence_refinements", "Also solve on this many uniform refinements and report the observed order", "PhlexSceneSolveModes", o->nrefine, &o->nrefine, NULL));
@@ -47,7 +47,7 @@ static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
 
 /* every option of a modal run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's, the
    analysis', the eigensolver's */
-static PetscErrorCode ModesRereadOptions(void *ctx)
+PetscErrorCode PhlexModesRereadOptions(void *ctx)
 {
   MPI_Comm     comm = *(MPI_Comm *)ctx;
   ModesOptions o;
@@ -152,7 +152,7 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     PetscCall(EPSDestroy(&eps));
   }
   if (PhlexHelpGetMode() != PHLEX_HELP_NONE) PetscFunctionReturn(0);
-  PetscCall(PhlexOptionsCheckUnused(scene->comm, ModesRereadOptions, &scene->comm));
+  PetscCall(PhlexOptionsCheckUnused(scene->comm, PhlexModesRereadOptions, &scene->comm));
   {
     /* read with the bodies' options (so that -help lists it), but the stress maps belong to the mixed operators */
     PetscBool check = PETSC_FALSE;

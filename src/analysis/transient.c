@@ -495,6 +495,7 @@ static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys, char fi
   PetscCall(PetscTestFile(file, 'r', &exists));
   PetscCheck(exists, comm, PETSC_ERR_FILE_OPEN, "cannot read the solver preset '%s' (option -solver_options_file; presets are in options/solver/)", file);
   PetscCall(PetscOptionsInsertFile(comm, NULL, file, PETSC_TRUE));
+  PetscCall(PhlexOptionsOriginAddFile(file)); /* its options' file and line, for the messages about them */
   PetscCall(PetscGetArgs(&argc, &argv));
   PetscCall(PetscOptionsInsert(NULL, &argc, &argv, NULL));
   PetscFunctionReturn(0);
@@ -546,7 +547,7 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCall(PetscOptionsReal("-watchdog_energy_factor", "Watchdog: stop when the energy created, H - H0 - supplied + dissipated, exceeds this times the energy's scale: the larger of |kinetic| + |strain| + |potential| at the start and the work (0: off)", "PhlexSceneSolveTransient", o->watch_energy, &o->watch_energy, NULL));
   PetscCall(PetscOptionsReal("-watchdog_deformation", "Watchdog: stop when a flexible body's elastic displacement exceeds this times its size (0: off)", "PhlexSceneSolveTransient", o->watch_deform, &o->watch_deform, NULL));
   PetscCall(PetscOptionsReal("-snes_velocity_rtol", "Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns converges when also the velocity rows' residual is below this share of its value at the stage's initial guess (0: off; not given: 1e-10 in a scene with joints, off without)", "PhlexSystemSNESConvergedStage", o->velocity_rtol, &o->velocity_rtol, &o->velocity_rtol_set));
-  PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
+  PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step: a PETSc viewer, ascii:<file>.csv:ascii_csv for a CSV file, empty for stdout", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
   PetscOptionsEnd();
   PetscCheck(o->velocity_rtol >= 0 && o->velocity_rtol < 1, comm, PETSC_ERR_USER_INPUT, "-snes_velocity_rtol must be in [0, 1) (0: off), got %g", (double)o->velocity_rtol);
   PetscCheck(o->watch_energy >= 0 && !PetscIsInfOrNanReal(o->watch_energy), comm, PETSC_ERR_USER_INPUT, "-watchdog_energy_factor must be a finite number >= 0 (0: off), got %g", (double)o->watch_energy);
@@ -565,8 +566,6 @@ static PetscErrorCode TransientOptionsFree(TransientOptions *o)
   PetscFunctionReturn(0);
 }
 
-/* every option of a transient run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
-   the analysis', the solver preset's, and those of TS, SNES, KSP and PC */
 /* Newton's Jacobian reuse within a step (PhlexSystemSNESConverged): read after the solver preset, which sets it */
 static PetscErrorCode JacobianReuseOption(MPI_Comm comm, PetscReal *rate, PetscBool *set)
 {
@@ -579,7 +578,9 @@ static PetscErrorCode JacobianReuseOption(MPI_Comm comm, PetscReal *rate, PetscB
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode TransientRereadOptions(void *ctx)
+/* every option of a transient run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's,
+   the analysis', the solver preset's, and those of TS, SNES, KSP and PC */
+PetscErrorCode PhlexTransientRereadOptions(void *ctx)
 {
   MPI_Comm         comm = *(MPI_Comm *)ctx;
   TransientOptions o;
@@ -636,7 +637,7 @@ static PetscErrorCode TransientProgress(TS ts, MonitorContext *m, PetscInt step,
       PetscCall(PetscFPrintf(m->scene->comm, PETSC_STDERR, "phlex: note: the steps are solved by SNES phlexreduced (Newton on the velocities and discrete unknowns, theta method; a mechanism's consistent start too): its linear solve reads -reduced_ksp_*, -reduced_pc_* and -reduced_bordered_*; -snes_type newtonls takes the preset's field split, which reads -ksp_*, -pc_*, -fieldsplit_*\n"));
     if (m->reduced || m->condensed) PetscCall(PhlexOptionsSetPathRenames(split_solve, stage_solve));
     else PetscCall(PhlexOptionsSetPathRenames(stage_solve, split_solve));
-    PetscCall(PhlexOptionsCheckUnused(m->scene->comm, TransientRereadOptions, &m->scene->comm));
+    PetscCall(PhlexOptionsCheckUnused(m->scene->comm, PhlexTransientRereadOptions, &m->scene->comm));
     PetscCall(PhlexOptionsSetPathRenames(NULL, NULL));
   }
   PetscCall(TSGetMaxTime(ts, &tmax));

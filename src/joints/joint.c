@@ -429,14 +429,14 @@ PetscErrorCode PhlexJointSetFromOptions(PhlexJoint j)
     PetscReal tab[129];
     PetscInt  ntab = 129;
     PetscBool ftab = PETSC_FALSE;
-    PetscCall(PetscOptionsRealArray("-force_table", "Spring-damper: force-elongation table e0,f0,e1,f1,... [m, N] (the tension f(e): the force on the second port is -f along the line; elongation = length - rest length, strictly increasing; piecewise linear, extended linearly beyond its ends), instead of -stiffness", "PhlexJointSetFromOptions", tab, &ntab, &ftab));
+    PetscCall(PhlexOptionsRealList("-force_table", "Spring-damper: force-elongation table e0,f0,e1,f1,... [m, N] (the tension f(e): the force on the second port is -f along the line; elongation = length - rest length, strictly increasing; piecewise linear, extended linearly beyond its ends), instead of -stiffness", "PhlexJointSetFromOptions", tab, &ntab, &ftab, 0));
     if (ftab && ftype) PetscCall(ForceTableCheck(j, tab, ntab, (PhlexJointType)type, fk && j->stiffness != 0));
     fl = (PetscBool)(fl || ftab);
   }
   PetscCall(PetscArrayzero(Kbuf, 37));
   PetscCall(PetscArrayzero(Cbuf, 37));
-  PetscCall(PetscOptionsRealArray("-stiffness_matrix", "Bushing: 6 x 6 stiffness, row-major, rows and columns t1,t2,t3,r1,r2,r3 of the joint frame [N/m, N/rad; N m/m, N m/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Kbuf, &nK, &j->Kgiven));
-  PetscCall(PetscOptionsRealArray("-damping_matrix", "Bushing: 6 x 6 damping, the same layout [N s/m, N s/rad; N m s/m, N m s/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Cbuf, &nC, &j->Cgiven));
+  PetscCall(PhlexOptionsRealList("-stiffness_matrix", "Bushing: 6 x 6 stiffness, row-major, rows and columns t1,t2,t3,r1,r2,r3 of the joint frame [N/m, N/rad; N m/m, N m/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Kbuf, &nK, &j->Kgiven, 0));
+  PetscCall(PhlexOptionsRealList("-damping_matrix", "Bushing: 6 x 6 damping, the same layout [N s/m, N s/rad; N m s/m, N m s/rad] (symmetric positive semi-definite)", "PhlexJointSetFromOptions", Cbuf, &nC, &j->Cgiven, 0));
   PetscOptionsEnd();
   /* a rest angle alone would make a torsion element of nothing */
   PetscCheck(!fra || frk || frc, j->comm, PETSC_ERR_USER_INPUT, "joint %s: -%srest_angle %g is the zero-moment angle of a torsion spring: give -%srotational_stiffness (and/or -%srotational_damping) too", j->name, j->prefix, (double)j->rest_angle, j->prefix, j->prefix);

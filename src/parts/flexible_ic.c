@@ -21,13 +21,24 @@ PetscErrorCode PhlexFlexibleICSetFromOptions(PhlexFlexible b, PhlexIC *ic, const
   PetscCall(PetscSNPrintf(prefix, sizeof(prefix), "%sic_%s_", b->prefix, field));
   PetscCall(PetscSNPrintf(who, sizeof(who), "body %s", b->name));
   PetscOptionsBegin(b->comm, prefix, "Initial condition options", NULL);
-  PetscCall(PetscOptionsEnum("-type", "Initial condition: zero, uniform, rigid (v + w x (x - origin)), beam (Euler-Bernoulli cantilever mode), mode (computed elastic mode)", "PhlexFlexibleICSetFromOptions", PhlexICTypes, (PetscEnum)ic->type, (PetscEnum *)&ic->type, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-value", ncomp == 6 ? "uniform: stress components xx,yy,zz,xy,yz,xz [Pa] (the order of the output fields)" : "uniform/rigid: vector [SI]", "PhlexFlexibleICSetFromOptions", ncomp, ic->value, &given));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-angular", "rigid: angular velocity [rad/s]", "PhlexFlexibleICSetFromOptions", 3, ic->angular, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-origin", "rigid: point of the rotation axis [m]", "PhlexFlexibleICSetFromOptions", 3, ic->origin, NULL));
-  PetscCall(PetscOptionsInt("-mode", "beam/mode: mode number (1 = lowest)", "PhlexFlexibleICSetFromOptions", ic->mode, &ic->mode, NULL));
-  PetscCall(PetscOptionsReal("-amplitude", "beam/mode: largest value of the field [SI]", "PhlexFlexibleICSetFromOptions", ic->amplitude, &ic->amplitude, NULL));
-  PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-direction", "beam: deflection direction", "PhlexFlexibleICSetFromOptions", 3, ic->direction, NULL));
+  if (ncomp == 6) {
+    /* the stress: zero or uniform (a mode's stress follows from the displacement's mode) */
+    const char *const stress_types[] = {"zero", "uniform"};
+    PetscInt          t              = ic->type == PHLEX_IC_UNIFORM ? 1 : 0;
+    PetscBool         set            = PETSC_FALSE;
+    PetscCall(PetscOptionsEList("-type", "Initial stress: zero or uniform (-value); a mode's stress follows from -ic_displacement_type mode", "PhlexFlexibleICSetFromOptions", stress_types, 2, stress_types[t], &t, &set));
+    if (set) ic->type = t ? PHLEX_IC_UNIFORM : PHLEX_IC_ZERO;
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-value", "uniform: stress components xx,yy,zz,xy,yz,xz [Pa] (the order of the output fields)", "PhlexFlexibleICSetFromOptions", ncomp, ic->value, &given));
+  } else {
+    const PetscBool velocity = strcmp(field, "velocity") ? PETSC_FALSE : PETSC_TRUE;
+    PetscCall(PetscOptionsEnum("-type", velocity ? "Initial velocity: zero, uniform (-value), rigid (v + w x (x - origin): -value, -angular, -origin), beam (Euler-Bernoulli cantilever mode: -mode, -amplitude, -direction), mode (computed elastic mode: -mode, -amplitude)" : "Initial displacement: zero, uniform (-value), rigid (u + w x (x - origin), w a small rotation: -value, -angular, -origin), beam (Euler-Bernoulli cantilever mode: -mode, -amplitude, -direction), mode (computed elastic mode: -mode, -amplitude)", "PhlexFlexibleICSetFromOptions", PhlexICTypes, (PetscEnum)ic->type, (PetscEnum *)&ic->type, NULL));
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-value", velocity ? "uniform/rigid: velocity [m/s]" : "uniform/rigid: displacement [m]", "PhlexFlexibleICSetFromOptions", ncomp, ic->value, &given));
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-angular", velocity ? "rigid: angular velocity [rad/s]" : "rigid: small rotation vector [rad]", "PhlexFlexibleICSetFromOptions", 3, ic->angular, NULL));
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-origin", "rigid: point of the rotation axis [m]", "PhlexFlexibleICSetFromOptions", 3, ic->origin, NULL));
+    PetscCall(PetscOptionsInt("-mode", "beam/mode: mode number (1 = lowest)", "PhlexFlexibleICSetFromOptions", ic->mode, &ic->mode, NULL));
+    PetscCall(PetscOptionsReal("-amplitude", velocity ? "beam/mode: largest value of the field [m/s]" : "beam/mode: largest value of the field [m]", "PhlexFlexibleICSetFromOptions", ic->amplitude, &ic->amplitude, NULL));
+    PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, prefix, "-direction", "beam: deflection direction", "PhlexFlexibleICSetFromOptions", 3, ic->direction, NULL));
+  }
   PetscOptionsEnd();
   if (ncomp == 6 && given) {
     /* one order for users, on input and output (ParaView's for symmetric tensors): xx,yy,zz,xy,yz,xz; stored in the

@@ -308,7 +308,7 @@ PetscErrorCode PhlexPoseSetFromOptions(PetscOptionItems *PetscOptionsObject, Phl
   pose->rotation[0] = pose->rotation[4] = pose->rotation[8] = 1.0;
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, p->comm, who, p->prefix, "-position", "Initial position r_P of the frame origin (default: as drawn) [m]", "PhlexPoseSetFromOptions", 3, pose->position, &pose->position_given));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, p->comm, who, p->prefix, "-orientation_quaternion", "Initial orientation R as a quaternion w,x,y,z [-]", "PhlexPoseSetFromOptions", 4, quat, &fq));
-  PetscCall(PetscOptionsRealArray("-orientation_axis_angle", "Initial orientation R as axis x,y,z and angle [deg]", "PhlexPoseSetFromOptions", aa, &n, &fa));
+  PetscCall(PhlexOptionsRealList("-orientation_axis_angle", "Initial orientation R as axis x,y,z and angle [deg]", "PhlexPoseSetFromOptions", aa, &n, &fa, 0));
   PetscCheck(!fa || n == 4, p->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sorientation_axis_angle needs 4 numbers (axis, angle in degrees), got %" PetscInt_FMT, p->name, p->prefix, n);
   PetscCheck(!(fq && fa), p->comm, PETSC_ERR_USER_INPUT, "body %s: give -%sorientation_quaternion or -%sorientation_axis_angle, not both", p->name, p->prefix, p->prefix);
   if (fq) {

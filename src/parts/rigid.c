@@ -34,7 +34,7 @@ static PetscErrorCode RigidSetFromOptions(PhlexPart part)
   PetscCall(PetscMalloc1(nports, &names));
   PetscOptionsBegin(part->comm, part->prefix, "Rigid body options", NULL);
   PetscCall(PetscOptionsReal("-mass", "Mass [kg]", "RigidSetFromOptions", r->mass, &r->mass, &fm));
-  PetscCall(PetscOptionsRealArray("-inertia", "Inertia tensor about the centre of mass, body axes: Ixx,Iyy,Izz or Ixx,Iyy,Izz,Iyz,Ixz,Ixy [kg m^2]", "RigidSetFromOptions", J, &n, &fJ));
+  PetscCall(PhlexOptionsRealList("-inertia", "Inertia tensor about the centre of mass, body axes: Ixx,Iyy,Izz or Ixx,Iyy,Izz,Iyz,Ixz,Ixy [kg m^2]", "RigidSetFromOptions", J, &n, &fJ, 0));
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, part->comm, who, part->prefix, "-center_of_mass", "Centre of mass in the drawing coordinates of the body's points [m]", "RigidSetFromOptions", 3, r->com, NULL));
   PetscCall(PetscOptionsStringArray("-ports", "Ports: named points of the body (-port_<name>_position, loads -port_<name>_force ...)", "RigidSetFromOptions", names, &nports, &flg));
   if (!flg) nports = 0;

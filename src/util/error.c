@@ -238,6 +238,52 @@ PetscErrorCode PhlexErrorHandlerPop(void)
   PetscFunctionReturn(0);
 }
 
+/* numbers joined by commas as PETSc prints them ("0.,-9.81,0."); "none" for no number */
+static PetscErrorCode JoinReals(const PetscReal v[], PetscInt n, char out[], size_t len)
+{
+  size_t o = 0;
+
+  PetscFunctionBeginUser;
+  out[0] = 0;
+  if (!n) PetscCall(PetscStrncpy(out, "none", len));
+  for (PetscInt i = 0; i < n && o + 1 < len; i++) {
+    PetscCall(PetscSNPrintf(out + o, len - o, "%s%g", i ? "," : "", (double)v[i]));
+    PetscCall(PetscStrlen(out, &o));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexOptionsRealList_Private - PetscOptionsRealArray with the whole value and default in -help (PETSc 3.18 prints
+  only the first number of a list not given: -gravity <0.>): "<now v1,v2,v3 : formerly d1,d2,d3>", which the help
+  filter shows as "<v1,v2,v3; default d1,d2,d3>"; ndefault: how many of value[] are the default (0: none). Use the
+  macro PhlexOptionsRealList inside PetscOptionsBegin/End.
+@*/
+PetscErrorCode PhlexOptionsRealList_Private(PetscOptionItems *PetscOptionsObject, const char opt[], const char text[], const char man[], PetscReal value[], PetscInt *n, PetscBool *set, PetscInt ndefault)
+{
+  const PetscBool help = (PetscOptionsObject->printhelp && PetscOptionsObject->count == 1 && !PetscOptionsObject->alreadyprinted) ? PETSC_TRUE : PETSC_FALSE;
+  const PetscBool printhelp = PetscOptionsObject->printhelp;
+  PetscReal       def[16];
+  const PetscInt  nd = PetscMin(PetscMin(ndefault, *n), 16);
+  PetscBool       flg = PETSC_FALSE;
+  PetscErrorCode  ierr;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < nd; i++) def[i] = value[i];
+  PetscOptionsObject->printhelp = PETSC_FALSE; /* PETSc's line is replaced by the one below */
+  ierr                          = PetscOptionsRealArray(opt, text, man, value, n, &flg);
+  PetscOptionsObject->printhelp = printhelp;
+  PetscCall(ierr);
+  if (help) {
+    char now[1024], was[1024];
+    PetscCall(JoinReals(flg ? value : def, flg ? *n : nd, now, sizeof(now)));
+    PetscCall(JoinReals(def, nd, was, sizeof(was)));
+    PetscCall((*PetscHelpPrintf)(PetscOptionsObject->comm, "  -%s%s <now %s : formerly %s>: %s (%s)\n", PetscOptionsObject->prefix ? PetscOptionsObject->prefix : "", opt + 1, now, was, text, man));
+  }
+  if (set) *set = flg;
+  PetscFunctionReturn(0);
+}
+
 /* A real-array option that must have exactly n numbers when given (inside PetscOptionsBegin/End, whose
    PetscOptionsObject is passed on). A wrong count is an input error naming what it belongs to and the option. */
 PetscErrorCode PhlexOptionsRealN(PetscOptionItems *PetscOptionsObject, MPI_Comm comm, const char what[], const char prefix[], const char opt[], const char text[], const char man[], PetscInt n, PetscReal value[], PetscBool *set)
@@ -250,7 +296,7 @@ PetscErrorCode PhlexOptionsRealN(PetscOptionItems *PetscOptionsObject, MPI_Comm 
   PetscCheck(n <= 16, comm, PETSC_ERR_PLIB, "PhlexOptionsRealN: at most 16 components");
   PetscCall(PetscArraycpy(buf, value, n));
   buf[n] = 0;
-  PetscCall(PetscOptionsRealArray(opt, text, man, buf, &got, &flg));
+  PetscCall(PhlexOptionsRealList(opt, text, man, buf, &got, &flg, n));
   PetscCheck(!flg || got == n, comm, PETSC_ERR_USER_INPUT, "%s: option -%s%s needs %" PetscInt_FMT " components, got %s%" PetscInt_FMT, what, prefix, opt + 1, n, got > n ? "more than " : "", got > n ? n : got);
   for (PetscInt i = 0; flg && i < n; i++) {
     char v[32];

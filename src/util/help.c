@@ -20,6 +20,9 @@ static size_t        npending, maxpending;
 static char        **lines; /* help: the option lines printed so far (a repeated one is skipped); capture: names */
 static char          boundary_head[512]; /* a -dm_plex_boundary_label line whose garbage value held a newline: its start, up to '<' */
 static int           boundary_dropped;   /* the lines of its garbage dropped so far */
+static PetscBool     separator_held;     /* a "-----" line, printed unless the title after it is a viewer's */
+static char          viewer_name[256];   /* a viewer option (PETSc's lines of its viewer types): one line for it, */
+static char          viewer_line[512];   /* printed unless the option's own line follows */
 static PetscInt      nlines, maxlines;
 static PetscErrorCode (*vfprintf_default)(FILE *, const char[], va_list);
 
@@ -173,6 +176,42 @@ static PetscErrorCode EmitLine(const char *line)
       PetscFunctionReturn(0);
     }
   }
+  if (!capturing) {
+    /* a viewer option (PetscOptionsViewer, PETSc's monitors) comes with PETSc's lines of every viewer type under a
+       title of its own ("Viewer (-ts_monitor) options:", "  -ts_monitor ascii[:[filename]...]: ...", binary, draw,
+       socket, saws): one line instead, in the block it belongs to, and none when the option has a line of its own */
+    static const char *const types[] = {" ascii[", " binary[", " draw[", " socket[", " saws[", " hdf5[", " vtk[", " glvis[", " matlab[", NULL};
+    const char              *name = line + strspn(line, " "), *end;
+    size_t                   nname;
+    PetscBool                viewer_type = PETSC_FALSE;
+    nname = name[0] == '-' ? strcspn(name, " <:\n") : 0;
+    end   = name + nname;
+    for (PetscInt t = 0; nname && types[t] && !viewer_type; t++)
+      if (!strncmp(end, types[t], strlen(types[t]))) viewer_type = PETSC_TRUE;
+    if (viewer_type) {
+      if (!viewer_name[0]) {
+        PetscCall(PetscSNPrintf(viewer_name, sizeof(viewer_name), "%.*s", (int)nname, name));
+        PetscCall(PetscSNPrintf(viewer_line, sizeof(viewer_line), "  %s <viewer>: a PETSc viewer: ascii[:file[:format[:append]]] (stdout without a file), binary[:file], draw, socket, saws\n", viewer_name));
+      }
+      PetscFunctionReturn(0);
+    }
+    if (viewer_name[0]) {
+      const PetscBool own = (nname == strlen(viewer_name) && !strncmp(name, viewer_name, nname)) ? PETSC_TRUE : PETSC_FALSE;
+      char            held[512];
+      PetscCall(PetscStrncpy(held, viewer_line, sizeof(held)));
+      viewer_name[0] = 0;
+      if (!own) PetscCall(EmitLine(held));
+    }
+    if (!strcmp(line, "----------------------------------------\n") && !separator_held) {
+      separator_held = PETSC_TRUE;
+      PetscFunctionReturn(0);
+    }
+    if (separator_held) {
+      separator_held = PETSC_FALSE;
+      if (!strncmp(line, "Viewer (-", 9) && strstr(line, ") options:")) PetscFunctionReturn(0);
+      PetscCall(WriteOut("----------------------------------------\n"));
+    }
+  }
   while (*c == ' ') c++;
   option = (c > line && c[0] == '-' && isalpha((unsigned char)c[1])) ? PETSC_TRUE : PETSC_FALSE;
   if (capturing) {
@@ -254,6 +293,18 @@ static PetscErrorCode FilterPop(void)
     PetscCall(EmitLine(pending));
   }
   npending = 0;
+  if (!capturing && viewer_name[0]) {
+    char held[512];
+    PetscCall(PetscStrncpy(held, viewer_line, sizeof(held)));
+    viewer_name[0] = 0;
+    PetscCall(EmitLine(held));
+  }
+  if (!capturing && separator_held) {
+    separator_held = PETSC_FALSE;
+    PetscCall(WriteOut("----------------------------------------\n"));
+  }
+  separator_held = PETSC_FALSE;
+  viewer_name[0] = 0;
   PetscVFPrintf = vfprintf_default;
   for (PetscInt i = 0; i < nlines; i++) PetscCall(PetscFree(lines[i]));
   PetscCall(PetscFree(lines));
@@ -321,13 +372,29 @@ PetscErrorCode PhlexHelpActivate(MPI_Comm comm)
   PhlexHelpEnd - prints the closing lines of the help and restores stdout
 
   Collective
+
+  Input Parameters:
++ comm      - the communicator
+. catalogue - no scene was given: the options of one body of each type and of every analysis were listed
+- analysis  - the scene's analysis (its options alone were listed)
 @*/
-PetscErrorCode PhlexHelpEnd(MPI_Comm comm, PetscBool catalogue)
+PetscErrorCode PhlexHelpEnd(MPI_Comm comm, PetscBool catalogue, const char analysis[])
 {
   PetscFunctionBeginUser;
   if (help_mode == PHLEX_HELP_NONE) PetscFunctionReturn(0);
   PetscCall(PetscPrintf(comm, "----------------------------------------\n"));
-  if (catalogue) PetscCall(PetscPrintf(comm, "No scene was given: the options above are those of one body of each type (flexible, rigid, lumped)\nand one driven joint, with example values where an option has no default (materials, masses, ports,\njoint); with -options_file <scene>.yaml they are the scene's, with its values.\n"));
+  if (catalogue) PetscCall(PetscPrintf(comm, "No scene was given: the options above are those of one body of each type (flexible, rigid, lumped)\nand one driven joint, with example values where an option has no default (materials, masses, ports,\njoint), and those of every analysis; with -options_file <scene>.yaml they are the scene's, with its values.\n"));
+  else {
+    const char *const all[] = {"transient", "modes", "linearized"};
+    char              others[64] = "";
+    for (int i = 0; i < 3; i++) {
+      size_t n;
+      if (!strcmp(all[i], analysis)) continue;
+      PetscCall(PetscStrlen(others, &n));
+      PetscCall(PetscSNPrintf(others + n, sizeof(others) - n, "%s%s", n ? "|" : "", all[i]));
+    }
+    PetscCall(PetscPrintf(comm, "The analysis options above are those of this scene's analysis (-analysis %s); add -analysis %s for\nanother's.\n", analysis, others));
+  }
   if (help_mode == PHLEX_HELP_OPTIONS) PetscCall(PetscPrintf(comm, "Solver options (-ts_*, -snes_*, -ksp_*, -pc_*, -modes_eps_*, -modes_st_*, -linearized_eps_*, -linearized_st_*): add\n\"-help solvers\" to list those this scene reads (the scene is then set up, no step is taken); the presets are in options/solver/.\n"));
   PetscCall(PetscPrintf(comm, "Nothing was run (help only).\n"));
   PetscCall(FilterPop());

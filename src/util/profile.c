@@ -322,7 +322,7 @@ PetscErrorCode PhlexProfileSetFromOptions(PhlexProfile p)
   PetscCall(PetscOptionsReal("-profile_frequency", "Sine profile: frequency [Hz]", "PhlexProfileSetFromOptions", p->frequency, &p->frequency, &flg[2]));
   PetscCall(PetscOptionsReal("-profile_phase", "Sine profile: phase [rad]", "PhlexProfileSetFromOptions", p->phase, &p->phase, &flg[3]));
   PetscCall(PetscOptionsReal("-profile_scale", "Factor applied to the profile [-]", "PhlexProfileSetFromOptions", p->scale, &p->scale, &flg[4]));
-  PetscCall(PetscOptionsRealArray("-profile_table", "Table profile: points t0,f0,t1,f1,... (t in s)", "PhlexProfileSetFromOptions", table, &ntable, &flg_table));
+  PetscCall(PhlexOptionsRealList("-profile_table", "Table profile: points t0,f0,t1,f1,... (t in s)", "PhlexProfileSetFromOptions", table, &ntable, &flg_table, 0));
   PetscCall(PetscOptionsString("-profile_file", "Table profile: a CSV file, the time [s] in its first column, f in another (-profile_column); a header line may name the columns", "PhlexProfileSetFromOptions", file, file, sizeof(file), &flg_file));
   PetscCall(PetscOptionsString("-profile_column", "Table profile from a file: the column f follows, by its header name or its number (1 is the time; default: the second of two columns)", "PhlexProfileSetFromOptions", column, column, sizeof(column), &flg_column));
   PetscCall(PetscOptionsEList("-profile_extrapolate", "Table profile outside its times: hold its end values, zero, or error (a run reaching outside the series is refused before its first step); default: error for a file, hold for -profile_table", "PhlexProfileSetFromOptions", PhlexExtrapolations, 3, PhlexExtrapolations[flg_file ? PHLEX_EXTRAPOLATE_ERROR : PHLEX_EXTRAPOLATE_HOLD], &extrapolate, &flg_extrapolate));
