@@ -117,6 +117,15 @@ int main(int argc, char **argv)
     (void)PetscOptionsSetValue(NULL, "-options_left", "0");
     code = PhlexExitCode();
     MPI_Comm_size(PETSC_COMM_WORLD, &size);
+    if (size > 1 && code == PHLEX_EXIT_NUMERICAL) {
+      /* a numerical failure is every rank's: let rank 0 finish moving the series to failed/ before the abort (a
+         non-blocking barrier, given up after 10 s in case some rank is elsewhere) */
+      MPI_Request req;
+      int         done = 0;
+      double      t0   = MPI_Wtime();
+      if (MPI_Ibarrier(PETSC_COMM_WORLD, &req) == MPI_SUCCESS)
+        while (!done && MPI_Wtime() - t0 < 10.0) (void)MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+    }
     /* an error on some ranks only would leave the others waiting: every rank ends with the same code */
     if (size > 1) MPI_Abort(PETSC_COMM_WORLD, code);
     (void)PhlexSceneDestroy(&scene);

@@ -131,7 +131,8 @@ struct _p_PhlexJoint {
   PetscReal     rest_t0;
   PetscBool     drive_step;             /* a midpoint step from drive_t0 is under way: a drive's (or a prescribed
                                            motion's) rate at its stage makes the step's increment the prescribed one */
-  PetscReal     drive_t0;
+  PetscReal     drive_t0, drive_dt;
+  PetscBool     drive_start;            /* the consistent start: the first step's stage rate (drive_dt), whatever t */
   PetscReal     eshift;                 /* evaluated: the rest's change from the nominal (non-dimensional) */
   PetscReal     actuator_work;          /* the work the moving rest did on the element so far (non-dimensional) */
 
@@ -169,7 +170,7 @@ PETSC_INTERN PetscBool      PhlexJointDamped(PhlexJoint);
 PETSC_INTERN PetscErrorCode PhlexJointElementInitial(PhlexJoint, const PhlexPartVec *, const PhlexPartVec *, PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexJointElementEnergy(PhlexJoint, PetscReal, const PetscReal *, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointElementStepStart(PhlexJoint, PetscReal, const PetscReal *, PetscBool, PetscBool);
-PETSC_INTERN PetscErrorCode PhlexJointDriveStepStart(PhlexJoint, PetscReal, PetscBool);
+PETSC_INTERN PetscErrorCode PhlexJointDriveStepStart(PhlexJoint, PetscReal, PetscReal, PetscBool, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexJointActuatorPower(PhlexJoint, PetscReal, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexJointPortWrench(PhlexJoint, const PetscReal *, PhlexPart, PetscInt, PetscReal[6]);
 PETSC_INTERN PetscErrorCode PhlexJointPower(PhlexJoint, const PetscReal *, PetscReal *);

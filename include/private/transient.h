@@ -38,6 +38,7 @@ typedef struct {
   PetscReal   watch_balance, watch_gap, watch_orth;
   PetscReal   watch_energy;    /* stop when the energy created (H - H0 - W + D) exceeds this times max(E0, the work) */
   PetscReal   E0abs;           /* |kinetic| + |strain| + |potential| at the start: the energy's scale (H0 may cancel to 0) */
+  PetscReal   V0, max_dV;      /* the potential at the start, the largest it exchanged since (a pendulum released at rest) */
   PetscReal   watch_deform;    /* stop when a body's elastic displacement exceeds this times its size */
   PetscBool   lossless_scheme; /* the implicit midpoint rule: the balance holds to solver tolerance */
   PhlexProgress progress;

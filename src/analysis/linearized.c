@@ -1486,11 +1486,11 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
       PetscCall(PetscViewerASCIIPrintf(csv, "%" PetscInt_FMT ",%.12g,%" PetscInt_FMT ",%s,%.12e,%.12e,%.3e,%.12e,%.12e,%.12e,%.12e\n", c, (double)pos, i + 1, kind, (double)f, (double)omega, (double)s.resid[i], (double)grow, (double)zeta, (double)fd, (double)decay));
       if (!mech && i - s.nmech < o.nev) PetscCall(PetscViewerASCIIPrintf(sweep, ",%.12e", (double)omega));
       if (!mech) worst = PetscMax(worst, s.resid[i]);
-      if (c == 0 && o.nexp && !mech) {
+      if (c == 0 && o.nexp && !mech && !over) { /* the oscillating modes (an overdamped motion has no frequency) */
         if (!fexp) PetscCall(PetscMalloc1(s.n, &fexp));
         fexp[nfexp++] = f;
       }
-      if (c == 0 && o.nzexp && !mech) {
+      if (c == 0 && o.nzexp && !mech && !over) {
         if (!zexp) PetscCall(PetscMalloc1(s.n, &zexp));
         zexp[nzexp++] = zeta;
       }

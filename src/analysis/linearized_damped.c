@@ -27,10 +27,10 @@ static PetscErrorCode ElementAlgebra(Pencil *p, const PetscReal *DE, const Petsc
   PhlexSystem    sys = p->sys;
   const PetscInt nq = sys->nq, nel = p->nel, nqv = p->nqv;
   PetscReal     *Ef, *Ee, *X, emax = 0, worst = 0;
-  PetscBLASInt   n, nrhs, info, *piv;
+  PetscBLASInt   n, nrhs, info, *piv, *piv2;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc4(nel * nel, &Ef, nel * nel, &Ee, nel * nel, &X, nel, &piv));
+  PetscCall(PetscMalloc5(nel * nel, &Ef, nel * nel, &Ee, nel * nel, &X, nel, &piv, nel, &piv2));
   /* column-major copies for LAPACK: Ef = E_FF, Ee = E_EE; X = A_FE */
   for (PetscInt a = 0; a < nel; a++)
     for (PetscInt b = 0; b < nel; b++) {
@@ -64,7 +64,7 @@ static PetscErrorCode ElementAlgebra(Pencil *p, const PetscReal *DE, const Petsc
     PetscCall(PetscMalloc2(nel * nel, &Et, nel * nel, &Xt));
     for (PetscInt a = 0; a < nel; a++)
       for (PetscInt b = 0; b < nel; b++) Et[b * nel + a] = Ee[a * nel + b], Xt[b * nel + a] = X[a * nel + b];
-    PetscCallBLAS("LAPACKgesv", LAPACKgesv_(&n, &nrhs, Et, &n, piv, Xt, &n, &info));
+    PetscCallBLAS("LAPACKgesv", LAPACKgesv_(&n, &nrhs, Et, &n, piv2, Xt, &n, &info)); /* piv keeps E_FF's pivots for getrs below */
     PetscCheck(!info, sys->comm, PETSC_ERR_PLIB, "linearized analysis: the force elements' state block is singular (LAPACK gesv info %d)", (int)info);
     /* Xt (column-major) = M1^T: M1[a][b] = Xt[a * nel + b] */
     for (PetscInt a = 0; a < nel; a++)
@@ -89,7 +89,7 @@ static PetscErrorCode ElementAlgebra(Pencil *p, const PetscReal *DE, const Petsc
     }
   for (PetscInt ii = 0; ii < nqv; ii++)
     for (PetscInt a = 0; a < nel; a++) BVF[ii * nel + a] = DE[p->Qq[ii] * nq + p->elF[a]];
-  PetscCall(PetscFree4(Ef, Ee, X, piv));
+  PetscCall(PetscFree5(Ef, Ee, X, piv, piv2));
   PetscFunctionReturn(0);
 }
 
@@ -203,11 +203,33 @@ PetscErrorCode PhlexLinearizedElementOperators(Pencil *p, const PetscReal *DE, c
   }
   {
     /* local rows: the field's, then rank 0's Q */
-    Mat Op[2];
-    for (PetscInt m = 0; m < 2; m++) {
-      PetscCall(MatCreateAIJ(sys->comm, nvl + Ql, nvl + Ql, PETSC_DETERMINE, PETSC_DETERMINE, nrecv + nqv, NULL, nrecv + nqv, NULL, &Op[m]));
-      PetscCall(MatSetOption(Op[m], MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+    Mat       Op[2];
+    PetscInt *nnz, nlocal = nvl + Ql, ncols = 0;
+    /* room only in the rows the elements' forces reach (B_VF non-zero): the gathered field columns and Q's velocities */
+    PetscCall(MPIU_Allreduce(&nlocal, &ncols, 1, MPIU_INT, MPI_SUM, sys->comm));
+    PetscCall(PetscCalloc1(PetscMax(nlocal, 1), &nnz));
+    for (PetscInt r = 0; r < nvl; r++)
+      for (PetscInt a = 0; a < nel; a++)
+        if (be[p->elF[a] * ld + r] != 0.0) nnz[r] = PetscMin(nrecv + nqv, ncols);
+    for (PetscInt ii = 0; ii < Ql && ii < nqv; ii++)
+      for (PetscInt a = 0; a < nel; a++)
+        if (BVd[ii * nel + a] != 0.0) nnz[nvl + ii] = PetscMin(nrecv + nqv, ncols);
+    {
+      /* split between the diagonal block (local columns) and the rest, each at most its width */
+      PetscInt *dnz, *onz;
+      PetscCall(PetscMalloc2(PetscMax(nlocal, 1), &dnz, PetscMax(nlocal, 1), &onz));
+      for (PetscInt r = 0; r < nlocal; r++) dnz[r] = PetscMin(nnz[r], nlocal), onz[r] = PetscMin(nnz[r], ncols - nlocal);
+      for (PetscInt m = 0; m < 2; m++) {
+        PetscCall(MatCreate(sys->comm, &Op[m]));
+        PetscCall(MatSetSizes(Op[m], nlocal, nlocal, PETSC_DETERMINE, PETSC_DETERMINE));
+        PetscCall(MatSetType(Op[m], MATAIJ));
+        PetscCall(MatSeqAIJSetPreallocation(Op[m], 0, dnz));
+        PetscCall(MatMPIAIJSetPreallocation(Op[m], 0, dnz, 0, onz));
+        PetscCall(MatSetOption(Op[m], MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+      }
+      PetscCall(PetscFree2(dnz, onz));
     }
+    PetscCall(PetscFree(nnz));
     /* a field row: only those the elements' forces reach (B_VF non-zero) */
     for (PetscInt r = 0; r < nvl; r++) {
       const PetscScalar *b = be;

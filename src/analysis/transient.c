@@ -239,7 +239,7 @@ static PetscErrorCode PreStep(TS ts)
       for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointElementStepStart(m->sys->joints[k], t0, m->sys->q, m->lossless_scheme, m->midpoint));
     }
     /* drives and prescribed motions: the step's start (a midpoint step's increment is the prescribed one) */
-    for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointDriveStepStart(m->sys->joints[k], t0, m->midpoint));
+    for (PetscInt k = 0; k < m->sys->njoints; k++) PetscCall(PhlexJointDriveStepStart(m->sys->joints[k], t0, dt, m->midpoint, PETSC_FALSE));
   }
   PetscFunctionReturn(0);
 }
@@ -347,6 +347,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
   if (step == 0) {
     m->H0 = m->Hprev = m->Hmax = H;
     m->E0abs = PetscAbsReal(kin) + PetscAbsReal(strain) + PetscAbsReal(pot);
+    m->V0    = pot;
   } else {
     m->work_total += dt * power;
     m->dissipated_total += dt * dissipated;
@@ -355,6 +356,7 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     m->max_work     = PetscMax(m->max_work, PetscMax(PetscAbsReal(m->work_total), m->dissipated_total));
     m->max_drift    = PetscMax(m->max_drift, PetscAbsReal(H - m->H0));
     m->Hmax         = PetscMax(m->Hmax, H);
+    m->max_dV       = PetscMax(m->max_dV, PetscAbsReal(pot - m->V0));
     m->Hprev        = H;
   }
   PetscCall(PhlexCSVPrintf(m->energy_csv, "%" PetscInt_FMT ",%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e,%.12e\n", step, (double)t, (double)(kin * u->energy), (double)(strain * u->energy), (double)(pot * u->energy), (double)(H * u->energy), (double)(power * u->power), (double)(m->work_total * u->energy), (double)(residual * u->energy), (double)(dissipated * u->power), (double)(m->dissipated_total * u->energy)));
@@ -399,7 +401,7 @@ static PetscErrorCode WatchDeformation(MonitorContext *m, PetscInt step, PetscRe
     PetscCall(PhlexSystemPartVecRestore(sys, part, X, &pv));
     if (umax > m->watch_deform * size || PetscIsInfOrNanReal(umax)) {
       char advice[256], f[32];
-      if (stiffen) PetscCall(PetscSNPrintf(advice, sizeof(advice), "its elastic model is linear: a fast rotation (a spin, a driven hub) softens it and past its first bending frequency it diverges; add -%sgeometric_stiffening (the centrifugal stiffening), or reduce the load or -ts_dt", part->prefix));
+      if (stiffen) PetscCall(PetscSNPrintf(advice, sizeof(advice), "its elastic model is linear: if it spins or is driven fast, the rotation softens it and past its first bending frequency it diverges (add -%sgeometric_stiffening, the centrifugal stiffening); else reduce the loads or -ts_dt, or check the material's units", part->prefix));
       else PetscCall(PetscSNPrintf(advice, sizeof(advice), "reduce the loads or -ts_dt, or check the material's units"));
       SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): body %s's elastic displacement reached %.4e m, more than -watchdog_deformation %s times its size %.4g m: the run blew up; %s (-watchdog_deformation 0 turns this check off); no result was written", step, (double)t, part->name, (double)umax, PhlexFormatReal(m->watch_deform, f, sizeof(f)), (double)size, advice);
     }
@@ -438,18 +440,20 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
        stays at solver tolerance (a spinning body's indefinite energy can also fall without bound: the deformation
        watchdog catches that) */
     const PetscReal created = H - m->H0 - m->work_total + m->dissipated_total - m->project_dH;
-    /* (a floor of 1e-12 of the scene's energy unit: a scene at rest starts with round-off for its energy) */
-    const PetscReal scale   = PetscMax(PetscMax(m->E0abs, m->max_work), 1e-12);
+    /* the energy's scale: the initial energies' magnitudes, the work, the potential energy exchanged so far (a
+       mechanism released at rest under gravity starts at 0), a floor of 1e-12 of the scene's energy unit (round-off) */
+    const PetscReal scale   = PetscMax(PetscMax(PetscMax(m->E0abs, m->max_work), m->max_dV), 1e-12);
     if (created > m->watch_energy * scale) {
       char advice[256], f[32];
       if (m->theta && m->theta_value < 0.5) PetscCall(PetscSNPrintf(advice, sizeof(advice), "-ts_theta_theta %g < 0.5 amplifies every mode the step does not resolve: use 0.5 (the implicit midpoint rule) or more", (double)m->theta_value));
+      else if (m->midpoint) PetscCall(PetscSNPrintf(advice, sizeof(advice), "the implicit midpoint rule keeps the balance to solver tolerance where the energy is quadratic: tighten Newton's and the linear solver's tolerances, or reduce -ts_dt (a floating body with full inertia: O(dt^2))"));
       else PetscCall(PetscSNPrintf(advice, sizeof(advice), "reduce -ts_dt, use the implicit midpoint rule, or tighten the solver's tolerances"));
       for (PetscInt i = 0; i < m->sys->nparts; i++)
         if (m->sys->parts[i]->material_warned) {
           PetscCall(PetscSNPrintf(advice, sizeof(advice), "first check body %s's material, warned about at the start (its units, or near incompressibility)", m->sys->parts[i]->name));
           break;
         }
-      SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the energy is %.4e J, %.3e J more than the initial energy %.4e J plus the work supplied %.4e J less the work dissipated %.4e J, more than -watchdog_energy_factor %s times the energy's scale %.3e J (the larger of the initial energies' magnitudes summed and the work): the run blew up; %s (-watchdog_energy_factor 0 turns this check off); no result was written",
+      SETERRQ(m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): the energy is %.4e J, %.3e J more than the initial energy %.4e J plus the work supplied %.4e J less the work dissipated %.4e J, more than -watchdog_energy_factor %s times the energy's scale %.3e J (the largest of the initial energies' magnitudes summed, the work and the potential energy exchanged): the run blew up; %s (-watchdog_energy_factor 0 turns this check off); no result was written",
               step, (double)t, (double)(H * u->energy), (double)(created * u->energy), (double)(m->H0 * u->energy), (double)(m->work_total * u->energy), (double)(m->dissipated_total * u->energy), PhlexFormatReal(m->watch_energy, f, sizeof(f)), (double)(scale * u->energy), advice);
     }
   }
@@ -464,7 +468,7 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
     PetscCheck(m->max_gap <= bound, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): a joint is open by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m)): the constraints drift (a dissipative scheme with large steps?); use the implicit midpoint rule, smaller steps or -joints_project_interval (-watchdog_joint_drift 0 turns this check off); no result was written",
                step, (double)t, (double)m->max_gap, (double)bound, (double)m->watch_gap);
     PetscCheck(m->max_drive <= bound, m->scene->comm, PETSC_ERR_NOT_CONVERGED, "watchdog at step %" PetscInt_FMT " (t = %g s): a drive or prescribed motion is off its profile by %.3e (m or rad), more than %.3e (-watchdog_joint_drift %g x min(L, 1 m)); the joints' other rows are closed to %.3e: %s (-watchdog_joint_drift 0 turns this check off); no result was written",
-               step, (double)t, (double)m->max_drive, (double)bound, (double)m->watch_gap, (double)m->max_gap, m->midpoint ? "the implicit midpoint rule follows a drive's profile to round-off, so Newton or the linear solver failed silently; tighten their tolerances" : "this scheme follows a drive only to its error (a rotation's: the midpoint rule's Cayley factor is exact only with the increments it is given); use the implicit midpoint rule (the default) or smaller steps");
+               step, (double)t, (double)m->max_drive, (double)bound, (double)m->watch_gap, (double)m->max_gap, m->midpoint ? "the implicit midpoint rule follows a drive from the ground to round-off, a drive between two rotating bodies to its error of composing their rotations (O(dt^2) per unit of both angles); use smaller steps or -joints_project_interval, or check Newton's and the linear solver's tolerances" : "this scheme follows a drive only to its error (the midpoint rule follows one from the ground exactly); use the implicit midpoint rule (the default) or smaller steps");
   }
   PetscFunctionReturn(0);
 }
@@ -544,7 +548,7 @@ static PetscErrorCode TransientSetFromOptions(MPI_Comm comm, TransientOptions *o
   PetscCall(PetscOptionsReal("-watchdog_balance_rtol", "Watchdog (implicit midpoint rule): stop when a step's power-balance residual exceeds this share of the energy (0: off)", "PhlexSceneSolveTransient", o->watch_balance, &o->watch_balance, NULL));
   PetscCall(PetscOptionsReal("-watchdog_orthogonality", "Watchdog (BDF, alpha: rotations not re-orthonormalised): stop when ||R^T R - I||_F of a frame exceeds this (0: off; a warning past 1e-2)", "PhlexSceneSolveTransient", o->watch_orth, &o->watch_orth, NULL));
   PetscCall(PetscOptionsReal("-watchdog_joint_drift", "Watchdog: stop when a joint opens by more than this times min(L, 1 m) [m or rad] (0: off)", "PhlexSceneSolveTransient", o->watch_gap, &o->watch_gap, NULL));
-  PetscCall(PetscOptionsReal("-watchdog_energy_factor", "Watchdog: stop when the energy created, H - H0 - supplied + dissipated, exceeds this times the energy's scale: the larger of |kinetic| + |strain| + |potential| at the start and the work (0: off)", "PhlexSceneSolveTransient", o->watch_energy, &o->watch_energy, NULL));
+  PetscCall(PetscOptionsReal("-watchdog_energy_factor", "Watchdog: stop when the energy created, H - H0 - supplied + dissipated, exceeds this times the energy's scale: the largest of |kinetic| + |strain| + |potential| at the start, the work and the potential energy exchanged (0: off)", "PhlexSceneSolveTransient", o->watch_energy, &o->watch_energy, NULL));
   PetscCall(PetscOptionsReal("-watchdog_deformation", "Watchdog: stop when a flexible body's elastic displacement exceeds this times its size (0: off)", "PhlexSceneSolveTransient", o->watch_deform, &o->watch_deform, NULL));
   PetscCall(PetscOptionsReal("-snes_velocity_rtol", "Newton on the whole state (SNES newtonls: BDF, Crank-Nicolson, generalized-alpha) of a scene with discrete unknowns converges when also the velocity rows' residual is below this share of its value at the stage's initial guess (0: off; not given: 1e-10 in a scene with joints, off without)", "PhlexSystemSNESConvergedStage", o->velocity_rtol, &o->velocity_rtol, &o->velocity_rtol_set));
   PetscCall(PetscOptionsViewer("-ts_monitor_energy", "Print energy, input power and balance residual every step: a PETSc viewer, ascii:<file>.csv:ascii_csv for a CSV file, empty for stdout", "PhlexSceneSolveTransient", &o->monitor, NULL, &flg));
@@ -1055,6 +1059,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
      continues a consistent state) */
   if (sys->njoints && !restarting) PetscCall(PhlexAssemblyClose(sys, 0.0, X, PETSC_TRUE, NULL));
   if (sys->njoints && !restarting) PetscCall(PhlexSystemInitElements(sys, X)); /* the force elements' states from the closed configuration */
+  /* drives: the consistent start takes the first step's stage rate (Source) */
+  for (PetscInt k = 0; k < sys->njoints && !restarting; k++) PetscCall(PhlexJointDriveStepStart(sys->joints[k], 0.0, dt, m.midpoint, PETSC_TRUE));
   if (sys->nq && !restarting) PetscCall(PhlexAssemblyConsistentStart(sys, ts, 0.0, dt, X, m.lambda));
   /* the stages need neither the whole state's stress blocks nor the assembled G and Ms (the initial state did) */
   if (m.reduced || m.condensed) PetscCall(PhlexSystemReleaseJacobian(sys));
@@ -1221,7 +1227,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PhlexExpectMax(scene->comm, "rotation orthogonality (max ||R^T R - I||_F)", "-expect_orthogonality_max", m.max_orth, o.orth_max, PETSC_TRUE));
     PetscCall(PhlexExpectMax(scene->comm, "per-step orthogonality defect of the integrator (max ||R^T R - I||_F after a step)", "-expect_orthogonality_max", m.max_defect, o.orth_max, PETSC_TRUE));
   }
-  if (o.gap_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "joint drift (max position-level violation, m or rad)", "-expect_joint_drift_max", m.max_gap, o.gap_max, PETSC_TRUE));
+  if (o.gap_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "joint drift (max position-level violation, m or rad)", "-expect_joint_drift_max", PetscMax(m.max_gap, m.max_drive), o.gap_max, PETSC_TRUE));
 
   PetscCall(PetscViewerDestroy(&m.monitor));
   PetscCall(TransientOptionsFree(&o));

@@ -18,7 +18,7 @@
 #include <private/transient.h>
 #include <petscviewerhdf5.h>
 
-#define CHECKPOINT_NMONITOR 29 /* the accumulators of PackMonitor */
+#define CHECKPOINT_NMONITOR 31 /* the accumulators of PackMonitor */
 
 /* the energy monitor's accumulators, in a fixed order; returns how many */
 static PetscInt PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMONITOR])
@@ -31,7 +31,7 @@ static PetscInt PackMonitor(const MonitorContext *m, PetscReal a[CHECKPOINT_NMON
   a[k++] = m->Pscale, a[k++] = m->Lscale, a[k++] = m->max_dP, a[k++] = m->max_dL, a[k++] = m->max_orth;
   a[k++] = m->max_defect, a[k++] = m->max_gap, a[k++] = m->project_dH, a[k++] = (PetscReal)m->nprojections;
   a[k++] = (PetscReal)m->last_written, a[k++] = (PetscReal)m->nretries, a[k++] = m->dissipated_total;
-  a[k++] = m->max_drive, a[k++] = m->E0abs;
+  a[k++] = m->max_drive, a[k++] = m->E0abs, a[k++] = m->V0, a[k++] = m->max_dV;
   return k;
 }
 
@@ -45,7 +45,7 @@ static void UnpackMonitor(MonitorContext *m, const PetscReal a[CHECKPOINT_NMONIT
   m->Pscale = a[k++], m->Lscale = a[k++], m->max_dP = a[k++], m->max_dL = a[k++], m->max_orth = a[k++];
   m->max_defect = a[k++], m->max_gap = a[k++], m->project_dH = a[k++], m->nprojections = (PetscInt)a[k++];
   m->last_written = (PetscInt)a[k++], m->nretries = (PetscInt)a[k++], m->dissipated_total = a[k++];
-  m->max_drive = a[k++], m->E0abs = a[k++];
+  m->max_drive = a[k++], m->E0abs = a[k++], m->V0 = a[k++], m->max_dV = a[k++];
 }
 
 /* removes the hashes after marker from a fingerprint: '@' and 16 hex digits, the placement hashes of

@@ -212,6 +212,24 @@ PetscErrorCode PhlexOutputCommit(PhlexOutput out)
   PetscCallMPI(MPI_Barrier(out->comm));
   if (rank == 0)
     for (PetscInt k = 0; k < out->nfiles; k++) PetscCheck(!rename(out->tmp[k], out->final[k]), PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "cannot rename '%s' to '%s': %s", out->tmp[k], out->final[k], strerror(errno));
+  if (rank == 0 && out->nfiles) {
+    /* results supersede the series an earlier failed run of this directory kept in failed/ */
+    char failed[PETSC_MAX_PATH_LEN + 16];
+    DIR *d;
+    (void)snprintf(failed, sizeof(failed), "%s/failed", out->dir);
+    if ((d = opendir(failed))) {
+      struct dirent *e;
+      while ((e = readdir(d))) {
+        char         old[2 * PETSC_MAX_PATH_LEN];
+        const size_t len = strlen(e->d_name);
+        if (e->d_name[0] == '.' || len < 5 || strcmp(e->d_name + len - 4, ".csv")) continue;
+        (void)snprintf(old, sizeof(old), "%s/%s", failed, e->d_name);
+        (void)remove(old);
+      }
+      closedir(d);
+      (void)rmdir(failed); /* fails if anything else is there: left alone */
+    }
+  }
   PetscCallMPI(MPI_Barrier(out->comm));
   /* where the results are: the directory, then the files in the order they were opened */
   if (out->nfiles) {
@@ -264,8 +282,10 @@ PetscErrorCode PhlexOutputKeepFailed(PhlexOutput out)
     if (d) {
       struct dirent *e;
       while ((e = readdir(d))) {
-        char old[2 * PETSC_MAX_PATH_LEN];
-        if (e->d_name[0] == '.') continue;
+        char         old[2 * PETSC_MAX_PATH_LEN];
+        const size_t len = strlen(e->d_name);
+        /* an earlier failed run's series (phlex writes nothing else there) */
+        if (e->d_name[0] == '.' || len < 5 || strcmp(e->d_name + len - 4, ".csv")) continue;
         (void)snprintf(old, sizeof(old), "%s/%s", failed, e->d_name);
         (void)remove(old);
       }
@@ -282,7 +302,7 @@ PetscErrorCode PhlexOutputKeepFailed(PhlexOutput out)
     (void)snprintf(dest, sizeof(dest), "%s/%s", failed, name ? name + 1 : out->final[k]);
     if (!rename(out->tmp[k], dest)) nkept++;
   }
-  if (nkept) fprintf(stderr, "phlex: the run's %d series up to the failed step are kept in '%s/' (not results: their last rows show how the failure grew; -output_keep_failed false keeps none)\n", (int)nkept, failed);
+  if (nkept) fprintf(stderr, "phlex: the run's %d series up to its last monitored step (a watchdog's: the step that failed) are kept in '%s/' (not results: their last rows show how the failure grew; -output_keep_failed false keeps none)\n", (int)nkept, failed);
   return 0;
 }
 

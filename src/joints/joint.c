@@ -832,12 +832,15 @@ static PetscErrorCode Source(PhlexJoint j, PetscInt k, PetscReal t, PetscReal *g
 
   PetscFunctionBeginUser;
   *g = 0.0;
-  if (j->drive_step && t > j->drive_t0 && (j->type == PHLEX_JOINT_PRESCRIBED || (j->drive_row >= 0 && k == j->nc - 1))) {
+  if (j->drive_step && (j->drive_start || t > j->drive_t0) && (j->type == PHLEX_JOINT_PRESCRIBED || (j->drive_row >= 0 && k == j->nc - 1))) {
     /* at the stage of a midpoint step: the rate whose step the scheme maps onto the prescribed increment. A position
        moves by dt v_m (exact for the step's mean rate); a rotation by the Cayley factor of dt w_m, an angle
        2 atan(|w_m| dt/2): w_m = 2 tan(phi/2)/dt along the increment phi (the mean rate alone lags by n (w dt -
        2 atan(w dt/2)) after n steps: 1e-2 rad in 100 steps of w dt = 0.5). The work is still exactly lambda . c. */
-    const PetscReal dt = 2.0 * (t - j->drive_t0), dtn = dt / u->time;
+    /* the stage of the step from drive_t0 (t - t0 = dt/2), or the consistent start before it (t at t0, or its two short
+       steps): the first step's stage rate, so that the velocities start at the rate the steps keep (with the mean rate
+       a constant-speed drive's velocity alternated by (w dt)^2/6 every step) */
+    const PetscReal dt = j->drive_start ? j->drive_dt : 2.0 * (t - j->drive_t0), dtn = dt / u->time;
     PetscReal       F0, F1, dF;
     PetscCall(PhlexProfileIntegrate(j->drive_profile, j->drive_t0, &F0));
     PetscCall(PhlexProfileIntegrate(j->drive_profile, j->drive_t0 + dt, &F1));
@@ -847,9 +850,17 @@ static PetscErrorCode Source(PhlexJoint j, PetscInt k, PetscReal t, PetscReal *g
       else {
         const PetscReal phi = PhlexNorm3(j->presc_angular) * PetscAbsReal(dF);
         const PetscReal scale = phi > 0 ? 2.0 * PetscTanReal(0.5 * phi) / phi : 1.0;
+        PetscCheck(phi < 0.5 * PETSC_PI, j->comm, PETSC_ERR_USER_INPUT, "joint %s: its prescribed rotation turns the port by %g rad in a step of %g s, more than pi/2: the step cannot follow it; reduce -ts_dt", j->name, (double)phi, (double)dt);
         *g = j->presc_angular[j->row[k] - PHLEX_ROW_R1] * dF * scale / dtn;
       }
-    } else if (j->row[k] == PHLEX_ROW_R3) *g = 2.0 * PetscTanReal(0.5 * j->drive_velocity * dF) / dtn;
+    } else if (j->row[k] == PHLEX_ROW_R3) {
+      /* past a half turn per step tan(phi/2) changes sign: the body would turn backwards (aliasing) */
+      if (PetscAbsReal(j->drive_velocity * dF) >= 0.5 * PETSC_PI) {
+        char turn[32], step[32], most[32];
+        SETERRQ(j->comm, PETSC_ERR_USER_INPUT, "joint %s: its drive turns it by %s rad in a step of %s s, more than pi/2: the step cannot follow it (a rotation's discrete map aliases past a half turn); reduce -ts_dt below %s s", j->name, PhlexFormatReal(j->drive_velocity * dF, turn, sizeof(turn)), PhlexFormatReal(dt, step, sizeof(step)), PhlexFormatReal(0.5 * PETSC_PI * dt / PetscAbsReal(j->drive_velocity * dF), most, sizeof(most)));
+      }
+      *g = 2.0 * PetscTanReal(0.5 * j->drive_velocity * dF) / dtn;
+    }
     else *g = j->drive_velocity * dF / dt / u->velocity;
     PetscFunctionReturn(0);
   }
@@ -1002,16 +1013,20 @@ PetscErrorCode PhlexJointElementStepStart(PhlexJoint j, PetscReal t0, const Pets
 }
 
 /*@C
-  PhlexJointDriveStepStart - before a step from t0: whether it is a midpoint step, whose stage then takes the rate of
-  a drive or a prescribed motion that makes the step's increment the prescribed one (Source)
+  PhlexJointDriveStepStart - before a step from t0 of length dt (and before the consistent start, with the first
+  step's): whether it is a midpoint step, whose stage then takes the rate of a drive or a prescribed motion that makes
+  the step's increment the prescribed one (Source); exact where the joint's other side does not rotate (a drive from
+  the ground), else to the midpoint rule's error of composing two rotations
 
   Not collective
 @*/
-PetscErrorCode PhlexJointDriveStepStart(PhlexJoint j, PetscReal t0, PetscBool midpoint)
+PetscErrorCode PhlexJointDriveStepStart(PhlexJoint j, PetscReal t0, PetscReal dt, PetscBool midpoint, PetscBool start)
 {
   PetscFunctionBeginUser;
+  j->drive_start = start;
   j->drive_step = (PetscBool)(midpoint && (j->drive_row >= 0 || j->type == PHLEX_JOINT_PRESCRIBED) && j->drive_profile);
   j->drive_t0   = t0;
+  j->drive_dt   = dt;
   PetscFunctionReturn(0);
 }
 
