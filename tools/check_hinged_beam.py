@@ -12,7 +12,9 @@ checks, each against a stated tolerance, the acceptance tests of cases.md 3.3 (e
     value: the torque's angular impulse 2e-6 N m s over rho A L^3 / 3);
   - after the pulse, the angular momentum about the vertical L_z = the torque's impulse 2e-6 N m s (the vertical tip
     force adds none) within --lrtol (default 1e-4: the midpoint rule conserves it to O(dt^2) with full inertia and
-    constant_without_gyroscopic; the constant model does not conserve it, README "inertia models").
+    constant_without_gyroscopic; the paper's constant model does not conserve it: its rate is
+    R int rho (v_P + w x x) x v_f (src/parts/frame.c), and it oscillates about 2e-6 N m s by up to 0.84 % by 50 s, so
+    make validate and hinged_beam_constant_pulse give that model --lrtol 0.02, the 2 % of the omega_z it carries).
 The windows of each check start where the input that precedes it ends (10.2 s, 15.4 s); a metric whose window the
 run does not reach is skipped. Also checked, as the cause a failing omega_z would have: the frame's mean spin about
 the beam's axis after the pulse, |time average of w_x| <= --spin_max (default rtol x 0.0302 rad/s: its vertical

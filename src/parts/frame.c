@@ -21,25 +21,39 @@
    - constant_without_gyroscopic: the Hamel equations of T0 alone. T0 does not depend on u, so the elastic field
      feels the frame's accelerations (t v_P', w' x x) but no velocity-dependent load: no centrifugal, Coriolis or
      transport (w x v_P) term.
-   - constant (the paper's constant-inertia model, Section 4 and eq. EB_J): the gyroscopic terms of J(e) of eq.
-     ph_mfd_all kept at u = 0, with the modified momenta of eq. mod_momenta and the operator of eq. mod_momentafl.
-     About the coefficient 2 there: in the full model it compensates -delta_u H = -p_f x w, the u-dependence of the
-     kinetic energy (the paper's remark after eq. mod_momentafl). With the mass operator at u = 0, delta_u H_kin = 0 and
-     nothing is left to compensate: the 2 would double the centrifugal and transport loads on the field. With
-     coefficient 1, I_pf = int {p_f + rho v_f} (.), the field gets (p_f + rho v) x w = rho (v_P + w x x + 2 v) x w:
-     the exact transport, centrifugal and Coriolis loads at the undeformed geometry (the exact equations with y = x);
-     J stays skew, so H0 is still conserved. What the coefficient 1 costs is in the frame's moment equation: the full
-     model at u = 0 has 2 int p_f x v there, this one int p_f x v, i.e. it misses int rho (v_P + w x x) x v, a term
-     of the elastic velocity times the rigid one. In Hamel form (what is implemented) the constant model is the
-     model without gyroscopic terms plus, power-neutral in total:
-       translation:  + w x int rho v                       (p~_t = p_t + int rho v, eq. mod_momenta)
-       rotation:     - int rho x x (v x w)                 (p~_r and the I_pf column, after the Jacobi identity)
-       field (node l): - (t_l v_P + w x w_l + 2 (Mv v)_l) x w   (-(I_pf)^* w)
-   (The author's beam code uses p_t instead of p~_t and int p_f without rho v_f: one Coriolis term fewer.) */
+   - constant (the paper's constant-inertia model, Section 4.3: "the dependence of the canonical momenta on the
+     deformation field is neglected"): the momenta p_t, p_r, p_f of eq. momenta at u = 0, so M(u) = M0, and the
+     interconnection J(e) of eq. ph_mfd_all built from them. Derivation: in the full model J(e) holds three things,
+       (a) the Hamel (Kirchhoff) terms [p_t]x, [p_r]x and int [p_f]x (.), the rotation of each momentum with the frame;
+       (b) the rate of the mass operator moved to the right (M(u) e' = p' - M(u)' e): the modified momenta of eq.
+           mod_momenta, p~_t = p_t + int rho v_f, p~_r = p_r + int rho y x v_f, and the rho v_f of eq. mod_momentafl
+           (the Coriolis term transported by u' = v_f);
+       (c) the coefficient 2 of eq. mod_momentafl, which (the paper's remark after it) compensates -delta_u H = -p_f x w.
+     With momenta that do not depend on u, M' = 0 removes (b) and delta_u H_kin = 0 removes what (c) compensates:
+     the model is (a) alone, I_pf = int [p_f]x (.) with coefficient 1 and no rho v_f, p_t and p_r unmodified:
+       p_t'                                   = p_t x w + F_ext
+       p_r'                                   = p_t x v_P + p_r x w + int p_f x v_f + M_ext
+       rho (v_P' + w' x x + v_f') - Div Sigma = p_f x w + b_ext,     p_f = rho (v_P + w x x + v_f)
+     (M0 e' = p' with p = M0 e.) This is what the paper's beam code computes (its J: skew(M[:n_r] e) in the rigid rows,
+     the elastic rows' Jf_om from rho (v_P + w x x + v_f), coefficient 1), and it reproduces the paper's figures (the
+     hinged beam here: omega_z 0.030225 rad/s, the paper's 0.0302). The paper's eq. EB_J prints the full model's J at
+     u = 0 (p~_t and the 2 of I_pf) beside that constant mass operator: with delta_u H = 0 its elastic rows get
+     (2 p_f + rho v_f) x w, twice the centrifugal and transport loads. An independent beam model of the crank-slider in
+     the paper's own frame (tools/crankslider_beam_model.py) gives the paper's figure with the model above and a first
+     peak of 0.0072 instead of 0.0186 with eq. EB_J as printed: the figure does not come from the printed equation.
+     In words: every particle obeys Newton's law in the inertial frame with its momentum R rho (v_P + w x x + v_f),
+     held at its undeformed place x (d/dt (R p_f) = R (Div Sigma + b)), and the frame's rows are the sums of these
+     (int and int x x): the frame's moment equation keeps int p_f x v_f, which cancels p_r x w's torque about a
+     beam's axis as in the full model (without it a beam with a small polar inertia spins about its axis). The field
+     feels rho (v_P + w x x + v_f) x w: transport, centrifugal and one of the two Coriolis terms (the other is (b)).
+     J stays skew (int p_f x v_f in the moment row and p_f x w in the field rows are each other's adjoints), so H0 is
+     conserved; R p_t is conserved (no loads); the angular momentum is not: its rate is R int rho (v_P + w x x) x v_f,
+     the moment of the particles' velocities at their undeformed places. In Hamel form (what is implemented) the
+     constant model is the model without gyroscopic terms plus, power-neutral in total (residual terms):
+       rotation:     - v_P x int rho v - (Wv w - w tr(Wv))   (- int p_f x v_f; Wv = int rho x v^T; int rho v x v = 0)
+       field (node l): - (t_l v_P + w x w_l + (Mv v)_l) x w   (-(I_pf)^* w = -p_f x w)
+*/
 #include <phlex_impl.h>
-
-/* ---------------------------------------------------------------------------------------------------------- */
-/* Node-wise reductions over the elastic space (local triples, then one reduction)                             */
 
 /* ---------------------------------------------------------------------------------------------------------- */
 /* Node-wise reductions over the elastic space (local triples, then one reduction)                             */
@@ -316,10 +330,10 @@ static inline void NodeLoad(const PhlexFrame *fr, const PhlexFrameState *f, cons
     PhlexCross(Mv_l, f->w, tmp);
     for (PetscInt k = 0; k < 3; k++) acc[k] -= tmp[k];
   } else if (fr->gyroscopic) {
-    /* constant model: - (t v_P + w x w_l + 2 Mv v) x w  (z = w_l: u = 0) */
+    /* constant model: - p_f x w = - (t v_P + w x w_l + Mv v) x w  (z = w_l: u = 0; -(I_pf)^* w, coefficient 1) */
     PhlexMatVec3(C, z, tmp2);
     PhlexCross(Mv_l, f->w, tmp);
-    for (PetscInt k = 0; k < 3; k++) acc[k] -= tl * vxw[k] + tmp2[k] + 2.0 * tmp[k];
+    for (PetscInt k = 0; k < 3; k++) acc[k] -= tl * vxw[k] + tmp2[k] + tmp[k];
   }
 }
 
@@ -400,11 +414,10 @@ PetscErrorCode PhlexFrameResidual(PhlexFrame *fr, PhlexFrameState *f, Vec u, Vec
   PhlexCross(f->sgrav, f->gbody, a);
   for (PetscInt k = 0; k < 3; k++) Fq[15 + k] -= a[k];
   if (fr->frozen && fr->gyroscopic) {
-    /* constant model: + w x int rho v (translation), + w tr(Wv) - Wv^T w = - int rho x x (v x w) (rotation) */
+    /* constant model, rotation: - int p_f x v = - v_P x int rho v - (Wv w - w tr(Wv))  (int rho (w x x) x v = Wv w - w tr(Wv)) */
     const PetscReal tr = f->Wv[0] + f->Wv[4] + f->Wv[8];
-    PhlexCross(f->w, f->Vf, a);
-    for (PetscInt k = 0; k < 3; k++) Fq[12 + k] += a[k];
-    for (PetscInt k = 0; k < 3; k++) Fq[15 + k] += f->w[k] * tr - (f->Wv[k] * f->w[0] + f->Wv[3 + k] * f->w[1] + f->Wv[6 + k] * f->w[2]);
+    PhlexCross(f->vP, f->Vf, a);
+    for (PetscInt k = 0; k < 3; k++) Fq[15 + k] -= a[k] + (f->Wv[3 * k] * f->w[0] + f->Wv[3 * k + 1] * f->w[1] + f->Wv[3 * k + 2] * f->w[2]) - f->w[k] * tr;
   }
 
   /* elastic rows: p_f' - Mv v' = t vP' + int rho phi (w' x y) + Mv (w x ud), minus dT/du, minus t R^T g */
@@ -482,13 +495,13 @@ static void NodeBorders(const PhlexFrame *fr, const PhlexFrameState *f, PetscRea
         col[c] += t1[c] - tl * t2[c] - dCz - t3[c];
       }
     } else if (fr->gyroscopic) {
-      /* constant model: - (t vP x e_a + dC/dw_a z + 2 Mv v x e_a) */
+      /* constant model: - (t vP x e_a + dC/dw_a z + Mv v x e_a) */
       PetscReal t2[3], t3[3];
       PhlexCross(vP, ej, t2);
       PhlexCross(Mvl, ej, t3);
       for (PetscInt c = 0; c < 3; c++) {
         const PetscReal dCz = 2.0 * w[j] * z[c] - ej[c] * PhlexDot3(w, z) - w[c] * z[j];
-        col[c] += -tl * t2[c] - dCz - 2.0 * t3[c];
+        col[c] += -tl * t2[c] - dCz - t3[c];
       }
     }
     for (PetscInt c = 0; c < 3; c++) bc[3 * (15 + j) + c] = col[c];
@@ -512,12 +525,8 @@ static void NodeBorders(const PhlexFrame *fr, const PhlexFrameState *f, PetscRea
         PhlexCross(zd, ee, mdx);
         for (PetscInt k = 0; k < 3; k++) cv[3 * (15 + k) + e] += mdx[k];
       } else if (fr->gyroscopic) {
-        /* constant model: translation + t (w x e_e); rotation + w z_e - e_e (z . w) (z = w_l) */
-        const PetscReal zw = PhlexDot3(z, w);
-        for (PetscInt k = 0; k < 3; k++) {
-          cv[3 * (12 + k) + e] += tl * a3[k];
-          cv[3 * (15 + k) + e] += w[k] * z[e] - ee[k] * zw;
-        }
+        /* constant model, rotation: d/dv(l,e) of - v_P x int rho v - Wv w + w tr(Wv) = - t vP x e_e - z w_e + w z_e (z = w_l) */
+        for (PetscInt k = 0; k < 3; k++) cv[3 * (15 + k) + e] += -tl * r3[k] - z[k] * w[e] + w[k] * z[e];
       }
     }
     /* u: sgrav depends on u in both models: p_r row -t (e_e x R^T g) */
@@ -599,7 +608,7 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
     PhlexSkew(wd, Sd);
     const PetscBool gyro = (PetscBool)(!full && fr->gyroscopic);
     for (PetscInt i = 0; i < 9; i++) {
-      Bvv[i] = full ? S[i] : (gyro ? 2.0 * S[i] : 0.0); /* constant model: -2 Mv v x w */
+      Bvv[i] = full ? S[i] : (gyro ? S[i] : 0.0); /* constant model: - Mv v x w */
       Bvu[i] = full ? shift * S[i] + Sd[i] - C[i] : 0.0;
     }
   }
@@ -669,14 +678,14 @@ PetscErrorCode PhlexFrameJacobian(PhlexFrame *fr, PhlexFrameState *f, PetscReal 
       }
   }
   if (!full && fr->gyroscopic) {
-    /* constant model: d(w x Vf)/dw = -[Vf]x; d(w tr(Wv) - Wv^T w)/dw = tr(Wv) I - Wv^T */
+    /* constant model, rotation: d(- v_P x Vf)/dv_P = [Vf]x; d(- Wv w + w tr(Wv))/dw = tr(Wv) I - Wv */
     PetscReal SVf[9];
     const PetscReal tr = f->Wv[0] + f->Wv[4] + f->Wv[8];
     PhlexSkew(f->Vf, SVf);
     for (PetscInt a = 0; a < 3; a++)
       for (PetscInt c = 0; c < 3; c++) {
-        A(12 + a, 15 + c) -= SVf[3 * a + c];
-        A(15 + a, 15 + c) += (a == c ? tr : 0.0) - f->Wv[3 * c + a];
+        A(15 + a, 12 + c) += SVf[3 * a + c];
+        A(15 + a, 15 + c) += (a == c ? tr : 0.0) - f->Wv[3 * a + c];
       }
   }
 #undef A
