@@ -378,6 +378,12 @@ post: cat {stderr2}; ls {outdir}; cat {stdout3}
         result = self.run_spec("args: out='Option left: name:-foo value: 1'\noutput: none\n")
         self.assertTrue(result.reason.startswith("an option went unused: Option left"), result.reason)
 
+    def test_stderr_names_outdir(self):
+        text = "args: err={outdir}/x.h5 exit=2\nexit: 2\nstderr: ^{outdir}/x\\.h5$\noutput: none\n"
+        self.assertEqual(self.run_spec(text).status, "ok")
+        text = "args: err=elsewhere/x.h5 exit=2\nexit: 2\nstderr: {outdir}/x\\.h5\noutput: none\n"
+        self.assertTrue(self.run_spec(text).reason.startswith("stderr does not match"))
+
     def test_setup(self):
         text = "setup: mkdir {outdir}/made\nargs: touch={outdir}/made/x\noutput: none\nfiles_present: made/x\n"
         self.assertEqual(self.run_spec(text).status, "ok")
