@@ -722,7 +722,7 @@ def run_process(cmd: List[str], env: Dict[str, str], timeout: float,
                      out.decode("utf-8", "replace"), err.decode("utf-8", "replace"), timed_out)
 
 
-def test_env() -> Dict[str, str]:
+def test_env(nsize: int = 1) -> Dict[str, str]:
     """The environment for test processes: ours plus OpenMPI settings.
 
     OMPI_MCA_ess_singleton_isolated: a process started without mpiexec does not spawn an
@@ -730,11 +730,14 @@ def test_env() -> Dict[str, str]:
     OMPI_MCA_sharedfp ^sm: isolated singletons share one session directory, where MPI-IO's shared-file-pointer
     component sm makes a file named after the file opened (checkpoint.h5_cid--1-0.sm): two tests writing
     checkpoint.h5 at once collide there, and a run that cannot make it prints 'unable to open file for mmap' on
-    stderr. HDF5 uses no shared file pointer, so the component is left out."""
+    stderr. HDF5 uses no shared file pointer, so the component is left out of serial runs (the other component then
+    chosen, lockedfile, keeps a .lock file beside an open file, which a run under mpiexec that aborts would leave in
+    its output directory: those keep sm, whose files are in their own job's session directory)."""
     env = dict(os.environ)
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_ess_singleton_isolated="1",
-               OMPI_MCA_sharedfp="^sm")
+               OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_ess_singleton_isolated="1")
+    if nsize == 1:
+        env["OMPI_MCA_sharedfp"] = "^sm"
     return env
 
 
@@ -1022,7 +1025,7 @@ def run_test(spec: Spec, cfg: Config) -> Result:
         if cfg.verbose:
             diag.append(f"$ {shlex.join(cmd)}")
         try:
-            out = run_process(cmd, test_env(), spec.timeout)
+            out = run_process(cmd, test_env(run.nsize), spec.timeout)
         except OSError as err:
             return Result(spec.name, "fail", f"{prefix}cannot run {cmd[0]}: {err}", time.monotonic() - start,
                           tuple(diag))
