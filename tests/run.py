@@ -317,8 +317,12 @@ def compare_cells(ref: CsvTable, out: CsvTable, names: Sequence[str], tol: Tol,
 KNOWN_KEYS = {
     "description", "args", "nsize", "requires", "filter", "output", "csv", "columns",
     "rtol", "atol", "ztol", "csv_rtol", "csv_atol", "csv_ztol", "csv_column_atol", "timeout", "exit",
-    "stderr", "files_absent", "files_present", "ref_source",
+    "stderr", "files_absent", "files_present", "ref_source", "setup", "post",
 }
+
+# the keys of one run; a test of several runs numbers them from the second on: args2, exit2, stderr2, nsize2, filter2
+RUN_KEYS = ("args", "nsize", "exit", "stderr", "filter")
+RUN_KEY_RE = re.compile(r"(" + "|".join(RUN_KEYS) + r")([2-9]|[1-9][0-9]+)")
 
 # requirement -> petscconf.h macro (None: always available)
 FEATURES = {
@@ -347,8 +351,20 @@ class SpecError(Exception):
     """A malformed test spec."""
 
 
+class Run(NamedTuple):
+    """One run of bin/phlex in a test: its arguments and what the runner checks of it."""
+
+    args: List[str]
+    nsize: int
+    exit: str                      # "0", "nonzero" or an integer as text
+    stderr: Optional["re.Pattern[str]"]
+    filter: Optional[str]          # shell command its stdout is piped through; None: compared whole
+    compared: bool = True          # False (filter: none): its stdout is not compared
+
+
 class Spec(NamedTuple):
-    """A parsed test spec (see tests/README.md)."""
+    """A parsed test spec (see tests/README.md). args, nsize, exit, stderr and filter are the first run's; runs
+    holds every run, the first one first."""
 
     name: str
     description: str
@@ -368,6 +384,20 @@ class Spec(NamedTuple):
     files_present: List[str]
     ref_source: Optional[str] = None  # how the reference CSVs were made (not phlex): --update leaves them alone
     column_atol: Optional[Dict[str, float]] = None  # CSV columns with their own absolute tolerance
+    runs: Tuple[Run, ...] = ()     # every run (empty: the one run of args, nsize, exit, stderr, filter)
+    setup: Optional[str] = None    # shell command before the first run
+    post: Optional[str] = None     # shell command after the last run; its stdout is compared after the runs'
+
+    def all_runs(self) -> Tuple[Run, ...]:
+        """The runs of the test (a spec built without runs: its one run)."""
+        if self.runs:
+            return self.runs
+        filt = self.filter
+        return (Run(self.args, self.nsize, self.exit, self.stderr, None if filt == "none" else filt, filt != "none"),)
+
+    def max_nsize(self) -> int:
+        """The largest number of MPI ranks of any run (a test with more than one runs alone)."""
+        return max(r.nsize for r in self.all_runs())
 
 
 def parse_column_atol(text: str) -> Dict[str, float]:
@@ -408,7 +438,7 @@ def read_spec_lines(text: str) -> Dict[str, str]:
         key = key.strip()
         if not sep or not key:
             raise SpecError(f"line {lineno}: expected 'key: value', got {shorten(stripped, 60)!r}")
-        if key not in KNOWN_KEYS:
+        if key not in KNOWN_KEYS and not RUN_KEY_RE.fullmatch(key):
             raise SpecError(f"line {lineno}: unknown key {key!r}")
         if key in values:
             raise SpecError(f"line {lineno}: duplicate key {key!r}")
@@ -462,11 +492,56 @@ def parse_csv_pairs(value: str) -> List[Tuple[str, str]]:
     return pairs
 
 
-def parse_exit(value: str) -> str:
-    """Validate the 'exit' key: 0, nonzero or an integer."""
+def parse_exit(value: str, key: str = "exit") -> str:
+    """Validate the 'exit' key (or exit<k>): 0, nonzero or an integer."""
     if value == "nonzero" or re.fullmatch(r"[+-]?\d+", value):
         return value if value == "nonzero" else str(int(value))
-    raise SpecError(f"exit: expected 0, nonzero or an integer, got {value!r}")
+    raise SpecError(f"{key}: expected 0, nonzero or an integer, got {value!r}")
+
+
+def parse_nsize(values: Dict[str, str], key: str, default: int) -> int:
+    """A number of MPI ranks (>= 1)."""
+    try:
+        nsize = int(values.get(key, str(default)))
+    except ValueError:
+        raise SpecError(f"{key}: not an integer: {values[key]!r}") from None
+    if nsize < 1:
+        raise SpecError(f"{key}: must be >= 1, got {nsize}")
+    return nsize
+
+
+def parse_run(values: Dict[str, str], k: int, nsize: int) -> Run:
+    """The keys of run k (1: args, exit, ...; k >= 2: args<k>, exit<k>, ...; nsize<k> defaults to nsize)."""
+    suffix = "" if k == 1 else str(k)
+    try:
+        args = shlex.split(values["args" + suffix])
+    except ValueError as err:
+        raise SpecError(f"args{suffix}: {err}") from None
+    stderr = None
+    if "stderr" + suffix in values:
+        try:
+            stderr = re.compile(values["stderr" + suffix], re.DOTALL)
+        except re.error as err:
+            raise SpecError(f"stderr{suffix}: bad regular expression: {err}") from None
+    exit_value = parse_exit(values.get("exit" + suffix, "0"), "exit" + suffix)
+    filt = values.get("filter" + suffix) or None
+    return Run(args=args, nsize=parse_nsize(values, "nsize" + suffix, nsize) if k > 1 else nsize, exit=exit_value,
+               stderr=stderr, filter=None if filt == "none" else filt, compared=filt != "none")
+
+
+def parse_runs(values: Dict[str, str], nsize: int) -> Tuple[Run, ...]:
+    """Run 1 and the numbered runs 2, 3, ... (their args<k> consecutive; no other key of a run without args)."""
+    numbers = sorted({int(m.group(2)) for m in map(RUN_KEY_RE.fullmatch, values) if m})
+    count = 1
+    while f"args{count + 1}" in values:
+        count += 1
+    for k in numbers:
+        if k > count:
+            key = next(key for key in values if RUN_KEY_RE.fullmatch(key) and int(RUN_KEY_RE.fullmatch(key).group(2)) == k)
+            if key.startswith("args"):
+                raise SpecError(f"{key} without args{count + 1}: number the runs 2, 3, ... without a gap")
+            raise SpecError(f"{key} without args{k}")
+    return tuple(parse_run(values, k, nsize) for k in range(1, count + 1))
 
 
 def parse_spec(name: str, text: str) -> Spec:
@@ -474,34 +549,21 @@ def parse_spec(name: str, text: str) -> Spec:
     values = read_spec_lines(text)
     if "args" not in values:
         raise SpecError("missing required key 'args'")
-    try:
-        args = shlex.split(values["args"])
-    except ValueError as err:
-        raise SpecError(f"args: {err}") from None
-    try:
-        nsize = int(values.get("nsize", "1"))
-    except ValueError:
-        raise SpecError(f"nsize: not an integer: {values['nsize']!r}") from None
-    if nsize < 1:
-        raise SpecError(f"nsize: must be >= 1, got {nsize}")
+    nsize = parse_nsize(values, "nsize", 1)
     requires = [r.lower() for r in split_list(values.get("requires", ""))]
     for feature in requires:
         if feature not in FEATURES and feature not in TOOLS:
             raise SpecError(f"requires: unknown feature {feature!r} "
                             f"(known: {', '.join(sorted({**FEATURES, **TOOLS}))})")
     output = values.get("output", f"{name}.out")
-    stderr = None
-    if "stderr" in values:
-        try:
-            stderr = re.compile(values["stderr"], re.DOTALL)
-        except re.error as err:
-            raise SpecError(f"stderr: bad regular expression: {err}") from None
+    runs = parse_runs(values, nsize)
     tol, csv_tol = parse_tolerances(values)
     columns = split_list(values["columns"]) if "columns" in values else None
+    first = runs[0]
     return Spec(
         name=name,
         description=values.get("description", ""),
-        args=args,
+        args=first.args,
         nsize=nsize,
         requires=requires,
         filter=values.get("filter") or None,
@@ -511,12 +573,15 @@ def parse_spec(name: str, text: str) -> Spec:
         tol=tol,
         csv_tol=csv_tol,
         timeout=parse_timeout(values),
-        exit=parse_exit(values.get("exit", "0")),
-        stderr=stderr,
+        exit=first.exit,
+        stderr=first.stderr,
         files_absent=values.get("files_absent", "").split(),
         files_present=values.get("files_present", "").split(),
         ref_source=values.get("ref_source") or None,
         column_atol=parse_column_atol(values.get("csv_column_atol", "")) or None,
+        runs=runs,
+        setup=values.get("setup") or None,
+        post=values.get("post") or None,
     )
 
 
@@ -657,14 +722,22 @@ def run_process(cmd: List[str], env: Dict[str, str], timeout: float,
                      out.decode("utf-8", "replace"), err.decode("utf-8", "replace"), timed_out)
 
 
-def test_env() -> Dict[str, str]:
+def test_env(nsize: int = 1) -> Dict[str, str]:
     """The environment for test processes: ours plus OpenMPI settings.
 
     OMPI_MCA_ess_singleton_isolated: a process started without mpiexec does not spawn an
-    orted (which costs seconds on some machines, e.g. a fresh chroot)."""
+    orted (which costs seconds on some machines, e.g. a fresh chroot).
+    OMPI_MCA_sharedfp ^sm: isolated singletons share one session directory, where MPI-IO's shared-file-pointer
+    component sm makes a file named after the file opened (checkpoint.h5_cid--1-0.sm): two tests writing
+    checkpoint.h5 at once collide there, and a run that cannot make it prints 'unable to open file for mmap' on
+    stderr. HDF5 uses no shared file pointer, so the component is left out of serial runs (the other component then
+    chosen, lockedfile, keeps a .lock file beside an open file, which a run under mpiexec that aborts would leave in
+    its output directory: those keep sm, whose files are in their own job's session directory)."""
     env = dict(os.environ)
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_ess_singleton_isolated="1")
+    if nsize == 1:
+        env["OMPI_MCA_sharedfp"] = "^sm"
     return env
 
 
@@ -675,16 +748,23 @@ def outdir_paths(spec: Spec, cfg: Config) -> Tuple[str, str]:
     return absdir, (absdir if rel.startswith("..") else rel)
 
 
-def substitute(text: str, outdir: str) -> str:
-    """Replace the {outdir} and {root} placeholders."""
-    return text.replace("{outdir}", outdir).replace("{root}", ROOT)
+LOG_RE = re.compile(r"\{(stdout|stderr)([1-9][0-9]*)\}")
 
 
-def build_command(spec: Spec, cfg: Config, outdir: str) -> List[str]:
-    """The command line for a test: the binary, under mpiexec if nsize > 1."""
-    args = [substitute(a, outdir) for a in spec.args]
-    if spec.nsize > 1:
-        return cfg.mpiexec + ["--oversubscribe", "-n", str(spec.nsize), cfg.binary] + args
+def substitute(text: str, outdir: str, logdir: Optional[str] = None) -> str:
+    """Replace the {outdir} and {root} placeholders, and {stdout<k>} / {stderr<k>} (the files holding run k's
+    output, under logdir) when logdir is given."""
+    text = text.replace("{outdir}", outdir).replace("{root}", ROOT)
+    if logdir is not None:
+        text = LOG_RE.sub(lambda m: os.path.join(logdir, f"run{m.group(2)}.{m.group(1)}"), text)
+    return text
+
+
+def build_command(run: Run, cfg: Config, outdir: str, logdir: Optional[str] = None) -> List[str]:
+    """The command line of a run: the binary, under mpiexec if its nsize > 1."""
+    args = [substitute(a, outdir, logdir) for a in run.args]
+    if run.nsize > 1:
+        return cfg.mpiexec + ["--oversubscribe", "-n", str(run.nsize), cfg.binary] + args
     return [cfg.binary] + args
 
 
@@ -711,6 +791,12 @@ def exit_ok(expected: str, code: int) -> bool:
 
 CRASH_RE = re.compile(r"Segmentation|SEGV|Caught signal|exited on signal|terminated with signal"
                       r"|killed by signal")
+
+# an option given to a run that ended normally and never read it: phlex's end-of-run warning, PETSc's -options_left
+# report (an option of the scene file or of a solver preset that is for another analysis is not one: phlex warns
+# about those by design)
+UNUSED_RE = re.compile(r"^.*(?:was never used \(misspelt\?\)|There are options you set that were not used"
+                       r"|^Option left: name:).*$", re.MULTILINE)
 
 
 def tail(text: str, n: int) -> List[str]:
@@ -744,23 +830,30 @@ class Checker:
             self.fail(f"{prefix}{diff.summary}", diff.details)
 
 
-def apply_filter(spec: Spec, stdout: str, outdir: str, chk: Checker) -> Optional[str]:
-    """Pipe stdout through the spec's filter (sh -c); None when the filter failed.
-
-    Exit status 1 is accepted (grep matching nothing); higher ones are errors.
-    """
-    if not spec.filter:
-        return stdout
+def shell_env() -> Dict[str, str]:
+    """The environment of a filter, a setup or a post command."""
     # a filter may start phlex itself with mpiexec, which refuses root without OMPI_ALLOW_RUN_AS_ROOT; not the other
     # settings of test_env(): singletons isolated from an orted share one session directory, and two filters' runs
     # writing checkpoint.h5 at once then collide in Open MPI's shared-file-pointer files
     env = os.environ.copy()
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1")
-    res = run_process(["sh", "-c", substitute(spec.filter, outdir)], env,
-                      spec.timeout, stdin_data=stdout.encode("utf-8"))
+    return env
+
+
+def apply_filter(command: Optional[str], stdin_text: str, outdir: str, logdir: Optional[str], timeout: float,
+                 chk: Checker, what: str = "filter") -> Optional[str]:
+    """Pipe stdin_text through a shell command (sh -c): a run's filter, or the post command (stdin empty); the
+    command's stdout, or None when it failed. No command: stdin_text itself.
+
+    Exit status 1 is accepted (grep matching nothing); higher ones are errors.
+    """
+    if not command:
+        return stdin_text
+    res = run_process(["sh", "-c", substitute(command, outdir, logdir)], shell_env(), timeout,
+                      stdin_data=stdin_text.encode("utf-8"))
     if res.timed_out or res.returncode not in (0, 1):
-        chk.fail(f"filter failed ({'timeout' if res.timed_out else describe_exit(res.returncode)})",
-                 [f"  filter: {spec.filter}"] + ["  " + l for l in tail(res.stderr, 5)])
+        chk.fail(f"{what} failed ({'timeout' if res.timed_out else describe_exit(res.returncode)})",
+                 [f"  {what}: {command}"] + ["  " + l for l in tail(res.stderr, 5)])
         return None
     return res.stdout
 
@@ -859,15 +952,28 @@ def check_files(spec: Spec, absdir: str, chk: Checker) -> None:
             chk.fail(f"{item} was not produced")
 
 
-def check_stderr(spec: Spec, run: RunOutput, chk: Checker) -> None:
-    """The stderr regex and, for error-path tests, the crash markers."""
-    if spec.stderr is not None or spec.exit == "nonzero":
-        crash = CRASH_RE.search(run.stdout + "\n" + run.stderr)
+def stderr_pattern(pattern: "re.Pattern[str]", outdir: str) -> "re.Pattern[str]":
+    """A stderr regex with {outdir} and {root} replaced by the paths, escaped."""
+    if "{outdir}" not in pattern.pattern and "{root}" not in pattern.pattern:
+        return pattern
+    text = pattern.pattern.replace("{outdir}", re.escape(outdir)).replace("{root}", re.escape(ROOT))
+    return re.compile(text, pattern.flags)
+
+
+def check_stderr(run: Run, out: RunOutput, chk: Checker, prefix: str = "", outdir: str = "") -> None:
+    """A run's stderr regex and, for error-path runs, the crash markers; for a run that must end normally and whose
+    stderr the spec leaves free, no option that went unused."""
+    if run.stderr is not None or run.exit == "nonzero":
+        crash = CRASH_RE.search(out.stdout + "\n" + out.stderr)
         if crash:
-            chk.fail(f"crash marker {crash.group()!r} in output")
-    if spec.stderr is not None and not spec.stderr.search(run.stderr):
-        chk.fail(f"stderr does not match /{shorten(spec.stderr.pattern, 60)}/",
-                 ["  stderr: " + l for l in tail(run.stderr, SHORT_TAIL_LINES)] or ["  stderr: (empty)"])
+            chk.fail(f"{prefix}crash marker {crash.group()!r} in output")
+    if run.stderr is not None and not stderr_pattern(run.stderr, outdir).search(out.stderr):
+        chk.fail(f"{prefix}stderr does not match /{shorten(run.stderr.pattern, 60)}/",
+                 ["  stderr: " + l for l in tail(out.stderr, SHORT_TAIL_LINES)] or ["  stderr: (empty)"])
+    if run.stderr is None and run.exit == "0":
+        unused = UNUSED_RE.findall(out.stderr) + UNUSED_RE.findall(out.stdout)
+        if unused:
+            chk.fail(f"{prefix}an option went unused: {shorten(unused[0].strip(), 100)}", ["  " + l for l in unused])
 
 
 def prepare_outdir(absdir: str) -> None:
@@ -876,37 +982,85 @@ def prepare_outdir(absdir: str) -> None:
     os.makedirs(absdir, exist_ok=True)
 
 
+def write_logs(logdir_abs: str, k: int, out: RunOutput) -> None:
+    """Keep run k's stdout and stderr in <work>/<name>.runs/run<k>.stdout and .stderr (for {stdout<k>},
+    {stderr<k>} and for reading after a failure)."""
+    for kind, text in (("stdout", out.stdout), ("stderr", out.stderr)):
+        with open(os.path.join(logdir_abs, f"run{k}.{kind}"), "w", encoding="utf-8") as fh:
+            fh.write(text)
+
+
+def join_texts(texts: Sequence[str]) -> str:
+    """The compared text of several runs: their filtered stdouts and the post command's, each ending a line."""
+    if len(texts) == 1:
+        return texts[0]
+    return "".join(t if not t or t.endswith("\n") else t + "\n" for t in texts)
+
+
 def run_test(spec: Spec, cfg: Config) -> Result:
-    """Run one (non-skipped) test and check everything its spec asks for."""
+    """Run one (non-skipped) test: its setup, its runs in order, its post command, and check everything its spec
+    asks for. A run that times out or ends with another exit status than expected stops the test."""
     absdir, outdir = outdir_paths(spec, cfg)
-    cmd = build_command(spec, cfg, outdir)
-    diag = [f"$ {shlex.join(cmd)}"] if cfg.verbose else []
+    logdir_abs, logdir = absdir + ".runs", outdir + ".runs"
+    runs = spec.all_runs()
+    diag: List[str] = []
     prepare_outdir(absdir)
-    start = time.monotonic()
-    try:
-        run = run_process(cmd, test_env(), spec.timeout)
-    except OSError as err:
-        return Result(spec.name, "fail", f"cannot run {cmd[0]}: {err}", time.monotonic() - start, tuple(diag))
-    elapsed = time.monotonic() - start
+    prepare_outdir(logdir_abs)
     chk = Checker()
-    if run.timed_out:
-        chk.fail("timeout", [f"  no exit after {spec.timeout:g} s"])
-    elif not exit_ok(spec.exit, run.returncode):
-        expected = "a nonzero exit status" if spec.exit == "nonzero" else f"exit status {spec.exit}"
-        chk.fail(f"{describe_exit(run.returncode)}, expected {expected}",
-                 [] if cfg.verbose else ["  stderr: " + l for l in head_and_tail(run.stderr, SHORT_TAIL_LINES)])
-    else:
-        check_stderr(spec, run, chk)
-        if spec.output is not None:
-            filtered = apply_filter(spec, run.stdout, outdir, chk)
-            if filtered is not None:
-                check_stdout(spec, cfg, filtered, chk)
-        check_csvs(spec, cfg, absdir, chk)
-        check_files(spec, absdir, chk)
-    return make_result(spec, cfg, chk, run, elapsed, diag)
+    start = time.monotonic()
+    last: Optional[RunOutput] = None
+    if spec.setup:
+        if cfg.verbose:
+            diag.append(f"$ (setup) {substitute(spec.setup, outdir, logdir)}")
+        res = run_process(["sh", "-c", substitute(spec.setup, outdir, logdir)], shell_env(), spec.timeout)
+        if res.timed_out or res.returncode != 0:
+            chk.fail(f"setup failed ({'timeout' if res.timed_out else describe_exit(res.returncode)})",
+                     [f"  setup: {spec.setup}"] + ["  " + l for l in tail(res.stderr, 5)])
+            return make_result(spec, cfg, chk, res, time.monotonic() - start, diag)
+    texts: List[str] = []
+    compare = spec.output is not None
+    for k, run in enumerate(runs, start=1):
+        prefix = f"run {k}: " if len(runs) > 1 else ""
+        cmd = build_command(run, cfg, outdir, logdir)
+        if cfg.verbose:
+            diag.append(f"$ {shlex.join(cmd)}")
+        try:
+            out = run_process(cmd, test_env(run.nsize), spec.timeout)
+        except OSError as err:
+            return Result(spec.name, "fail", f"{prefix}cannot run {cmd[0]}: {err}", time.monotonic() - start,
+                          tuple(diag))
+        write_logs(logdir_abs, k, out)
+        last = out
+        if out.timed_out:
+            chk.fail(f"{prefix}timeout", [f"  no exit after {spec.timeout:g} s"])
+            return make_result(spec, cfg, chk, out, time.monotonic() - start, diag)
+        if not exit_ok(run.exit, out.returncode):
+            expected = "a nonzero exit status" if run.exit == "nonzero" else f"exit status {run.exit}"
+            chk.fail(f"{prefix}{describe_exit(out.returncode)}, expected {expected}",
+                     [] if cfg.verbose else ["  stderr: " + l for l in head_and_tail(out.stderr, SHORT_TAIL_LINES)])
+            return make_result(spec, cfg, chk, out, time.monotonic() - start, diag)
+        check_stderr(run, out, chk, prefix, outdir)
+        if compare and run.compared:
+            filtered = apply_filter(run.filter, out.stdout, outdir, logdir, spec.timeout, chk,
+                                    "filter" if k == 1 else f"filter{k}")
+            if filtered is None:
+                compare = False
+            else:
+                texts.append(filtered)
+    if compare and spec.post:
+        posted = apply_filter(spec.post, "", outdir, logdir, spec.timeout, chk, "post")
+        if posted is None:
+            compare = False
+        else:
+            texts.append(posted)
+    if compare:
+        check_stdout(spec, cfg, join_texts(texts) if texts else "", chk)
+    check_csvs(spec, cfg, absdir, chk)
+    check_files(spec, absdir, chk)
+    return make_result(spec, cfg, chk, last, time.monotonic() - start, diag)
 
 
-def make_result(spec: Spec, cfg: Config, chk: Checker, run: RunOutput, elapsed: float,
+def make_result(spec: Spec, cfg: Config, chk: Checker, run: Optional[RunOutput], elapsed: float,
                 diag: List[str]) -> Result:
     """Turn the collected problems and notes into a Result."""
     if not chk.problems:
@@ -915,7 +1069,7 @@ def make_result(spec: Spec, cfg: Config, chk: Checker, run: RunOutput, elapsed: 
         diag.append(problem.summary)
         diag.extend(problem.details)
     diag.extend(chk.notes)
-    if cfg.verbose:
+    if cfg.verbose and run is not None:
         for label, text in (("stdout", run.stdout), ("stderr", run.stderr)):
             lines = tail(text, TAIL_LINES)
             diag.append(f"--- last {len(lines)} lines of {label} ---" if lines else f"--- {label}: empty ---")
@@ -1053,7 +1207,7 @@ def run_cases(cases: Sequence[Case], cfg: Config, jobs: int, reporter: Reporter)
 
     try:
         for index, case in runnable:
-            if case.spec.nsize > 1:
+            if case.spec.max_nsize() > 1:
                 concurrent.futures.wait(pending)
                 pending.clear()
                 concurrent.futures.wait([submit(index, case)])
@@ -1112,7 +1266,9 @@ def list_tests(names: Sequence[Tuple[str, bool]], cases_dir: str) -> int:
             status = 1
             print(f"{name:<{width}}  ({case.error})")
         else:
-            extra = f" [nsize {case.spec.nsize}]" if case.spec.nsize > 1 else ""
+            runs = case.spec.all_runs()
+            extra = f" [nsize {case.spec.max_nsize()}]" if case.spec.max_nsize() > 1 else ""
+            extra += f" [{len(runs)} runs]" if len(runs) > 1 else ""
             req = f" [requires {' '.join(case.spec.requires)}]" if case.spec.requires else ""
             print(f"{name:<{width}}  {case.spec.description}{extra}{req}")
     return status

@@ -240,6 +240,161 @@ files_absent: energy.csv outdir-empty
             self.assertEqual(run.parse_spec("t", "args: a\nrequires: shell\n").requires, ["shell"])
 
 
+class MultiRunSpecTest(unittest.TestCase):
+    def test_numbered_runs(self):
+        text = """args: -a {outdir}
+nsize: 2
+exit: 2
+stderr: first
+filter: grep A
+args2: -b
+exit2: nonzero
+stderr2: second
+filter2: none
+args3: -c
+nsize3: 1
+filter3: grep C
+setup: mkdir -p {outdir}/x
+post: echo done
+"""
+        spec = run.parse_spec("t", text)
+        runs = spec.all_runs()
+        self.assertEqual(len(runs), 3)
+        self.assertEqual((spec.args, spec.nsize, spec.exit), (["-a", "{outdir}"], 2, "2"))
+        self.assertEqual([r.args for r in runs], [["-a", "{outdir}"], ["-b"], ["-c"]])
+        self.assertEqual([r.nsize for r in runs], [2, 2, 1])   # nsize is inherited, the others are per run
+        self.assertEqual([r.exit for r in runs], ["2", "nonzero", "0"])
+        self.assertEqual([r.stderr.pattern if r.stderr else None for r in runs], ["first", "second", None])
+        self.assertEqual([(r.filter, r.compared) for r in runs], [("grep A", True), (None, False), ("grep C", True)])
+        self.assertEqual((spec.setup, spec.post), ("mkdir -p {outdir}/x", "echo done"))
+        self.assertEqual(spec.max_nsize(), 2)
+
+    def test_one_run(self):
+        spec = run.parse_spec("t", "args: -x\nfilter: none\n")
+        self.assertEqual(len(spec.all_runs()), 1)
+        self.assertFalse(spec.all_runs()[0].compared)
+
+    def test_errors(self):
+        for text in ["args: a\nargs3: b\n", "args: a\nexit2: 1\n", "args: a\nargs2: b\nstderr3: x\n",
+                     "args: a\nargs2: b\nexit2: maybe\n", "args: a\nargs2: b\nnsize2: 0\n",
+                     "args: a\nargs2: b\nstderr2: (\n", "args: a\nargs1: b\n", "args: a\nargs02: b\n",
+                     "args: a\nargs2: b\nargs2: c\n", "args: a\noutput2: x\n"]:
+            with self.assertRaises(run.SpecError, msg=text):
+                run.parse_spec("t", text)
+
+    def test_substitute_logs(self):
+        text = run.substitute("{outdir}/a {stdout2} {stderr10}", "out/t", "out/t.runs")
+        self.assertEqual(text, "out/t/a out/t.runs/run2.stdout out/t.runs/run10.stderr")
+
+
+FAKE_PHLEX = """#!/bin/sh
+# a stand-in for bin/phlex: out=TEXT (stdout), err=TEXT (stderr), touch=FILE, sleep=S, exit=N
+code=0
+for a in "$@"; do
+  case "$a" in
+    out=*) echo "${a#out=}" ;;
+    err=*) echo "${a#err=}" >&2 ;;
+    touch=*) : > "${a#touch=}" ;;
+    sleep=*) sleep "${a#sleep=}" ;;
+    exit=*) code="${a#exit=}" ;;
+  esac
+done
+exit $code
+"""
+
+
+class MultiRunTest(unittest.TestCase):
+    """run_test on a stand-in binary: each run checked, the texts joined, the post command's output last."""
+
+    def setUp(self):
+        import tempfile
+        self.tmp = tempfile.TemporaryDirectory()
+        self.dir = self.tmp.name
+        self.binary = os.path.join(self.dir, "fake_phlex")
+        with open(self.binary, "w") as fh:
+            fh.write(FAKE_PHLEX)
+        os.chmod(self.binary, 0o755)
+        self.cfg = run.Config(binary=self.binary, mpiexec=["mpiexec"], cases=self.dir, ref=self.dir,
+                              expected=self.dir, work=os.path.join(self.dir, "work"), verbose=False, update=False)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def run_spec(self, text, expected=None):
+        if expected is not None:
+            with open(os.path.join(self.dir, "t.out"), "w") as fh:
+                fh.write(expected)
+        return run.run_test(run.parse_spec("t", text), self.cfg)
+
+    def test_runs_filters_post(self):
+        text = """args: out=one out=skip touch={outdir}/a
+filter: grep one
+args2: out=two err=refused exit=2
+exit2: 2
+stderr2: refused
+args3: out=three
+filter3: none
+post: cat {stderr2}; ls {outdir}; cat {stdout3}
+"""
+        result = self.run_spec(text, "one\ntwo\nrefused\na\nthree\n")
+        self.assertEqual(result.status, "ok", result.diagnostics)
+        with open(os.path.join(self.cfg.work, "t.runs", "run2.stderr")) as fh:
+            self.assertEqual(fh.read(), "refused\n")
+
+    def test_compared_text_differs(self):
+        result = self.run_spec("args: out=one\nargs2: out=two\n", "one\nTWO\n")
+        self.assertEqual(result.status, "fail")
+        self.assertIn("line 2: expected TWO got two", result.reason)
+
+    def test_exit_of_a_later_run_stops_the_test(self):
+        text = "args: out=one\nargs2: exit=3\nargs3: touch={outdir}/third\noutput: none\n"
+        result = self.run_spec(text)
+        self.assertEqual(result.status, "fail")
+        self.assertEqual(result.reason, "run 2: exit status 3, expected exit status 0")
+        self.assertFalse(os.path.exists(os.path.join(self.cfg.work, "t", "third")))
+
+    def test_one_run_messages_unchanged(self):
+        result = self.run_spec("args: exit=3\noutput: none\n")
+        self.assertEqual(result.reason, "exit status 3, expected exit status 0")
+
+    def test_timeout_per_run(self):
+        result = self.run_spec("args: out=a\nargs2: sleep=5\ntimeout: 0.5\noutput: none\n")
+        self.assertEqual(result.reason, "run 2: timeout")
+
+    def test_stderr_and_crash_markers_per_run(self):
+        result = self.run_spec("args: out=a\nargs2: err=other exit=1\nexit2: 1\nstderr2: refused\noutput: none\n")
+        self.assertTrue(result.reason.startswith("run 2: stderr does not match /refused/"), result.reason)
+        result = self.run_spec("args: out=a\nargs2: err=Segmentation exit=1\nexit2: nonzero\noutput: none\n")
+        self.assertEqual(result.reason, "run 2: crash marker 'Segmentation' in output")
+
+    def test_unused_option(self):
+        warning = "err='phlex: warning: option -foo 1 was never used (misspelt?)'"
+        result = self.run_spec(f"args: out=a\nargs2: {warning}\noutput: none\n")
+        self.assertEqual(result.status, "fail")
+        self.assertTrue(result.reason.startswith("run 2: an option went unused: phlex: warning: option -foo 1"),
+                        result.reason)
+        result = self.run_spec(f"args: out=a\nargs2: {warning}\nstderr2: never used\noutput: none\n")
+        self.assertEqual(result.status, "ok", result.diagnostics)   # a stderr the spec states is its own check
+        result = self.run_spec("args: out='Option left: name:-foo value: 1'\noutput: none\n")
+        self.assertTrue(result.reason.startswith("an option went unused: Option left"), result.reason)
+
+    def test_stderr_names_outdir(self):
+        text = "args: err={outdir}/x.h5 exit=2\nexit: 2\nstderr: ^{outdir}/x\\.h5$\noutput: none\n"
+        self.assertEqual(self.run_spec(text).status, "ok")
+        text = "args: err=elsewhere/x.h5 exit=2\nexit: 2\nstderr: {outdir}/x\\.h5\noutput: none\n"
+        self.assertTrue(self.run_spec(text).reason.startswith("stderr does not match"))
+
+    def test_setup(self):
+        text = "setup: mkdir {outdir}/made\nargs: touch={outdir}/made/x\noutput: none\nfiles_present: made/x\n"
+        self.assertEqual(self.run_spec(text).status, "ok")
+        result = self.run_spec("setup: exit 3\nargs: touch={outdir}/x\noutput: none\nfiles_absent: outdir-empty\n")
+        self.assertEqual(result.reason, "setup failed (exit status 3)")
+
+    def test_post_failure(self):
+        result = self.run_spec("args: out=a\npost: exit 2\n", "a\n")
+        self.assertEqual(result.reason, "post failed (exit status 2)")
+
+
 class SelectTest(unittest.TestCase):
     def test_select(self):
         avail = ["a_1", "a_2", "b"]

@@ -19,7 +19,7 @@ PetscErrorCode PhlexExpectMax(MPI_Comm comm, const char what[], const char optio
 {
   PetscFunctionBeginUser;
   PetscCheck(observed <= bound, comm, PETSC_ERR_USER, "%s: FAIL: observed %.6e, expected <= %.3e (%s)", what, (double)observed, (double)bound, option);
-  if (print) PetscCall(PetscPrintf(comm, "%s: PASS (< %.0e)\n", what, (double)bound));
+  if (print) PetscCall(PetscPrintf(comm, "%s: PASS (< %g)\n", what, (double)bound));
   PetscFunctionReturn(0);
 }
 
@@ -53,6 +53,6 @@ PetscErrorCode PhlexExpectValues(MPI_Comm comm, const char what[], const char op
     }
   }
   PetscCheck(worst <= rtol, comm, PETSC_ERR_USER, "%s: FAIL: value %" PetscInt_FMT " observed %.10g, expected %.10g, relative error %.3e > tolerance %.3e (%s)", what, iworst + 1, (double)observed[iworst], (double)expected[iworst], (double)worst, (double)rtol, option);
-  PetscCall(PetscPrintf(comm, "%s: PASS (%" PetscInt_FMT " values within rel. tol. %.0e)\n", what, nexp, (double)rtol));
+  PetscCall(PetscPrintf(comm, "%s: PASS (%" PetscInt_FMT " values within rel. tol. %g)\n", what, nexp, (double)rtol));
   PetscFunctionReturn(0);
 }

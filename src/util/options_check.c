@@ -928,19 +928,33 @@ PetscErrorCode PhlexOptionsSetUsedOverridden(const char file[])
 }
 
 /*@C
-  PhlexOptionsWarnUnused - at the end of a run, a warning for every option that was never read
+  PhlexOptionsWarnUnused - at the end of a run, a warning for every option that was never read: one typed on the
+  command line may be misspelt; one that a scene or preset file gives passed PhlexOptionsCheckUnused, so phlex knows
+  it, and it is for another analysis or configuration (a scene's -solver_options_file or -ts_* options in a
+  linearised or reduce run): said with its file and line, not as a misspelling
 
   Collective
 @*/
 PetscErrorCode PhlexOptionsWarnUnused(MPI_Comm comm)
 {
-  PetscInt n;
-  char   **names, **values;
+  PetscInt  n;
+  char    **names, **values;
+  PetscBool given;
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsLeftGet(NULL, &n, &names, &values));
-  for (PetscInt i = 0; i < n; i++)
-    if (!ReadAtFinalize(names[i]) && !PetscGlobal(names[i])) PetscCall(PetscFPrintf(comm, PETSC_STDERR, "phlex: warning: option -%s %s was never used (misspelt?)\n", names[i], values[i] ? values[i] : ""));
+  for (PetscInt i = 0; i < n; i++) {
+    const char *value                                 = values[i] ? values[i] : "";
+    char        origin[PETSC_MAX_PATH_LEN + 64] = "";
+    if (ReadAtFinalize(names[i]) || PetscGlobal(names[i])) continue;
+    PetscCall(OnCommandLine(names[i], &given));
+    if (given) {
+      PetscCall(PetscFPrintf(comm, PETSC_STDERR, "phlex: warning: option -%s %s was never used (misspelt?)\n", names[i], value));
+      continue;
+    }
+    PetscCall(OriginText(names[i], origin, sizeof(origin)));
+    PetscCall(PetscFPrintf(comm, PETSC_STDERR, "phlex: warning: option -%s %s%s is not used: this run does not read it (another analysis or configuration does)\n", names[i], value, origin));
+  }
   PetscCall(PetscOptionsLeftRestore(NULL, &n, &names, &values));
   PetscFunctionReturn(0);
 }

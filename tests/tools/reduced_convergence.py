@@ -4,7 +4,8 @@ normal modes (--modes; --option names another option of the body that grows the 
 compares chosen series with the full body's run (--ref, already made), and checks that every
 column's error (max over time of |reduced - full| / max |full|) falls strictly as the modes grow and that the largest
 number of modes meets the stated tolerance (--tol column=bound). Prints one PASS/FAIL line per check (with the errors
-on failure, or always with --verbose); exit 1 on any failure."""
+on failure, or always with --verbose); exit 1 on any failure. With --no-run it runs nothing and compares the runs a
+test made itself (its args2, args3, ...: the runner then checks each) in OUTDIR/modes<n>."""
 import argparse
 import csv
 import os
@@ -22,6 +23,7 @@ p.add_argument("--option", default="reduction_modes", help="the body's option th
 p.add_argument("--series", required=True, help="file:column,column;file:column... compared")
 p.add_argument("--tol", required=True, help="column=bound,... for the largest number of modes")
 p.add_argument("--verbose", action="store_true")
+p.add_argument("--no-run", action="store_true", help="compare the runs already in OUTDIR/modes<n>")
 p.add_argument("args", nargs=argparse.REMAINDER, help="the scene's arguments (after --)")
 a = p.parse_args()
 args = [x for x in a.args if x != "--"]
@@ -46,12 +48,13 @@ def check(name, cond, detail=""):
 errors = []
 for n in modes:
     out = os.path.join(a.outdir, f"modes{n}")
-    shutil.rmtree(out, ignore_errors=True)
-    cmd = [a.bin] + args + ["-output_dir", out, "-progress", "0", f"-{a.body}_type", "reduced", f"-{a.body}_{a.option}", str(n)]
-    r = subprocess.run(cmd, capture_output=True, text=True)
-    if r.returncode:
-        check(f"{what} {n}: run", False, r.stderr[-300:])
-        sys.exit(1)
+    if not a.no_run:
+        shutil.rmtree(out, ignore_errors=True)
+        cmd = [a.bin] + args + ["-output_dir", out, "-progress", "0", f"-{a.body}_type", "reduced", f"-{a.body}_{a.option}", str(n)]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+        if r.returncode:
+            check(f"{what} {n}: run", False, r.stderr[-300:])
+            sys.exit(1)
     e = {}
     for fname, cols in series:
         ref, run = load(os.path.join(a.ref, fname)), load(os.path.join(out, fname))
