@@ -198,6 +198,22 @@ PetscErrorCode PhlexOutputFile(PhlexOutput out, const char name[], char tmp[])
   PetscFunctionReturn(0);
 }
 
+/* the series a failed run kept in the directory failed (phlex writes nothing but .csv there; anything else stays) */
+static void RemoveFailedSeries(const char failed[])
+{
+  DIR *d = opendir(failed);
+
+  if (!d) return;
+  for (struct dirent *e = readdir(d); e; e = readdir(d)) {
+    char         old[2 * PETSC_MAX_PATH_LEN];
+    const size_t len = strlen(e->d_name);
+    if (e->d_name[0] == '.' || len < 5 || strcmp(e->d_name + len - 4, ".csv")) continue;
+    (void)snprintf(old, sizeof(old), "%s/%s", failed, e->d_name);
+    (void)remove(old);
+  }
+  closedir(d);
+}
+
 /*@C
   PhlexOutputCommit - renames every completed output file to its final name
 
@@ -215,20 +231,9 @@ PetscErrorCode PhlexOutputCommit(PhlexOutput out)
   if (rank == 0 && out->nfiles) {
     /* results supersede the series an earlier failed run of this directory kept in failed/ */
     char failed[PETSC_MAX_PATH_LEN + 16];
-    DIR *d;
     (void)snprintf(failed, sizeof(failed), "%s/failed", out->dir);
-    if ((d = opendir(failed))) {
-      struct dirent *e;
-      while ((e = readdir(d))) {
-        char         old[2 * PETSC_MAX_PATH_LEN];
-        const size_t len = strlen(e->d_name);
-        if (e->d_name[0] == '.' || len < 5 || strcmp(e->d_name + len - 4, ".csv")) continue;
-        (void)snprintf(old, sizeof(old), "%s/%s", failed, e->d_name);
-        (void)remove(old);
-      }
-      closedir(d);
-      (void)rmdir(failed); /* fails if anything else is there: left alone */
-    }
+    RemoveFailedSeries(failed);
+    (void)rmdir(failed); /* fails if anything else is there: left alone */
   }
   PetscCallMPI(MPI_Barrier(out->comm));
   /* where the results are: the directory, then the files in the order they were opened */
@@ -277,21 +282,7 @@ PetscErrorCode PhlexOutputKeepFailed(PhlexOutput out)
   if (!nkept) return 0;
   (void)snprintf(failed, sizeof(failed), "%s/failed", out->dir);
   if (mkdir(failed, 0777) && errno != EEXIST) return 0;
-  {
-    DIR *d = opendir(failed);
-    if (d) {
-      struct dirent *e;
-      while ((e = readdir(d))) {
-        char         old[2 * PETSC_MAX_PATH_LEN];
-        const size_t len = strlen(e->d_name);
-        /* an earlier failed run's series (phlex writes nothing else there) */
-        if (e->d_name[0] == '.' || len < 5 || strcmp(e->d_name + len - 4, ".csv")) continue;
-        (void)snprintf(old, sizeof(old), "%s/%s", failed, e->d_name);
-        (void)remove(old);
-      }
-      closedir(d);
-    }
-  }
+  RemoveFailedSeries(failed); /* an earlier failed run's */
   nkept = 0;
   for (PetscInt k = 0; k < out->nfiles; k++) {
     FILE       *fp   = NULL;
