@@ -25,6 +25,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from typing import Dict, List, NamedTuple, Optional, Sequence, Tuple
@@ -722,22 +723,21 @@ def run_process(cmd: List[str], env: Dict[str, str], timeout: float,
                      out.decode("utf-8", "replace"), err.decode("utf-8", "replace"), timed_out)
 
 
-def test_env(nsize: int = 1) -> Dict[str, str]:
+def test_env(session_base: Optional[str] = None) -> Dict[str, str]:
     """The environment for test processes: ours plus OpenMPI settings.
 
     OMPI_MCA_ess_singleton_isolated: a process started without mpiexec does not spawn an
     orted (which costs seconds on some machines, e.g. a fresh chroot).
-    OMPI_MCA_sharedfp ^sm: isolated singletons share one session directory, where MPI-IO's shared-file-pointer
-    component sm makes a file named after the file opened (checkpoint.h5_cid--1-0.sm): two tests writing
-    checkpoint.h5 at once collide there, and a run that cannot make it prints 'unable to open file for mmap' on
-    stderr. HDF5 uses no shared file pointer, so the component is left out of serial runs (the other component then
-    chosen, lockedfile, keeps a .lock file beside an open file, which a run under mpiexec that aborts would leave in
-    its output directory: those keep sm, whose files are in their own job's session directory)."""
+    OMPI_MCA_orte_tmpdir_base: each run's own Open MPI session directory (session_base, made and removed by the
+    runner). Isolated singletons otherwise share one, /tmp/ompi.<host>.<uid>/jf.0/1: two starting at once can fail
+    in its mkdir ('File exists', exit 1: log_view_stages once), and MPI-IO's shared-file-pointer component makes a
+    file there named after the file opened, where two runs writing checkpoint.h5 at once collided ('unable to open
+    file for mmap' on stderr)."""
     env = dict(os.environ)
     env.update(OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMPI_MCA_rmaps_base_oversubscribe="1", OMPI_MCA_ess_singleton_isolated="1")
-    if nsize == 1:
-        env["OMPI_MCA_sharedfp"] = "^sm"
+    if session_base:
+        env["OMPI_MCA_orte_tmpdir_base"] = session_base
     return env
 
 
@@ -1024,11 +1024,14 @@ def run_test(spec: Spec, cfg: Config) -> Result:
         cmd = build_command(run, cfg, outdir, logdir)
         if cfg.verbose:
             diag.append(f"$ {shlex.join(cmd)}")
+        session_base = tempfile.mkdtemp(prefix="phlex-test-ompi-")
         try:
-            out = run_process(cmd, test_env(run.nsize), spec.timeout)
+            out = run_process(cmd, test_env(session_base), spec.timeout)
         except OSError as err:
             return Result(spec.name, "fail", f"{prefix}cannot run {cmd[0]}: {err}", time.monotonic() - start,
                           tuple(diag))
+        finally:
+            shutil.rmtree(session_base, ignore_errors=True)
         write_logs(logdir_abs, k, out)
         last = out
         if out.timed_out:
