@@ -43,11 +43,12 @@ Standard library only.
                                   [--out curve.csv] [--check]
 """
 import argparse
-import bisect
 import csv
 import math
 import os
 import sys
+
+from crankslider_midpoint import interp  # the same piecewise-linear interpolation of a reference curve
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REF = os.path.join(ROOT, "validation", "reference")
@@ -246,16 +247,6 @@ class Model:
         S = [[sum(C[r][j] * MC[k][j] for j in range(n)) for k in range(3)] for r in range(3)]
         lam = solve(S, rhs)
         return lam[0] * (-OMEGA_CR * L_CR * math.sin(OMEGA_CR * t)) + lam[1] * (OMEGA_CR * L_CR * math.cos(OMEGA_CR * t))
-
-
-def interp(xs, ys, x):
-    i = bisect.bisect_left(xs, x)
-    if i <= 0:
-        return ys[0]
-    if i >= len(xs):
-        return ys[-1]
-    t = (x - xs[i - 1]) / (xs[i] - xs[i - 1])
-    return ys[i - 1] + t * (ys[i] - ys[i - 1])
 
 
 def main():
