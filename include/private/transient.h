@@ -47,6 +47,7 @@ typedef struct {
   PetscBool   condensed; /* SNES phlexcondensed solves the stages (the preset's field split is not used) */
   PetscBool   reduced;   /* SNES phlexreduced solves the stages (Newton on velocities and discrete unknowns; the preset's field split is not used) */
   char        preset[PETSC_MAX_PATH_LEN]; /* the solver preset file ("": none) */
+  char        preset_why[256];            /* why it (the default's reason, or the option) */
   PetscInt    nretries, snes_failures, max_snes_failures; /* retries over the run; Newton failures of this step, the user's bound (-1: none) */
   char        last_retry[256]; /* why the step being taken was retried (cleared when a step is accepted) */
   char        run_retry[256];  /* why the last retried step of the run was retried */

@@ -474,27 +474,88 @@ static PetscErrorCode Watchdogs(MonitorContext *m, PetscInt step, PetscReal t, P
 }
 
 /* The solver preset (-solver_options_file) goes under the scene and the command line: insert it, then insert the
-   command line again (with its -options_file scenes) so that they keep precedence. The default follows the
-   system: one fixed flexible body (no discrete unknowns): exact.opts; flexible bodies with discrete unknowns:
-   bordered.opts; no flexible body: rigid.opts. */
-static PetscErrorCode SolverPresetOption(MPI_Comm comm, char file[])
+   command line again (with its -options_file scenes) so that they keep precedence. */
+#define PRESET_RULE "chosen for the scene and process count: exact_serial.opts (CHOLMOD) for fixed bodies on one process, exact.opts on several, exact_krylov.opts with spin or stiffening; bordered_serial.opts with discrete unknowns on one process or bodies whole on one process each, bordered.opts otherwise; rigid.opts without flexible body"
+
+static PetscErrorCode SolverPresetOption(MPI_Comm comm, const char dflt[], char file[], PetscBool *set)
 {
+  char help[1024];
+
   PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(help, sizeof(help), "Solver preset (options file) under the scene and command-line options; empty for none (default %s)", dflt));
   PetscOptionsBegin(comm, NULL, "Solver preset", NULL);
-  PetscCall(PetscOptionsString("-solver_options_file", "Solver preset (options file) under the scene and command-line options; empty for none (default: options/solver/exact.opts for fixed flexible bodies without discrete unknowns, bordered.opts with them, rigid.opts without flexible body)", "PhlexSceneSolveTransient", file, file, PETSC_MAX_PATH_LEN, NULL));
+  PetscCall(PetscOptionsString("-solver_options_file", help, "PhlexSceneSolveTransient", file, file, PETSC_MAX_PATH_LEN, set));
   PetscOptionsEnd();
   PetscFunctionReturn(0);
 }
 
-static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys, char file[])
+/* every flexible body's field unknowns on one process (-whole_bodies, -<body>_process): their solvers are sequential */
+static PetscErrorCode BodiesWhole(PhlexSystem sys, PetscBool *whole)
+{
+  PetscInt    nf = sys->nfparts;
+  PetscInt   *mine, *all;
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(sys->comm, &size));
+  *whole = PETSC_TRUE;
+  if (size == 1 || !nf) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc2(nf, &mine, nf, &all));
+  for (PetscInt i = 0; i < nf; i++) mine[i] = sys->fparts[i]->nv > 0 ? 1 : 0;
+  PetscCallMPI(MPI_Allreduce(mine, all, (PetscMPIInt)nf, MPIU_INT, MPI_SUM, sys->comm));
+  for (PetscInt i = 0; i < nf; i++)
+    if (all[i] > 1) *whole = PETSC_FALSE;
+  PetscCall(PetscFree2(mine, all));
+  PetscFunctionReturn(0);
+}
+
+/* The default preset: the fastest correct one for the scene on its processes (issue 43, BENCHMARKS.md section 37).
+   No flexible body: rigid.opts. Fixed flexible bodies alone (no discrete unknowns): exact_krylov.opts with spin or
+   stiffening (its condensed operator is not symmetric: LU), else exact_serial.opts on one process (CHOLMOD: its
+   triangular solves run near the bandwidth bound, a step about 1.25-1.7 x faster than MUMPS's, section 19) and
+   exact.opts (MUMPS) on several. With discrete unknowns (frames, joints, rigid parts): bordered_serial.opts where
+   every flexible body is whole on one process (one process, or -whole_bodies: CHOLMOD per body, section 25, 26),
+   else bordered.opts. Without SuiteSparse in the PETSc build the MUMPS presets. */
+static PetscErrorCode DefaultSolverPreset(PhlexSystem sys, char file[], char why[], size_t len)
+{
+  PetscMPIInt size;
+  PetscBool   whole = PETSC_TRUE, cholmod = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+#if defined(PETSC_HAVE_SUITESPARSE)
+  cholmod = PETSC_TRUE;
+#endif
+  PetscCallMPI(MPI_Comm_size(sys->comm, &size));
+  PetscCall(BodiesWhole(sys, &whole));
+  if (!sys->nfparts) {
+    PetscCall(PetscStrcpy(file, "options/solver/rigid.opts"));
+    PetscCall(PetscSNPrintf(why, len, "default without flexible body: dense LU of the frames and impulses"));
+  } else if (!sys->nq && sys->inexact_schur) {
+    PetscCall(PetscStrcpy(file, "options/solver/exact_krylov.opts"));
+    PetscCall(PetscSNPrintf(why, len, "default for a fixed body with spin or geometric stiffening: its condensed operator is not symmetric"));
+  } else if (!sys->nq) {
+    PetscCall(PetscStrcpy(file, size == 1 && cholmod ? "options/solver/exact_serial.opts" : "options/solver/exact.opts"));
+    PetscCall(PetscSNPrintf(why, len, "default for fixed bodies on %s: %s", size == 1 ? "one process" : "several processes", size == 1 && cholmod ? "CHOLMOD, the fastest steps" : (cholmod ? "MUMPS, parallel" : "MUMPS (this PETSc has no SuiteSparse)")));
+  } else {
+    PetscCall(PetscStrcpy(file, whole && cholmod ? "options/solver/bordered_serial.opts" : "options/solver/bordered.opts"));
+    PetscCall(PetscSNPrintf(why, len, "default with discrete unknowns%s: %s", size == 1 ? " on one process" : (whole ? ", each flexible body whole on one process" : " on several processes"), whole && cholmod ? "CHOLMOD per body, the fastest steps" : (cholmod ? "MUMPS, parallel" : "MUMPS (this PETSc has no SuiteSparse)")));
+  }
+  PetscFunctionReturn(0);
+}
+
+static PetscErrorCode InsertSolverPreset(MPI_Comm comm, PhlexSystem sys, char file[], char why[], size_t len)
 {
   PetscBool exists;
   int       argc;
   char    **argv;
+  char      dflt[PETSC_MAX_PATH_LEN];
+  PetscBool set;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscStrcpy(file, !sys->nfparts ? "options/solver/rigid.opts" : (sys->nq ? "options/solver/bordered.opts" : (sys->inexact_schur ? "options/solver/exact_krylov.opts" : "options/solver/exact.opts"))));
-  PetscCall(SolverPresetOption(comm, file));
+  PetscCall(DefaultSolverPreset(sys, dflt, why, len));
+  PetscCall(PetscStrcpy(file, dflt));
+  PetscCall(SolverPresetOption(comm, dflt, file, &set));
+  if (set) PetscCall(PetscSNPrintf(why, len, "-solver_options_file"));
   if (!file[0]) PetscFunctionReturn(0);
   PetscCall(PetscTestFile(file, 'r', &exists));
   PetscCheck(exists, comm, PETSC_ERR_FILE_OPEN, "cannot read the solver preset '%s' (option -solver_options_file; presets are in options/solver/)", file);
@@ -596,7 +657,7 @@ PetscErrorCode PhlexTransientRereadOptions(void *ctx)
   PetscCall(TransientSetFromOptions(comm, &o));
   PetscCall(PetscViewerDestroy(&o.monitor));
   PetscCall(TransientOptionsFree(&o));
-  PetscCall(SolverPresetOption(comm, file));
+  PetscCall(SolverPresetOption(comm, PRESET_RULE, file, NULL));
   {
     PetscReal rate;
     PetscBool set;
@@ -773,7 +834,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   m.monitor = o.monitor;
   if (PhlexHelpGetMode() == PHLEX_HELP_OPTIONS) {
     char file[PETSC_MAX_PATH_LEN] = "";
-    PetscCall(SolverPresetOption(scene->comm, file));
+    PetscCall(SolverPresetOption(scene->comm, PRESET_RULE, file, NULL));
     PetscCall(PetscViewerDestroy(&m.monitor));
     PetscCall(TransientOptionsFree(&o));
     PetscFunctionReturn(0);
@@ -797,7 +858,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCheck(frames || o.orth_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_orthogonality_max needs a moving frame (a floating or rigid body)");
   }
   PetscCheck(sys->njoints || o.gap_max < 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_joint_drift_max needs joints");
-  PetscCall(InsertSolverPreset(scene->comm, sys, m.preset));
+  PetscCall(InsertSolverPreset(scene->comm, sys, m.preset, m.preset_why, sizeof(m.preset_why)));
   PetscCall(TSCreate(scene->comm, &ts));
   PetscCall(TSSetDM(ts, sys->dm));
   /* linear fields (KSP only); moving frames and joints make it nonlinear (Newton) */
@@ -1174,6 +1235,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(TSGetType(ts, &type));
     PetscCall(PetscPrintf(scene->comm, "Transient: %" PetscInt_FMT " steps to t = %g s with TS %s", nsteps, (double)tfinal, type));
     if (m.theta) PetscCall(PetscPrintf(scene->comm, " (theta %g%s)", (double)m.theta_value, m.endpoint ? ", endpoint" : ""));
+    PetscCall(PetscPrintf(scene->comm, "\n  solver preset: %s (%s)", m.preset[0] ? m.preset : "none", m.preset_why));
     PetscCall(PetscPrintf(scene->comm, "\n  energy: initial %.8e J, final %.8e J", (double)(m.H0 * u->energy), (double)(m.Hprev * u->energy)));
     PetscCall(PetscPrintf(scene->comm, ", max |H - H0| %.3e J", (double)(m.max_drift * u->energy)));
     if (m.H0 > 1e-6 * m.Emax) PetscCall(PetscPrintf(scene->comm, " (%.3e of H0)", (double)(m.max_drift / m.H0)));
