@@ -230,7 +230,7 @@ static PetscErrorCode WriteSlab(PhlexFieldWriter w, const char group[], const ch
     d++;
     if (nc > 1) dims[d] = maxdims[d] = chunk[d] = count[d] = (hsize_t)nc, start[d] = 0;
   }
-  has = H5Lexists(file, group, H5P_DEFAULT);
+  has = group[0] == '/' && !group[1] ? 1 : H5Lexists(file, group, H5P_DEFAULT); /* the root group always exists */
   PetscCheck(has >= 0, w->out->comm, PETSC_ERR_LIB, "HDF5: cannot read the group %s of '%s'", group, w->h5tmp);
   grp = has ? H5Gopen2(file, group, H5P_DEFAULT) : H5Gcreate2(file, group, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
   PetscCheck(grp >= 0, w->out->comm, PETSC_ERR_FILE_WRITE, "HDF5: cannot create the group %s in '%s'", group, w->h5tmp);
