@@ -115,6 +115,7 @@ PETSC_INTERN void      PhlexQuaternionToRotation(const PetscReal[4], PetscReal[9
 PETSC_INTERN void      PhlexAxisAngleToRotation(const PetscReal[3], PetscReal, PetscReal[9]);
 PETSC_INTERN void      PhlexRotationVector(const PetscReal[9], PetscReal[3]);
 PETSC_INTERN void      PhlexRotationUpdate(PetscReal[9], const PetscReal[3]);
+PETSC_INTERN void      PhlexLeftJacobian(const PetscReal[3], PetscReal[9]);
 PETSC_INTERN void      PhlexCompleteFrame(const PetscReal[3], const PetscReal *, PetscReal[9]);
 
 /* output.c and fields.c */

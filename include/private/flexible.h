@@ -261,6 +261,11 @@ struct _p_PhlexFlexible {
   PetscReal (*port_ext)[6];   /* external port wrenches at the evaluated time (body frame) */
   PetscReal (*port_y)[6];     /* port outputs at the evaluated state */
   PetscReal (*port_ubar)[3];  /* full model: mean displacement of each port (the arm of its force beyond the drawn point) */
+  PetscReal (*port_rate)[9];  /* per port: A, the rate map of its mean rotation theta = B_r^T u, held over a step: the port
+                                 turns at w + A B_r^T v and a moment T on it acts as B_r A^T T on the field (-port_rate
+                                 exact: A = J_l(theta) at the step's extrapolated middle, PhlexJointUpdateGeometry;
+                                 first_order: A = I); the identity but on a port with a joint */
+  PetscBool  port_rate_exact, port_rate_given; /* -port_rate exact (the default) or first_order; given */
   PetscReal  t_eval, power_ext;
   PetscBool  joints_added;    /* the joint wrenches are in the loads of the evaluated state */
   Vec        bgrav;           /* fixed body: nodal gravity load */

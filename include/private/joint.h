@@ -8,6 +8,10 @@
    Its impulses Lambda_k are unknowns; their rates lambda_k are the multipliers. They enter the two parts through the
    same port distributions as wrenches, w_a = -T_a^T G S lambda on port a and w_b = T_b^T R_ab^T S lambda on port b, so
    that w_a . y_a + w_b . y_b = lambda . (c + g): the interconnection is power preserving (lossless for g = 0).
+   A flexible port's output is the exact rate of its orientation R exp(theta) (theta its patch-averaged rotation):
+   w + J_l(theta) B_r^T v, J_l the left Jacobian of SO(3) held over the step, and its distribution the transpose,
+   B_r J_l^T T (PhlexPartOps.portrate, refreshed with the joint frames in PhlexJointUpdateGeometry); with the
+   first-order rate w + B_r^T v a joint on a whirling port opens by the geometric phase 1/2 oint theta x dtheta.
 
    Force elements (issue 45): a joint may also have ne compliant rows s_i (after its nc constraint rows), each a
    small pH system with a state e_i (elongation, angle, relative displacement or rotation; unknown kind

@@ -131,6 +131,7 @@ typedef struct {
   PetscErrorCode (*portlinear)(PhlexPart, PetscInt, Vec, PetscReal, Vec, const PetscReal *, PetscReal[6]); /* dy for (a du, dv, dq); NULL: zero */
   PetscErrorCode (*portforce)(PhlexPart, PetscInt, const PetscReal[6], Vec, PetscReal *);      /* += generalized force of w (fv may be NULL) */
   PetscErrorCode (*portplacement)(PhlexPart, PetscInt, const PhlexPartVec *, PetscReal[3], PetscReal[9]); /* inertial position, orientation */
+  PetscErrorCode (*portrate)(PhlexPart, PetscInt, const PhlexPartVec *, PetscReal[9]); /* a deforming port: holds (X given) and returns the map A of its elastic rotation's rate, the port's angular velocity w + A B_r^T v (PhlexJointUpdateGeometry, once per step); NULL: none (A = I) */
   /* energy, inputs, outputs */
   PetscErrorCode (*energy)(PhlexPart, const PhlexPartVec *, PetscReal *, PetscReal *, PetscReal *); /* kinetic, strain, potential at the evaluated state X */
   PetscErrorCode (*momenta)(PhlexPart, PetscReal[3], PetscReal[3]);         /* inertial linear and angular momentum (about the origin), evaluated state; NULL: held */

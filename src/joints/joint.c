@@ -670,7 +670,9 @@ PetscErrorCode PhlexJointSetUp(PhlexJoint j, const PhlexPartVec *Xa, const Phlex
   Called at set-up and before every step, at the displacements extrapolated to the middle of the step
   (PhlexSystemUpdateJoints). Within a step P is held: the rows and the wrenches use the same directions, so the
   joint stays exactly workless, and the Jacobian has no term from P; the joint frame follows the port's elastic
-  rotation up to a lag of second order in the step. A step retried with a smaller step size (adaptive steps,
+  rotation up to a lag of second order in the step. A flexible port's rate map (the left Jacobian of its mean rotation, by which its
+  output is the exact rate of its orientation R exp(theta), and its transpose on the moment it takes) is taken here
+  too, at the same state, and held likewise (PhlexPartOps.portrate). A step retried with a smaller step size (adaptive steps,
   Newton failure) keeps the directions of the first try.
 @*/
 PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint j, const PhlexPartVec *Xa, const PhlexPartVec *Xb)
@@ -684,6 +686,10 @@ PetscErrorCode PhlexJointUpdateGeometry(PhlexJoint j, const PhlexPartVec *Xa, co
     PetscReal       xp[3], Rp[9], Rf[9];
     PetscCall(SidePlacement(j, s, X[s], xp, Rp, Rf));
     PhlexMatTMat3(Rf, Rp, P[s]);
+    if (!PhlexPartIsGround(side->part) && side->part->ops.portrate) {
+      PetscReal A[9];
+      PetscCall((*side->part->ops.portrate)(side->part, side->port, X[s], A)); /* the port's rate map, held likewise */
+    }
     if (PhlexPartIsGround(side->part))
       for (PetscInt k = 0; k < 3; k++) side->arm[k] = side->offset[k];
     else PhlexMatVec3(P[s], side->offset, side->arm);
@@ -1339,13 +1345,22 @@ PetscErrorCode PhlexJointBorderRows(PhlexJoint j, PhlexPart part, Mat Y, PetscRe
   PetscFunctionReturn(0);
 }
 
+/* a port wrench w as coefficients on the port's distribution vectors (its columns of W): (F, A^T T), A the port's
+   rate map (PhlexPartOps.portrate) */
+static void PortCoefficients(const PetscReal A[9], PetscReal w[6])
+{
+  const PetscReal T[3] = {w[3], w[4], w[5]};
+
+  PhlexMatTVec3(A, T, w + 3);
+}
+
 /*@C
   PhlexJointBorderCoefficients - beta += the coefficients on the part's border basis W of the joint's columns (the
   field force of the joint wrench lies in the span of the port's distribution: exact)
 @*/
 PetscErrorCode PhlexJointBorderCoefficients(PhlexJoint j, PhlexPart part, PetscReal shift, PetscReal *beta, PetscInt ld)
 {
-  PetscReal wJ[6];
+  PetscReal wJ[6], A[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
 
   PetscFunctionBeginUser;
   JointWrench(j, j->lambda, NULL, wJ);
@@ -1354,11 +1369,13 @@ PetscErrorCode PhlexJointBorderCoefficients(PhlexJoint j, PhlexPart part, PetscR
     if (j->side[s].part != part) continue;
     PetscCall((*part->fieldops->portbasiscolumn)(part, j->side[s].port, &c0));
     if (c0 < 0) continue; /* no field force on this port (a frame patch) */
+    if (part->ops.portrate) PetscCall((*part->ops.portrate)(part, j->side[s].port, NULL, A));
     for (PetscInt k = 0; k < NumRows(j); k++) {
       PetscReal e[PHLEX_JOINT_MAX_ROWS] = {0}, wk[6], w[2][6];
       e[k] = 1.0;
       JointWrench(j, e, NULL, wk);
       PortWrenches(j, wk, NULL, NULL, NULL, w[0], w[1]);
+      PortCoefficients(A, w[s]);
       for (PetscInt c = 0; c < 6; c++) beta[c0 + c + ld * (j->qoff + k)] -= shift * w[s][c];
     }
     for (PetscInt t = 0; t < 2; t++) {
@@ -1367,6 +1384,7 @@ PetscErrorCode PhlexJointBorderCoefficients(PhlexJoint j, PhlexPart part, PetscR
       for (PetscInt m = 0; m < 9; m++) {
         PetscReal dRab[9], dG[9], w[2][6];
         WrenchesRDerivative(j, t, m, wJ, dRab, dG, w);
+        PortCoefficients(A, w[s]);
         for (PetscInt c = 0; c < 6; c++) beta[c0 + c + ld * QIndex(p, p->frame.R + m)] -= w[s][c];
       }
     }

@@ -103,6 +103,13 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin", "Fixed body: constant angular velocity of its hub; the body's frame rotates uniformly about -spin_center (inertial loads of the rotating frame; the linearised analysis linearises about the steady spin) [rad/s]", "PhlexFlexibleSetFromOptions", 3, b->spin, &spin_given));
   b->pc_rate_tol = 1e-3;
   PetscCall(PetscOptionsReal("-preconditioner_rate_tol", "Floating body: once the Coriolis and centrifugal terms of the frame's angular velocity exceed this share of the step's shift (about w dt), the preconditioner factors them with the condensed operator (not symmetric: LU instead of Cholesky), and again whenever they drift by as much; 0: never (the symmetric operator without them)", "PhlexFlexibleSetFromOptions", b->pc_rate_tol, &b->pc_rate_tol, &rate_given));
+  {
+    /* issue 42 item 3: the rate of a port's orientation R exp(theta) is w + J_l(theta) theta', not w + theta' */
+    static const char *const rates[] = {"first_order", "exact", "PhlexPortRate", "PHLEX_PORT_RATE_", NULL};
+    PetscInt                 rate    = 1;
+    PetscCall(PetscOptionsEList("-port_rate", "Angular velocity of a port with a joint, whose orientation is R exp(theta) (theta = B_r^T u, the patch-averaged rotation): exact (w + J_l(theta) B_r^T v, J_l the left Jacobian of SO(3) at the step's middle; a moment acts as B_r J_l^T T) or first_order (w + B_r^T v: a joint on a whirling port opens by the geometric phase 1/2 int theta x dtheta)", "PhlexFlexibleSetFromOptions", rates, 2, rates[rate], &rate, &b->port_rate_given));
+    b->port_rate_exact = rate ? PETSC_TRUE : PETSC_FALSE;
+  }
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin_center", "Fixed body with -spin: a point of the spin axis (mesh coordinates) [m]", "PhlexFlexibleSetFromOptions", 3, b->spin_center, &center_given));
   PetscOptionsEnd();
   /* the self-checks of the element structure (flexible_fe.c, flexible_stress_maps.c), read here so that -help lists them */
@@ -295,6 +302,9 @@ static PetscErrorCode SetUpPorts(PhlexPart part)
     part->ports[n - 1].dim = 6;
   }
   PetscCall(PetscCalloc3(PetscMax(n, 1), &b->port_ext, PetscMax(n, 1), &b->port_y, PetscMax(n, 1), &b->port_ubar));
+  PetscCall(PetscMalloc1(PetscMax(n, 1), &b->port_rate));
+  for (PetscInt p = 0; p < n; p++)
+    for (PetscInt k = 0; k < 9; k++) b->port_rate[p][k] = (k % 4 == 0) ? 1.0 : 0.0;
   PetscCall(PetscCalloc1(PetscMax(n, 1), &b->port_basis_col));
   for (PetscInt p = 0; p < n; p++) b->port_basis_col[p] = -1;
   PetscFunctionReturn(0);
@@ -436,6 +446,7 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(VecDestroy(&b->vd));
   PetscCall(VecDestroy(&b->bgrav));
   PetscCall(PetscFree3(b->port_ext, b->port_y, b->port_ubar));
+  PetscCall(PetscFree(b->port_rate));
   PetscCall(PetscFree(b->port_basis_col));
   PetscCall(PhlexFlexibleStressMapsDestroy(b));
   PetscCall(PhlexFlexibleStiffeningDestroy(b));

@@ -10,9 +10,13 @@
    The operators Mv, Ms, G are constant in the body frame and assembled once (flexible_fe.c); the residual is a few
    sparse mat-vecs. Time derivatives arrive in SI time (X'_nondim = T X'_SI).
 
-   Port p: output y = B_p^T v (+ (v_P + w x (c - P + ubar_p), w) floating), wrench distribution B_p w on the elastic
-   rows and (F, (c - P + ubar_p) x F + T) on the frame rows: the transposes of each other, so that the port power is
-   w . y (ubar_p = B_t^T u, the port's mean displacement: full-inertia model only, as the inertia terms). */
+   Port p: output y = (B_t^T v, A_p B_r^T v) (+ (v_P + w x (c - P + ubar_p), w) floating), wrench distribution
+   B_t F + B_r A_p^T T on the elastic rows and (F, (c - P + ubar_p) x F + T) on the frame rows: the transposes of each
+   other, so that the port power is w . y (ubar_p = B_t^T u, the port's mean displacement: full-inertia model only,
+   as the inertia terms). A_p is the port's rate map (FlexPortRate): on a port with a joint, the left Jacobian
+   J_l(theta_p) of its mean rotation theta_p = B_r^T u at the step's middle, so that w + A_p theta_p' is the exact
+   angular velocity of its orientation R exp(theta_p) (issue 42 item 3), held over the step; I elsewhere (and with
+   -port_rate first_order). */
 #include <phlex_impl.h>
 #include <petsc/private/petscimpl.h> /* PetscObjectStateIncrease: blocks changed in place */
 
@@ -88,6 +92,14 @@ static PetscErrorCode ExternalLoads(PhlexPart part, PetscReal t, const PhlexPart
   PetscFunctionReturn(0);
 }
 
+/* the coefficients on port q's distribution vectors of a wrench w on it: (F, A^T T), A its rate map (the transpose of
+   the output's w + A B_r^T v, so that the power is w . y) */
+static void PortDistribution(PhlexFlexible b, PetscInt q, const PetscReal w[6], PetscReal wd[6])
+{
+  for (PetscInt k = 0; k < 3; k++) wd[k] = w[k];
+  PhlexMatTVec3(b->port_rate[q], w + 3, wd + 3);
+}
+
 /* the joint wrenches on the ports join the loads (once per evaluation) */
 static PetscErrorCode AddJointLoads(PhlexPart part)
 {
@@ -104,12 +116,15 @@ static PetscErrorCode AddJointLoads(PhlexPart part)
     for (PetscInt k = 0; k < 6; k++)
       if (w[k] != 0.0) zero = PETSC_FALSE;
     if (zero) continue;
-    if (q < b->nports)
+    if (q < b->nports) {
+      PetscReal wd[6];
+      PortDistribution(b, q, w, wd); /* the moment through the port's rate map: B_r A^T T */
       for (PetscInt k = 0; k < 6; k++) {
-        if (w[k] == 0.0) continue;
-        PetscCall(VecAXPY(bext, w[k], b->ports[q].dist[k]));
-        if (b->floating && !b->frozen_inertia && k < 3) PetscCall(VecAXPY(f->barm, w[k], b->ports[q].dist[k])); /* the Jacobian's arms */
+        if (wd[k] == 0.0) continue;
+        PetscCall(VecAXPY(bext, wd[k], b->ports[q].dist[k]));
+        if (b->floating && !b->frozen_inertia && k < 3) PetscCall(VecAXPY(f->barm, wd[k], b->ports[q].dist[k])); /* the Jacobian's arms */
       }
+    }
     if (b->floating) {
       PetscReal a[3], c[3];
       PhlexCross(part->ports[q].point, w, a);
@@ -128,8 +143,9 @@ static PetscErrorCode AddJointLoads(PhlexPart part)
 /* Ports                                                                                                          */
 
 /* Port q's output, the velocity of its mean motion (body frame): translation B_t^T V of the material velocity
-   V = v [+ v_P + w x (x - P + u)], rotation w + B_r^T v. A port turns with its mean rotation theta = B_r^T u, so its
-   angular velocity has no w x u term (to first order in theta); its position r + R (c - P + ubar) has exactly the
+   V = v [+ v_P + w x (x - P + u)], rotation w + A B_r^T v. A port turns with its mean rotation theta = B_r^T u, its
+   orientation R exp(theta), so its angular velocity has no w x u term: it is w + J_l(theta) theta' exactly (A = J_l
+   held over the step on a port with a joint: FlexPortRate; A = I, the first-order rate, elsewhere); its position r + R (c - P + ubar) has exactly the
    rate of the translation (full inertia), so a joint's position-level gap follows its velocity constraint (midpoint
    rule: exactly for translations). With a constant-inertia model the kinematics are those at u = 0 (no w x ubar): a joint on
    such a port drifts at |w x ubar|, the model's own approximation. The wrench distribution is the transpose: B w on the elastic rows; F and
@@ -153,6 +169,11 @@ static PetscErrorCode PortOutputs(PhlexPart part, const PhlexPartVec *X, PetscBo
     if (!(all || part->port_used[q])) continue;
     if (q < b->nports) PetscCall(VecMDot(X->v, 6, b->ports[q].dist, d));
     for (PetscInt k = 0; k < 6; k++) b->port_y[q][k] = PetscRealPart(d[k]);
+    if (q < b->nports) {
+      /* the elastic rotation's rate through the port's rate map: A theta' (exact: J_l(theta) theta') */
+      const PetscReal th[3] = {PetscRealPart(d[3]), PetscRealPart(d[4]), PetscRealPart(d[5])};
+      PhlexMatVec3(b->port_rate[q], th, b->port_y[q] + 3);
+    }
     if (b->floating) {
       PetscReal arm[3], a[3];
       for (PetscInt k = 0; k < 3; k++) arm[k] = part->ports[q].point[k] + ub[k];
@@ -231,6 +252,7 @@ static PetscErrorCode FlexPortLinearSummed(PhlexPart part, PetscInt q, Vec du, P
   PetscFunctionBeginUser;
   PortLinearTerms(b, q, du, au, dv, &with_v, &with_u);
   for (PetscInt k = 0; k < 6; k++) dy[k] = with_v ? sums[k] : 0.0;
+  if (with_v) PhlexMatVec3(b->port_rate[q], sums + 3, dy + 3); /* A B_r^T dv (A held over the step) */
   if (with_u) {
     /* w x d ubar */
     PetscReal dub[3], a[3];
@@ -314,6 +336,12 @@ static PetscErrorCode FlexPortLinearBlock(PhlexPart part, PetscInt q, Mat Y, Pet
     PetscCall(MatDenseRestoreArrayRead(Y, &Ya));
   }
   PetscCall(MPIU_Allreduce(loc, out, 6 * k, MPIU_REAL, MPI_SUM, b->comm));
+  if (q < b->nports)
+    for (PetscInt j = 0; j < k; j++) {
+      /* rotation: A B_r^T Y (the port's rate map) */
+      PetscReal th[3] = {out[6 * j + 3], out[6 * j + 4], out[6 * j + 5]};
+      PhlexMatVec3(b->port_rate[q], th, out + 6 * j + 3);
+    }
   if (full)
     for (PetscInt j = 0; j < k; j++) {
       /* translation: + w x (mean of Y/shift) */
@@ -331,9 +359,12 @@ static PetscErrorCode FlexPortForce(PhlexPart part, PetscInt q, const PetscReal 
   PhlexFlexible b = (PhlexFlexible)part->data;
 
   PetscFunctionBeginUser;
-  if (fv && q < b->nports)
+  if (fv && q < b->nports) {
+    PetscReal wd[6];
+    PortDistribution(b, q, w, wd);
     for (PetscInt k = 0; k < 6; k++)
-      if (w[k] != 0.0) PetscCall(VecAXPY(fv, w[k], b->ports[q].dist[k]));
+      if (wd[k] != 0.0) PetscCall(VecAXPY(fv, wd[k], b->ports[q].dist[k]));
+  }
   if (b->floating && fq) {
     PetscReal arm[3], a[3];
     for (PetscInt k = 0; k < 3; k++) arm[k] = part->ports[q].point[k] + (!b->frozen_inertia && q < b->nports ? b->port_ubar[q][k] : 0.0);
@@ -366,6 +397,29 @@ static PetscErrorCode FlexPortPlacement(PhlexPart part, PetscInt q, const PhlexP
     for (PetscInt k = 0; k < 6; k++) ub[k] = PetscRealPart(d[k]);
   }
   PhlexPortPlacementFromMean(b->floating ? X->q : NULL, part->ports[q].point, ub, x, Rp);
+  PetscFunctionReturn(0);
+}
+
+/* port q's rate map A (PhlexPartOps.portrate): with X, held at X's mean rotation theta = B_r^T u of the port (the
+   left Jacobian J_l(theta) with -port_rate exact, else I); returned in A. The port's orientation is R exp([theta]x),
+   whose angular velocity (body frame) is w + J_l(theta) theta' exactly; w + theta' is its first-order part, and the
+   difference (1/2 theta x theta' + O(theta^2) theta') integrates over a closed whirl of theta to the geometric phase
+   1/2 oint theta x dtheta, by which a joint on the port would open at each turn. Held over a step (taken at the step's
+   extrapolated middle, as the joint frames are: PhlexSystemUpdateJoints): the output and the distribution then use the
+   same A, so the joint stays exactly workless and the Jacobian has no term from A's change within the step. */
+static PetscErrorCode FlexPortRate(PhlexPart part, PetscInt q, const PhlexPartVec *X, PetscReal A[9])
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+
+  PetscFunctionBeginUser;
+  if (X && q < b->nports && b->port_rate_exact) {
+    PetscScalar d[3];
+    PetscReal   th[3];
+    PetscCall(VecMDot(X->u, 3, b->ports[q].dist + 3, d));
+    for (PetscInt k = 0; k < 3; k++) th[k] = PetscRealPart(d[k]);
+    PhlexLeftJacobian(th, b->port_rate[q]);
+  }
+  for (PetscInt k = 0; k < 9; k++) A[k] = b->port_rate[q][k];
   PetscFunctionReturn(0);
 }
 
@@ -1177,6 +1231,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->ops.portlinear    = FlexPortLinear;
   part->ops.portforce     = FlexPortForce;
   part->ops.portplacement = FlexPortPlacement;
+  part->ops.portrate      = FlexPortRate;
   part->fieldops->evaluatebegin            = FlexEvaluateBegin;
   part->fieldops->fieldoperators           = FlexFieldOperators;
   part->fieldops->mixedoperators           = FlexMixedOperators;

@@ -74,6 +74,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscCall(PhlexPartCreate_Flexible(r->full));
   PetscCall((*r->full->ops.setfromoptions)(r->full));
   r->fb = b  = (PhlexFlexible)r->full->data;
+  PetscCheck(!(b->port_rate_given && b->port_rate_exact), part->comm, PETSC_ERR_SUP, "body %s: -%sport_rate exact is not implemented for a reduced body (its ports turn at the first-order rate w + B_r^T v); use -%sport_rate first_order or -%stype flexible", part->name, part->prefix, part->prefix, part->prefix);
   r->nmodes  = 10;
   r->expect_rtol  = 1e-6;
   r->nexpect_held = r->nexpect_full = 64;

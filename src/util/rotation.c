@@ -176,6 +176,27 @@ void PhlexRotationVector(const PetscReal R[9], PetscReal phi[3])
   for (PetscInt k = 0; k < 3; k++) phi[k] = s > 0 ? q[1 + k] / s * angle : 2.0 * q[1 + k]; /* small angles: 2 q_v */
 }
 
+/* The left Jacobian of SO(3) at the rotation vector theta: d/dt exp([theta]x) = [J_l(theta) theta']x exp([theta]x),
+   J_l = I + (1 - cos a)/a^2 [theta]x + (a - sin a)/a^3 [theta]x^2 (a = |theta|; series below 1e-4: I + [theta]x/2 +
+   [theta]x^2/6, its error a^2/24 of the last term). exp(theta) turns with the angular velocity J_l theta' in the frame it
+   is applied in (a flexible port's orientation R exp(theta): w + J_l theta' in the body frame) */
+void PhlexLeftJacobian(const PetscReal theta[3], PetscReal J[9])
+{
+  const PetscReal a = PhlexNorm3(theta);
+  PetscReal       S[9], S2[9], c1, c2;
+
+  if (a < 1e-4) {
+    c1 = 0.5 - a * a / 24.0;
+    c2 = 1.0 / 6.0 - a * a / 120.0;
+  } else {
+    c1 = (1.0 - PetscCosReal(a)) / (a * a);
+    c2 = (a - PetscSinReal(a)) / (a * a * a);
+  }
+  PhlexSkew(theta, S);
+  PhlexMatMat3(S, S, S2);
+  for (PetscInt k = 0; k < 9; k++) J[k] = (k % 4 == 0 ? 1.0 : 0.0) + c1 * S[k] + c2 * S2[k];
+}
+
 /* R <- R exp([theta]x): a rotation by the body-frame rotation vector theta (assembly and drift corrections) */
 void PhlexRotationUpdate(PetscReal R[9], const PetscReal theta[3])
 {
