@@ -122,8 +122,6 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   PetscCheck(!spin_given || !motion, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin is the prescribed spin of a fixed body's hub; a floating body spins through its frame (-%sangular_velocity, or a driven joint)", b->name, b->prefix, b->prefix);
   PetscCheck(!center_given || spin_given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin_center without -%sspin: give the spin's angular velocity", b->name, b->prefix, b->prefix);
   PetscCheck(!b->ic_steady_spin || motion, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin on a fixed body: it starts a floating body (-%smotion floating) in the steady state of its frame's spin; a fixed body's prescribed spin (-%sspin) has its steady state in the linearised analysis", b->name, b->prefix, b->prefix, b->prefix);
-  PetscCheck(!b->ic_steady_spin || b->ic_displacement.type == PHLEX_IC_ZERO, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -%sic_displacement_type %s: the steady spin gives the displacement (its centrifugal stretch); perturb it with an initial velocity (-%sic_velocity_type)", b->name, b->prefix, b->prefix, PhlexICTypes[b->ic_displacement.type], b->prefix);
-  PetscCheck(!b->ic_steady_spin || b->ic_stress.type == PHLEX_IC_ZERO, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -%sic_stress_type uniform: the steady spin gives the stress (its centrifugal tension)", b->name, b->prefix, b->prefix);
   b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
   b->rcm            = order ? PETSC_TRUE : PETSC_FALSE;
   b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
@@ -351,10 +349,12 @@ static PetscErrorCode FlexSetUp(PhlexPart part)
     /* a steady spin has no load that turns in the rotating frame, nor one that does work */
     PetscBool loaded = (PetscBool)(b->has_body_force || b->frame_loaded);
     char      g[3][32];
-    for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(part->gravity[k], g[k], sizeof(g[k]));
+    for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(part->gravity[k] * part->units->velocity / part->units->time, g[k], sizeof(g[k])); /* SI */
     PetscCheck(part->gravity[0] == 0 && part->gravity[1] == 0 && part->gravity[2] == 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -gravity %s,%s,%s: the weight turns in the spinning frame, so the spin has no steady state; remove -gravity or start from rest", b->name, b->prefix, g[0], g[1], g[2]);
     for (PetscInt q = 0; q < b->nports; q++)
       if (b->ports[q].load.loaded) loaded = PETSC_TRUE;
+    PetscCheck(b->ic_displacement.type == PHLEX_IC_ZERO, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -%sic_displacement_type %s: the steady spin gives the displacement (its centrifugal stretch); perturb it with an initial velocity (-%sic_velocity_type)", b->name, b->prefix, b->prefix, PhlexICTypes[b->ic_displacement.type], b->prefix);
+    PetscCheck(b->ic_stress.type == PHLEX_IC_ZERO, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -%sic_stress_type uniform: the steady spin gives the stress (its centrifugal tension)", b->name, b->prefix, b->prefix);
     PetscCheck(!loaded, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with a load on the body (a port, frame or body force): the steady spin is that of the unloaded body; remove the load or start from rest", b->name, b->prefix);
   }
   if (!b->floating && (part->gravity[0] != 0 || part->gravity[1] != 0 || part->gravity[2] != 0)) {
