@@ -762,6 +762,7 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   part->analysisops->steadystate = PhlexFlexibleSpinSteadyState;
   part->analysisops->spinrate    = PhlexFlexibleSpinRate;
   part->analysisops->steadystart = PhlexFlexibleSteadySpinStart;
+  part->analysisops->steadydrive = PhlexFlexibleSteadyDrive;
   PetscCall(PhlexFlexibleSetDynamicsOps(part));
   PetscFunctionReturn(0);
 }

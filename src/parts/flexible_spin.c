@@ -267,6 +267,7 @@ PetscErrorCode PhlexFlexibleSpinDestroy(PhlexFlexible b)
   PetscCall(VecDestroy(&b->fcen));
   PetscCall(VecDestroy(&b->fcen1));
   PetscCall(KSPDestroy(&b->steady_ksp));
+  PetscCall(MatDestroy(&b->Kspin));
   PetscFunctionReturn(0);
 }
 
@@ -333,5 +334,44 @@ PetscErrorCode PhlexFlexibleSteadySpinStart(PhlexPart part, PhlexPartVec *X, Pet
     PetscCall(PetscPrintf(b->comm, "Steady spin start: body %s in the steady state of its frame's spin, %.10g rad/s about %.6g,%.6g,%.6g (body frame) through %.6g,%.6g,%.6g m (mesh): largest stretch %.6e m\n", b->name, (double)rate, (double)a[0], (double)a[1], (double)a[2], (double)cc[0], (double)cc[1], (double)cc[2], (double)(umax * un->length)));
   }
   *done = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleSteadyDrive - the linearised analysis of a rotor (part contract analysisops->steadydrive): a floating
+  body held at its frame patch by a revolute to the ground driven at a constant rate moves steadily, a uniform
+  rotation w about the joint's axis. In the co-rotating frame (the body's frame) the state is constant: the field's
+  equations are those of a fixed body on a hub spinning at w about that axis (Coriolis, centrifugal load and
+  softening: flexible_spin.c's operators, in the floating body's residual and Jacobian while it is so marked), and
+  the frame is held by the joint's six rows (the drive's among them), so no perturbation moves it and the frame's
+  own inertial terms of the spin do not enter the modes. Its steady state (the centrifugal stretch) and the sweep
+  over the rate then come from the spin's analysis ops. Called before the system is built (the field operators
+  then carry the spin's). w and c inertial, as drawn [rad/s, m]; mapped to the body frame and the mesh by the
+  initial pose.
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleSteadyDrive(PhlexPart part, PetscInt port, const PetscReal w[3], const PetscReal *cgiven)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscReal     rate = PetscSqrtReal(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), c[3];
+
+  PetscFunctionBeginUser;
+  if (!b->floating) PetscFunctionReturn(0); /* a fixed body on a joint: nothing turns it */
+  PetscCheck(rate > 0 && !b->Cor, b->comm, PETSC_ERR_PLIB, "body %s: a steady drive needs a rate", b->name);
+  PetscCheck(b->frame_patch[0] && port == b->nports, b->comm, PETSC_ERR_USER_INPUT, "linearized analysis: body %s turns on a driven revolute at its port %s, not at its frame patch: its frame does not turn steadily with the hub; join the hub at the frame patch (-%sframe_patch %s)", b->name, part->ports[port].name, b->prefix, part->ports[port].name);
+  PetscCheck(!b->damped, b->comm, PETSC_ERR_USER_INPUT, "linearized analysis: body %s, a rotor on a driven revolute, with structural damping: not implemented about a spin (as -%sspin)", b->name, b->prefix);
+  for (PetscInt k = 0; k < 3; k++) c[k] = cgiven ? cgiven[k] : b->pose.position[k]; /* the frame patch's point: P */
+  for (PetscInt k = 0; k < 3; k++) {
+    PetscReal wb = 0, cb = 0;
+    for (PetscInt i = 0; i < 3; i++) {
+      wb += b->pose.rotation[3 * i + k] * w[i];                        /* R^T w */
+      cb += b->pose.rotation[3 * i + k] * (c[i] - b->pose.position[i]); /* R^T (c - r_P) */
+    }
+    b->spin[k]        = wb;
+    b->spin_axis[k]   = wb / rate;
+    b->spin_center[k] = b->origin[k] + cb;
+  }
+  b->spinning = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
