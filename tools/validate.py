@@ -236,7 +236,7 @@ def rotating_transient(out, S, walls, quick):
                                              "-ts_dt", repr(dt), "-ts_max_steps", str(steps), "-ts_max_time", "10", "-body0_angular_velocity", "0,0,%.12g" % W, "-joint0_drive_velocity", "%.12g" % W] + extra, out)
         walls.append(("spin_transient_%d (%d steps)" % (b, steps), w))
         args += ["--run", "%.12g:%s" % (W, d)]
-    p = subprocess.run([sys.executable, os.path.join(ROOT, "tests", "tools", "spin_frequencies.py"), "--linearized", lin, "--dt", repr(dt), "--omega-ref", repr(omega0), "--order", "16",
+    p = subprocess.run([sys.executable, os.path.join(ROOT, "tests", "tools", "spin_frequencies.py"), "--linearized", lin, "--dt", repr(dt), "--omega-ref", repr(omega0), "--order", "16", "--stride", "8",
                         "--rtol", "1e-4", "--nominal-rtol", "2e-3", "--out", os.path.join(out, "spin_transient.csv")] + args, cwd=ROOT, capture_output=True, text=True)
     for l in p.stdout.splitlines():
         if l.startswith("largest"):

@@ -1337,7 +1337,9 @@ static PetscErrorCode SpinningPart(PhlexSystem sys, PhlexPart *spun, PetscInt *n
 - -linearized_eps_*, -linearized_st_*     - SLEPc options (defaults: Krylov-Schur, shift-and-invert, LDL^T by MUMPS)
 
   Notes:
-  A driven joint is held at its position (its drive row is a constraint: a clamped crank). A body with -spin is
+  A driven joint is held at its position (its drive row is a constraint: a clamped crank), but for a rotor (a
+  floating body held at its frame patch by a revolute to the ground driven at a constant rate, and by nothing else:
+  SteadyDrives), which is linearised about its steady spin in the co-rotating frame as a body with -spin. A body with -spin is
   linearised about its steady spin in its rotating frame: the centrifugal stretch u0 and its stress (Newton with
   -geometric_stiffening), the stiffness G(u0)^T Ms^{-1} G(u0) + K_sigma + Cen and the Coriolis coupling. Writes
   linearized_modes.csv (every mode of every configuration), linearized_sweep.csv (one row per configuration) and the

@@ -6,8 +6,8 @@ Each transient (--run W:DIR, W the drive's rate in rad/s) is the beam of tests/s
 started in its steady spin (-body0_ic_steady_spin) with a small velocity perturbation, with a port on its tip face
 (-body0_ports C). The tip's deflection in the body frame, R^T (x_C - r_P) from <body>_ports.csv and <body>_rigid.csv,
 has a flapwise (z, out of the plane of rotation) and a lagwise (y) component, which the beam's symmetry decouples.
-Each is fitted by linear prediction (Prony, least squares by Householder QR, --order coefficients) on the
-samples; the roots of its polynomial (Durand-Kerner, then Newton) are the discrete modes z_k, and the mode of
+Each is fitted by linear prediction (Prony, least squares by Householder QR, --order coefficients) on every
+--stride-th sample; the roots of its polynomial (Durand-Kerner, then Newton) are the discrete modes z_k, and the mode of
 largest amplitude (a second least-squares fit of the amplitudes) is the one the perturbation put in (the first:
 the start is the Euler-Bernoulli first mode). Its angle per step theta is the implicit midpoint rule's map of the
 pulsation, theta = 2 atan(omega dt / 2), inverted exactly: omega = 2 tan(theta / 2) / dt, so the period error of the
@@ -130,8 +130,11 @@ def roots(c):
     return out
 
 
-def dominant_angle(x, order):
-    """the angle per sample of the largest-amplitude oscillating mode of x (linear prediction)"""
+def dominant_angle(x, order, stride=1):
+    """the angle per sample of the largest-amplitude oscillating mode of x (linear prediction on every stride-th
+    sample: densely sampled, consecutive samples are nearly collinear and the prediction ill-conditioned; the modes are
+    the same, their angles times stride, which must stay below pi for the dominant one)"""
+    x = x[::stride]
     n = len(x)
     A = [[x[k - j] for j in range(1, order + 1)] for k in range(order, n)]
     b = [x[k] for k in range(order, n)]
@@ -148,7 +151,9 @@ def dominant_angle(x, order):
         amp = abs(ci) * max(1.0, abs(z) ** (n - 1))
         if best is None or amp > best[0]:
             best = (amp, th, abs(z))
-    return best
+    if best is None:
+        return None
+    return (best[0], best[1] / stride, best[2] ** (1.0 / stride))
 
 
 def read_linearized(path):
@@ -201,6 +206,7 @@ def main():
     ap.add_argument("--body", default="beam")
     ap.add_argument("--port", default="C")
     ap.add_argument("--order", type=int, default=12)
+    ap.add_argument("--stride", type=int, default=1, help="fit every stride-th sample (keep the dominant mode's angle per fitted sample below pi)")
     ap.add_argument("--rtol", type=float, default=1e-4)
     ap.add_argument("--nominal-rtol", type=float, default=None)
     ap.add_argument("--out", default=None)
@@ -225,7 +231,7 @@ def main():
         for name, sig, idx in (("flap1", zs, 1), ("lag1", ys, 0)):
             if W == 0:
                 idx = 0  # at rest flap and lag are the same pair
-            fit = dominant_angle(sig, a.order)
+            fit = dominant_angle(sig, a.order, a.stride)
             if fit is None:
                 print("Omega_bar %.4g %s: no oscillating mode found in the tip deflection: FAIL" % (ob, name))
                 ok = False
