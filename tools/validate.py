@@ -8,7 +8,10 @@ with 5-40 normal modes, the flexible pendulum's bar, the hinged beam, each again
 body's run and the full body's frequencies; reduced_crankslider_modes.csv, reduced_convergence.png), checks each metric with the tools that the regression tests use
 (tools/compare_fourbar.py, tools/crankslider_midpoint.py, tools/check_hinged_beam.py, tools/rotating_cantilever.py),
 runs the independent beam model of the crank-slider in the paper's own frame for the readings of its constant-inertia
-model (case "paper_frame", tools/crankslider_beam_model.py: issue 42), and writes under validation/:
+model (case "paper_frame", tools/crankslider_beam_model.py: issue 42), the rotating cantilever's beam floating on a
+driven hub, its flap and lag frequencies from transients started in the steady spin against the fixed-hub linearised
+analysis (case "rotating_transient", tests/tools/spin_frequencies.py: issue 42 item 5; --cases chooses the cases),
+and writes under validation/:
   <case>_*.csv                   the computed curves beside the references
   <case>.png                     plots of them (matplotlib; skipped with a note when it is missing)
   summary.csv, summary.md        case, metric, tolerance, value, pass/fail, and the wall time of each run
