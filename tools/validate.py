@@ -8,7 +8,10 @@ with 5-40 normal modes, the flexible pendulum's bar, the hinged beam, each again
 body's run and the full body's frequencies; reduced_crankslider_modes.csv, reduced_convergence.png), checks each metric with the tools that the regression tests use
 (tools/compare_fourbar.py, tools/crankslider_midpoint.py, tools/check_hinged_beam.py, tools/rotating_cantilever.py),
 runs the independent beam model of the crank-slider in the paper's own frame for the readings of its constant-inertia
-model (case "paper_frame", tools/crankslider_beam_model.py: issue 42), and writes under validation/:
+model (case "paper_frame", tools/crankslider_beam_model.py: issue 42), the rotating cantilever's beam floating on a
+driven hub, its flap and lag frequencies from transients started in the steady spin against the fixed-hub linearised
+analysis (case "rotating_transient", tests/tools/spin_frequencies.py: issue 42 item 5; --cases chooses the cases),
+and writes under validation/:
   <case>_*.csv                   the computed curves beside the references
   <case>.png                     plots of them (matplotlib; skipped with a note when it is missing)
   summary.csv, summary.md        case, metric, tolerance, value, pass/fail, and the wall time of each run
@@ -18,6 +21,7 @@ Exit status 1 if a checked metric fails. Usage: python3 tools/validate.py [--out
 """
 import argparse
 import csv
+import math
 import os
 import re
 import shutil
@@ -214,6 +218,36 @@ def rotating(out, S, walls, quick):
         for l in lines:
             if l.startswith("largest"):
                 S.add("rotating cantilever", what, l, checked=checked)
+
+
+def rotating_transient(out, S, walls, quick):
+    """issue 42 item 5: the flapwise and lagwise frequencies of the beam floating on its driven hub, measured from
+    transients started in the steady spin, against the fixed-hub linearised analysis of the same mesh"""
+    print("rotating beam on a driven hub, transients from the steady spin against the linearised analysis (Omega_bar = 0..10)")
+    omega0, dt, steps = 29.95723, 2.5e-4, 480  # 480 steps: two periods of the slowest mode (lag1 at rest, 105 rad/s)
+    bars = [0, 5, 10] if quick else list(range(11))
+    rates = [b * omega0 for b in bars]
+    stage = [2 * math.tan(w * dt / 2) / dt for w in rates]
+    sweep = ",".join("%.12g" % w for w in sorted(set(rates + stage)))
+    d, w = run("spin_transient_linearized", ["-options_file", "tests/scenes/rotating_cantilever_single.yaml", "-linearized_spin_sweep", sweep, "-linearized_nev", "2"], out)
+    walls.append(("spin_transient_linearized (%d spin rates)" % (2 * len(rates) - 1), w))
+    lin = os.path.join(d, "linearized_modes.csv")
+    args = []
+    for b, W in zip(bars, rates):
+        extra = ["-body0_ic_steady_spin"] if W > 0 else []
+        d, w = run("spin_transient_%d" % b, ["-options_file", "tests/scenes/rotating_floating.yaml", "-body0_geometric_stiffening", "-body0_ic_velocity_direction", "0,1,1", "-body0_ports", "C",
+                                             "-ts_dt", repr(dt), "-ts_max_steps", str(steps), "-ts_max_time", "10", "-body0_angular_velocity", "0,0,%.12g" % W, "-joint0_drive_velocity", "%.12g" % W] + extra, out)
+        walls.append(("spin_transient_%d (%d steps)" % (b, steps), w))
+        args += ["--run", "%.12g:%s" % (W, d)]
+    p = subprocess.run([sys.executable, os.path.join(ROOT, "tests", "tools", "spin_frequencies.py"), "--linearized", lin, "--dt", repr(dt), "--omega-ref", repr(omega0), "--order", "16", "--stride", "8",
+                        "--rtol", "1e-4", "--nominal-rtol", "2e-3", "--out", os.path.join(out, "spin_transient.csv")] + args, cwd=ROOT, capture_output=True, text=True)
+    for l in p.stdout.splitlines():
+        if l.startswith("largest"):
+            S.add("rotating beam on a driven hub", "floating, full inertia, stiffening, 8 cells, dt %g, steady start" % dt, l)
+        elif l.strip():
+            S.add("rotating beam on a driven hub", "per rate", l, checked=False)
+    if p.returncode and not any(l.startswith("largest") for l in p.stdout.splitlines()):
+        S.add("rotating beam on a driven hub", "spin_frequencies.py", "failed: " + (p.stderr.strip().splitlines() or ["?"])[-1] + ": FAIL")
 
 
 def full_frequencies(name, args, out, n):
@@ -492,7 +526,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", default=os.path.join(ROOT, "validation"))
     ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--cases", default="fourbar,crankslider,paper_frame,hinged,rotating,reduced")
+    ap.add_argument("--cases", default="fourbar,crankslider,paper_frame,hinged,rotating,rotating_transient,reduced")
     ap.add_argument("--plots-only", action="store_true", help="only redraw the PNGs from the CSV files in --out")
     a = ap.parse_args()
     if a.plots_only:
@@ -502,7 +536,7 @@ def main():
     S, walls = Summary(), []
     t0 = time.time()
     for c in a.cases.split(","):
-        {"fourbar": fourbar, "crankslider": crankslider, "paper_frame": paper_frame, "hinged": hinged, "rotating": rotating, "reduced": reduced}[c](a.out, S, walls, a.quick)
+        {"fourbar": fourbar, "crankslider": crankslider, "paper_frame": paper_frame, "hinged": hinged, "rotating": rotating, "rotating_transient": rotating_transient, "reduced": reduced}[c](a.out, S, walls, a.quick)
     S.write(a.out, walls)
     # the plots: this interpreter's matplotlib, else the system Python's (a pyenv shim may hide python3-matplotlib)
     python = next((p for p in [sys.executable, "/usr/bin/python3"] if os.path.exists(p) and have_matplotlib(p)), None)

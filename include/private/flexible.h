@@ -293,6 +293,9 @@ struct _p_PhlexFlexible {
   Mat       Cor1, Cen1; /* the same at 1 rad/s about the axis (a sweep over the rate scales them) */
   Vec       fcen, fcen1; /* Cen (x - c): the centrifugal load at the drawn geometry; at 1 rad/s */
   KSP       steady_ksp; /* the steady spin's Newton (linearised analysis) */
+  PetscBool ic_steady_spin; /* floating: start a transient in the steady state of the frame's spin (PhlexFlexibleSteadySpinStart) */
+  Vec       ic_steady_v;    /* its elastic velocity perturbation as the initial condition gave it (the consistent start's projection left out) */
+  Mat       Kspin;          /* floating, in its drive's co-rotating frame (linearised analysis, PhlexFlexibleSteadyDrive): K_sigma + Cen */
 
   /* structural damping (flexible_damping.c): R = alpha Mv + sum over regions of (beta E + eta) / E K_region on the
      velocity rows (symmetric positive semi-definite), assembled once */
@@ -375,6 +378,8 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSpinEnergy(PhlexFlexible, Vec, PetscRea
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinSteadyState(PhlexPart, PhlexPartVec *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinRate(PhlexPart, PetscBool, PetscReal *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSpinDestroy(PhlexFlexible);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSteadySpinStart(PhlexPart, PhlexPartVec *, PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexFlexibleSteadyDrive(PhlexPart, PetscInt, const PetscReal[3], const PetscReal *);
 
 /* flexible_modes.c */
 PETSC_INTERN PetscErrorCode PhlexFlexibleComputeModes(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);

@@ -185,6 +185,8 @@ typedef struct {
   PetscErrorCode (*steadystate)(PhlexPart, PhlexPartVec *); /* its fields in the steady state of a prescribed uniform spin (NULL: at rest) */
   PetscErrorCode (*spinrate)(PhlexPart, PetscBool, PetscReal *); /* get (PETSC_FALSE) or set (PETSC_TRUE) the rate of its prescribed spin [rad/s]; -1 on get: it has none */
   PetscErrorCode (*reduce)(PhlexPart, PetscViewer);               /* -analysis reduce: its reduced model's file (built or checked at set-up), reported */
+  PetscErrorCode (*steadydrive)(PhlexPart, PetscInt, const PetscReal[3], const PetscReal *); /* linearised analysis, before the system is built: a floating body held at a port by a drive at constant rate lives in the drive's co-rotating frame (the port, angular velocity [rad/s] and a point of the axis [m] or NULL: the port's point; inertial, as drawn) */
+  PetscErrorCode (*steadystart)(PhlexPart, PhlexPartVec *, PetscBool *); /* transient: a floating body asked to start in the steady state of its frame's spin (-ic_steady_spin) takes it, from the frame's consistent velocities; PETSC_FALSE: not asked */
 } PhlexPartAnalysisOps;
 
 /* an entry of a part's analysis table, NULL when it has no such table or entry */

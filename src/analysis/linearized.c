@@ -1259,6 +1259,49 @@ static PetscErrorCode SteadyStates(Pencil *p)
   PetscFunctionReturn(0);
 }
 
+/* Rotors: a floating body held at one port by a revolute to the ground whose drive turns at a constant rate, and by
+   nothing else, moves steadily (a uniform rotation): it is linearised in its drive's co-rotating frame, where its
+   state is constant (analysisops->steadydrive, before the system is built). A driven joint of a mechanism (the
+   four-bar's crank) is held at its position, as before: its bodies do not move steadily. Refused: a rotor whose drive's
+   rate varies, and a body that turns at the start (-angular_velocity) without such a drive (a free revolute: nothing
+   makes the spin steady, and the analysis about rest would silently drop it). */
+static PetscErrorCode SteadyDrives(PhlexScene scene)
+{
+  PetscInt nrot = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < scene->njoints; k++) {
+    PhlexJoint j = scene->joints[k];
+    PetscInt   s, others = 0;
+    PhlexPart  body;
+    PetscReal  e3[3], n = 0, w[3], fmax;
+    char       rate[32];
+    if (j->drive_row < 0 || j->drive_velocity == 0 || j->type != PHLEX_JOINT_REVOLUTE) continue;
+    if (j->side[0].port >= 0 && j->side[1].port < 0) s = 0;
+    else if (j->side[1].port >= 0 && j->side[0].port < 0) s = 1;
+    else continue; /* between two bodies */
+    body = j->side[s].part;
+    if (!PhlexPartAnalysisOp(body, steadydrive)) continue;
+    for (PetscInt l = 0; l < scene->njoints; l++)
+      if (l != k && (scene->joints[l]->side[0].part == body || scene->joints[l]->side[1].part == body)) others++;
+    if (others) continue; /* in a mechanism: the drive is held */
+    PhlexFormatReal(j->drive_velocity, rate, sizeof(rate));
+    /* steady: a constant profile from t = 0 (its value the scale) */
+    fmax = j->drive_profile->scale;
+    PetscCheck(j->drive_profile->type == PHLEX_PROFILE_CONSTANT && j->drive_profile->start_time <= 0 && fmax != 0, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: body %s turns on joint %s, whose drive (-%sdrive_velocity %s) follows a profile that varies (-%sdrive_profile_*): not a steady motion; linearise about a constant rate (or at rest: -%sdrive_velocity 0)", body->name, j->name, j->prefix, rate, j->prefix, j->prefix);
+    for (PetscInt i = 0; i < 3; i++) n += j->axis[i] * j->axis[i];
+    for (PetscInt i = 0; i < 3; i++) {
+      e3[i] = j->axis[i] / PetscSqrtReal(n);
+      /* the drive turns b relative to a about e3: the body is b (+) or a, the ground b (-) */
+      w[i] = (s == 1 ? 1.0 : -1.0) * j->drive_velocity * fmax * e3[i];
+    }
+    PetscCall((*body->analysisops->steadydrive)(body, j->side[s].port, w, j->position_given ? j->position : NULL));
+    nrot++;
+  }
+  PetscCheck(nrot <= 1, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has %" PetscInt_FMT " rotors on driven revolutes; the analysis linearises about one steady spin (its co-rotating frame): one rotor per scene", nrot);
+  PetscFunctionReturn(0);
+}
+
 /* the part on a prescribed spin (a spin sweep needs exactly one) */
 static PetscErrorCode SpinningPart(PhlexSystem sys, PhlexPart *spun, PetscInt *nspun)
 {
@@ -1294,7 +1337,9 @@ static PetscErrorCode SpinningPart(PhlexSystem sys, PhlexPart *spun, PetscInt *n
 - -linearized_eps_*, -linearized_st_*     - SLEPc options (defaults: Krylov-Schur, shift-and-invert, LDL^T by MUMPS)
 
   Notes:
-  A driven joint is held at its position (its drive row is a constraint: a clamped crank). A body with -spin is
+  A driven joint is held at its position (its drive row is a constraint: a clamped crank), but for a rotor (a
+  floating body held at its frame patch by a revolute to the ground driven at a constant rate, and by nothing else:
+  SteadyDrives), which is linearised about its steady spin in the co-rotating frame as a body with -spin. A body with -spin is
   linearised about its steady spin in its rotating frame: the centrifugal stretch u0 and its stress (Newton with
   -geometric_stiffening), the stiffness G(u0)^T Ms^{-1} G(u0) + K_sigma + Cen and the Coriolis coupling. Writes
   linearized_modes.csv (every mode of every configuration), linearized_sweep.csv (one row per configuration) and the
@@ -1345,7 +1390,30 @@ PetscErrorCode PhlexSceneSolveLinearized(PhlexScene scene)
   p.coriolis = o.coriolis;
   PetscCall(PhlexLogStagePush("Phlex Modes", &PHLEX_StageModes));
   PetscCall(PetscTime(&t0));
+  PetscCall(SteadyDrives(scene));
   PetscCall(PhlexSystemCreateForScene(scene, &p.sys, &p.X));
+  {
+    /* a body that turns at the start without a drive that makes it steady (a free revolute, a body of a mechanism
+       whose drive the analysis holds): the analysis about rest drops its spin, and says so (a scene of a transient
+       linearised about its drawn configuration: tests/scenes/force_elements.yaml) */
+    PetscCall(PhlexSystemGather(p.sys, p.X, p.sys->q));
+    for (PetscInt i = 0; i < p.sys->nparts; i++) {
+      PhlexPart part = p.sys->parts[i];
+      PetscReal rate = -1, w = 0;
+      PetscBool jointed = PETSC_FALSE;
+      if (part->frame.w < 0) continue;
+      if (PhlexPartAnalysisOp(part, spinrate)) PetscCall((*part->analysisops->spinrate)(part, PETSC_FALSE, &rate));
+      if (rate >= 0) continue; /* the rotor, in its hub's co-rotating frame */
+      for (PetscInt k = 0; k < 3; k++) w += PetscSqr(p.sys->q[part->qoff + part->frame.w + k] / p.sys->units->time);
+      for (PetscInt k = 0; k < p.sys->njoints; k++)
+        if (p.sys->joints[k]->side[0].part == part || p.sys->joints[k]->side[1].part == part) jointed = PETSC_TRUE;
+      if (w > 0 && jointed) {
+        char a[32];
+        PhlexFormatReal(PetscSqrtReal(w), a, sizeof(a));
+        PetscCall(PetscFPrintf(scene->comm, PETSC_STDERR, "phlex: warning: linearized analysis: body %s turns at the start (%s rad/s: -%sangular_velocity or its initial velocity field), but no drive makes the motion steady: it is linearised about rest, its spin left out (the analysis linearises about rest, where its joints' drives are held, or about the steady spin of one floating body held at its frame patch by a revolute to the ground driven at a constant rate and by nothing else)\n", part->name, a, part->prefix));
+      }
+    }
+  }
   /* a body's damping or an element's damper: the quadratic eigenproblem of the damped assembly */
   for (PetscInt i = 0; i < p.sys->nparts; i++)
     if (p.sys->parts[i]->ops.dissipation) p.damped = PETSC_TRUE;

@@ -111,6 +111,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
     b->port_rate_exact = rate ? PETSC_TRUE : PETSC_FALSE;
   }
   PetscCall(PhlexOptionsRealN(PetscOptionsObject, b->comm, who, b->prefix, "-spin_center", "Fixed body with -spin: a point of the spin axis (mesh coordinates) [m]", "PhlexFlexibleSetFromOptions", 3, b->spin_center, &center_given));
+  PetscCall(PetscOptionsBool("-ic_steady_spin", "Floating body, transient: start in the steady state of its frame's spin (the centrifugal stretch and its stress, by the linearised analysis' Newton, at the frame's consistent velocities after the start's projection; the elastic velocity of -ic_velocity_type is a perturbation about it)", "PhlexFlexibleSteadySpinStart", b->ic_steady_spin, &b->ic_steady_spin, NULL));
   PetscOptionsEnd();
   /* the self-checks of the element structure (flexible_fe.c, flexible_stress_maps.c), read here so that -help lists them */
   PetscOptionsBegin(b->comm, NULL, "Flexible body checks", NULL);
@@ -127,6 +128,7 @@ static PetscErrorCode FlexSetFromOptions(PhlexPart part)
   }
   PetscCheck(!spin_given || !motion, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin is the prescribed spin of a fixed body's hub; a floating body spins through its frame (-%sangular_velocity, or a driven joint)", b->name, b->prefix, b->prefix);
   PetscCheck(!center_given || spin_given, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin_center without -%sspin: give the spin's angular velocity", b->name, b->prefix, b->prefix);
+  PetscCheck(!b->ic_steady_spin || motion, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin on a fixed body: it starts a floating body (-%smotion floating) in the steady state of its frame's spin; a fixed body's prescribed spin (-%sspin) has its steady state in the linearised analysis", b->name, b->prefix, b->prefix, b->prefix);
   b->floating       = motion ? PETSC_TRUE : PETSC_FALSE;
   b->rcm            = order ? PETSC_TRUE : PETSC_FALSE;
   b->frozen_inertia = inertia ? PETSC_TRUE : PETSC_FALSE;
@@ -353,6 +355,18 @@ static PetscErrorCode FlexSetUp(PhlexPart part)
     for (PetscInt q = 0; q < b->nports; q++)
       PetscCheck(!b->ports[q].load.loaded || b->ports[q].load.frame != PHLEX_DIRECTION_INERTIAL, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin %s,%s,%s with -%sport_%s_direction inertial: the body lives in the hub's rotating frame, where a direction fixed in space turns; give the load in body directions (it turns with the hub) or model the hub as a driven joint", b->name, b->prefix, w[0], w[1], w[2], b->prefix, b->ports[q].name);
   }
+  if (b->ic_steady_spin) {
+    /* a steady spin has no load that turns in the rotating frame, nor one that does work */
+    PetscBool loaded = (PetscBool)(b->has_body_force || b->frame_loaded);
+    char      g[3][32];
+    for (PetscInt k = 0; k < 3; k++) PhlexFormatReal(part->gravity[k] * part->units->velocity / part->units->time, g[k], sizeof(g[k])); /* SI */
+    PetscCheck(part->gravity[0] == 0 && part->gravity[1] == 0 && part->gravity[2] == 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -gravity %s,%s,%s: the weight turns in the spinning frame, so the spin has no steady state; remove -gravity or start from rest", b->name, b->prefix, g[0], g[1], g[2]);
+    for (PetscInt q = 0; q < b->nports; q++)
+      if (b->ports[q].load.loaded) loaded = PETSC_TRUE;
+    PetscCheck(b->ic_displacement.type == PHLEX_IC_ZERO, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -%sic_displacement_type %s: the steady spin gives the displacement (its centrifugal stretch); perturb it with an initial velocity (-%sic_velocity_type)", b->name, b->prefix, b->prefix, PhlexICTypes[b->ic_displacement.type], b->prefix);
+    PetscCheck(b->ic_stress.type == PHLEX_IC_ZERO, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with -%sic_stress_type uniform: the steady spin gives the stress (its centrifugal tension)", b->name, b->prefix, b->prefix);
+    PetscCheck(!loaded, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin with a load on the body (a port, frame or body force): the steady spin is that of the unloaded body; remove the load or start from rest", b->name, b->prefix);
+  }
   if (!b->floating && (part->gravity[0] != 0 || part->gravity[1] != 0 || part->gravity[2] != 0)) {
     /* the weight of a fixed body as a nodal load: t(l) g_c on component c (gravity is a potential: no input power) */
     PetscScalar       *ga;
@@ -451,6 +465,7 @@ static PetscErrorCode FlexDestroy(PhlexPart part)
   PetscCall(PhlexFlexibleStressMapsDestroy(b));
   PetscCall(PhlexFlexibleStiffeningDestroy(b));
   PetscCall(PhlexFlexibleSpinDestroy(b));
+  PetscCall(VecDestroy(&b->ic_steady_v));
   PetscCall(PhlexFlexibleDampingDestroy(b));
   PetscCall(PhlexFlexibleDestroyFE(b));
   PetscCall(PetscFree(part->data));
@@ -757,6 +772,8 @@ PetscErrorCode PhlexPartCreate_Flexible(PhlexPart part)
   part->analysisops->modeskind   = PhlexFlexibleModesKind;
   part->analysisops->steadystate = PhlexFlexibleSpinSteadyState;
   part->analysisops->spinrate    = PhlexFlexibleSpinRate;
+  part->analysisops->steadystart = PhlexFlexibleSteadySpinStart;
+  part->analysisops->steadydrive = PhlexFlexibleSteadyDrive;
   PetscCall(PhlexFlexibleSetDynamicsOps(part));
   PetscFunctionReturn(0);
 }

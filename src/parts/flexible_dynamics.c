@@ -520,6 +520,13 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
     PetscCall(PhlexFlexibleDampingForce(part));
     PetscCall(VecAXPY(F->v, 1.0, b->rv));
   }
+  if (b->spinning) {
+    /* a rotor's co-rotating frame in the linearised analysis (PhlexFlexibleSteadyDrive): the field's rows as a fixed
+       body's on a spinning hub, + Cor v + Cen (x - c + u); the frame is held there */
+    PetscCall(MatMultAdd(b->Cor, X->v, F->v, F->v));
+    PetscCall(MatMultAdd(b->Cen, X->u, F->v, F->v));
+    PetscCall(VecAXPY(F->v, 1.0, b->fcen));
+  }
   PetscCall(PhlexFrameResidual(&b->frame, &b->fs, X->u, X->v, b->ud, F->v, F->q));
   if (b->frame_condition == PHLEX_FRAME_MEAN_AXES) {
     /* the multipliers of int rho v = 0, int rho (x - P) x v = 0 enter through the transposed map (paper Section 5:
@@ -616,6 +623,7 @@ static PetscErrorCode MatMult_Avv(Mat A, Vec x, Vec y)
   PetscCall(MatShellGetContext(A, &b));
   PetscCall(NodeMassMult(b, b->shift, b->Bvv, x, y));
   if (b->Rsb) PetscCall(MatMultAdd(b->Rsb, x, y, y)); /* structural damping */
+  if (b->spinning) PetscCall(MatMultAdd(b->Cor, x, y, y)); /* a rotor's co-rotating frame (linearised analysis) */
   PetscFunctionReturn(0);
 }
 
@@ -630,6 +638,12 @@ static PetscErrorCode MatMult_Avc(Mat A, Vec x, Vec y)
   for (PetscInt k = 0; k < 9; k++) B[k] = b->Bvv[k] + b->Bvu[k] / b->shift;
   PetscCall(NodeMassMult(b, b->shift, B, x, y));
   if (b->Rsb) PetscCall(MatMultAdd(b->Rsb, x, y, y)); /* structural damping */
+  if (b->spinning) {
+    /* a rotor's co-rotating frame (linearised analysis): Cor + Cen / shift */
+    PetscCall(MatMultAdd(b->Cor, x, y, y));
+    PetscCall(MatMult(b->Cen, x, b->work));
+    PetscCall(VecAXPY(y, 1.0 / b->shift, b->work));
+  }
   PetscFunctionReturn(0);
 }
 
@@ -641,6 +655,7 @@ static PetscErrorCode MatMult_Avu(Mat A, Vec x, Vec y)
   PetscCall(MatShellGetContext(A, &b));
   PetscCall(NodeMassMult(b, 0.0, b->Bvu, x, y));
   if (b->stiffening) PetscCall(MatMultAdd(b->Ksig, x, y, y)); /* the initial-stress stiffness */
+  if (b->spinning) PetscCall(MatMultAdd(b->Cen, x, y, y));   /* a rotor's co-rotating frame (linearised analysis) */
   PetscFunctionReturn(0);
 }
 
@@ -734,7 +749,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
     if (b->spinning) {
       /* the spin's operators (on Sv's pattern), and room for them in the fixed body's Jvv */
       PetscCall(PhlexFlexibleSpinSetUp(b, part->units));
-      PetscCall(MatAXPY(b->Jvv, 0.0, b->Cor, DIFFERENT_NONZERO_PATTERN));
+      if (!b->floating) PetscCall(MatAXPY(b->Jvv, 0.0, b->Cor, DIFFERENT_NONZERO_PATTERN));
     }
     if (b->stiffening) PetscCall(PhlexFlexibleStiffeningSetUp(b));
     if (!b->floating && (b->spinning || b->stiffening)) {
@@ -750,7 +765,13 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   ops->G         = b->stiffening ? b->Gu : b->G;
   ops->Gt        = b->stiffening ? b->Gut : NULL; /* NULL: the system transposes G if the generic path needs G^T */
   ops->Jsu       = b->stiffening ? b->Jsu : NULL;
-  ops->Kstate    = b->floating ? (b->stiffening ? b->Ksig : NULL) : ((b->stiffening || b->spinning) ? b->Jvu : NULL);
+  if (b->floating && b->spinning) {
+    /* a rotor's co-rotating frame (linearised analysis): K_sigma + Cen at the state, refreshed at every request */
+    if (!b->Kspin) PetscCall(MatDuplicate(b->Cen, MAT_COPY_VALUES, &b->Kspin));
+    else PetscCall(MatCopy(b->Cen, b->Kspin, SAME_NONZERO_PATTERN));
+    if (b->stiffening) PetscCall(MatAXPY(b->Kspin, 1.0, b->Ksig, SUBSET_NONZERO_PATTERN));
+  }
+  ops->Kstate    = b->floating ? (b->spinning ? b->Kspin : (b->stiffening ? b->Ksig : NULL)) : ((b->stiffening || b->spinning) ? b->Jvu : NULL);
   ops->Gyro      = b->spinning ? b->Cor : NULL;
   ops->inexact_schur = (PetscBool)(b->stiffening || b->spinning);
   ops->Ms        = b->Ms;

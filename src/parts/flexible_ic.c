@@ -359,6 +359,12 @@ PetscErrorCode PhlexFlexibleInitialState(PhlexPart part, PhlexPartVec *X)
     PetscCall(RemoveRigidContent(part, X->u, au));
   }
   PetscCall(SetStressIC(part, X->u, X->s));
+  if (b->ic_steady_spin) {
+    /* the perturbation about the steady spin, kept as given (PhlexFlexibleSteadySpinStart) */
+    PetscCall(VecDestroy(&b->ic_steady_v));
+    PetscCall(VecDuplicate(X->v, &b->ic_steady_v));
+    PetscCall(VecCopy(X->v, b->ic_steady_v));
+  }
   if (b->floating) {
     PetscReal *q = X->q, Ra[3];
     PhlexMatVec3(R0, au, Ra);

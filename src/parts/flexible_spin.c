@@ -267,5 +267,111 @@ PetscErrorCode PhlexFlexibleSpinDestroy(PhlexFlexible b)
   PetscCall(VecDestroy(&b->fcen));
   PetscCall(VecDestroy(&b->fcen1));
   PetscCall(KSPDestroy(&b->steady_ksp));
+  PetscCall(MatDestroy(&b->Kspin));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleSteadySpinStart - -<body>_ic_steady_spin: a floating body's transient starts in the steady state of
+  its frame's spin, so that it does not carry the start-up transient (part contract analysisops->steadystart)
+
+  Collective
+
+  Notes:
+  Called after the consistent start has put the frame's velocities on the joints (a drive's: its first step's stage
+  rate, 2 tan(W dt/2)/dt with the implicit midpoint rule, the rate at which the scheme turns the frame). In the body
+  frame that motion (v_P, w) is a uniform rotation about the axis through c = P + w x v_P / |w|^2 (a screw motion if
+  v_P has a part along w, which loads nothing). With the frame at that constant motion, the field's equations in the
+  body frame are those of a fixed body on a hub spinning at w about c (flexible_spin.c's Cor, Cen, fcen; the full
+  inertia's node-wise loads Mv (x) [w]^2 (x - P + u) and the transport of the frame's own velocity are the same
+  terms), so its steady state is the linearised analysis' one (PhlexFlexibleSpinSteadyState: Newton on
+  G(u)^T Sigma(u) + Cen u + fcen = 0): u0 and its stress. The elastic velocity is set back to the one the initial
+  condition gave (-ic_velocity_type: the perturbation; zero: the body stays on its steady state), leaving out what
+  the start's impulsive projection put there. The spin's operators are built for the Newton and freed after it:
+  the floating body's own equations carry the rotation. *done: whether the body asked for it.
+@*/
+PetscErrorCode PhlexFlexibleSteadySpinStart(PhlexPart part, PhlexPartVec *X, PetscBool *done)
+{
+  PhlexFlexible     b  = (PhlexFlexible)part->data;
+  const PhlexUnits *un = part->units;
+  PetscReal         w[3], vP[3], w2 = 0, c[3], rate, umax;
+
+  PetscFunctionBeginUser;
+  *done = PETSC_FALSE;
+  if (!b->ic_steady_spin) PetscFunctionReturn(0);
+  PetscCheck(b->floating && b->ic_steady_v && b->Sv, b->comm, PETSC_ERR_PLIB, "body %s: steady spin start without a floating body's initial state and operators", b->name);
+  for (PetscInt k = 0; k < 3; k++) {
+    vP[k] = X->q[part->frame.v + k] * un->velocity; /* SI, body frame */
+    w[k]  = X->q[part->frame.w + k] / un->time;
+    w2 += w[k] * w[k];
+  }
+  rate = PetscSqrtReal(w2);
+  PetscCheck(rate > 0, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin, but its frame does not turn at the start (angular velocity 0 after the consistent start): give it -%sangular_velocity or drive the joint that turns it", b->name, b->prefix, b->prefix);
+  PhlexCross(w, vP, c);
+  for (PetscInt k = 0; k < 3; k++) c[k] = b->origin[k] + c[k] / w2;
+  /* the spin's operators about that axis, the Newton, then the body floats again */
+  b->spinning = PETSC_TRUE;
+  for (PetscInt k = 0; k < 3; k++) {
+    b->spin[k]        = w[k];
+    b->spin_axis[k]   = w[k] / rate;
+    b->spin_center[k] = c[k];
+  }
+  PetscCall(PhlexFlexibleSpinSetUp(b, un));
+  PetscCall(PhlexFlexibleSpinSteadyState(part, X)); /* u0, Sigma(u0), v = 0 */
+  PetscCall(PhlexFlexibleSpinDestroy(b));
+  b->spinning = PETSC_FALSE;
+  for (PetscInt k = 0; k < 3; k++) b->spin[k] = b->spin_axis[k] = b->spin_center[k] = 0.0;
+  PetscCall(VecCopy(b->ic_steady_v, X->v));
+  PetscCall(VecDestroy(&b->ic_steady_v));
+  PetscCall(VecNorm(X->u, NORM_INFINITY, &umax));
+  {
+    PetscReal a[3], cc[3];
+    /* round-off of the projected velocities left out of the printed axis and centre */
+    for (PetscInt k = 0; k < 3; k++) {
+      a[k]  = PetscAbsReal(w[k]) < 1e-12 * rate ? 0.0 : w[k] / rate;
+      cc[k] = PetscAbsReal(c[k]) < 1e-12 * un->length ? 0.0 : c[k];
+    }
+    PetscCall(PetscPrintf(b->comm, "Steady spin start: body %s in the steady state of its frame's spin, %.10g rad/s about %.6g,%.6g,%.6g (body frame) through %.6g,%.6g,%.6g m (mesh): largest stretch %.6e m\n", b->name, (double)rate, (double)a[0], (double)a[1], (double)a[2], (double)cc[0], (double)cc[1], (double)cc[2], (double)(umax * un->length)));
+  }
+  *done = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleSteadyDrive - the linearised analysis of a rotor (part contract analysisops->steadydrive): a floating
+  body held at its frame patch by a revolute to the ground driven at a constant rate moves steadily, a uniform
+  rotation w about the joint's axis. In the co-rotating frame (the body's frame) the state is constant: the field's
+  equations are those of a fixed body on a hub spinning at w about that axis (Coriolis, centrifugal load and
+  softening: flexible_spin.c's operators, in the floating body's residual and Jacobian while it is so marked), and
+  the frame is held by the joint's six rows (the drive's among them), so no perturbation moves it and the frame's
+  own inertial terms of the spin do not enter the modes. Its steady state (the centrifugal stretch) and the sweep
+  over the rate then come from the spin's analysis ops. Called before the system is built (the field operators
+  then carry the spin's). w and c inertial, as drawn [rad/s, m]; mapped to the body frame and the mesh by the
+  initial pose.
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleSteadyDrive(PhlexPart part, PetscInt port, const PetscReal w[3], const PetscReal *cgiven)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscReal     rate = PetscSqrtReal(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), c[3];
+
+  PetscFunctionBeginUser;
+  if (!b->floating) PetscFunctionReturn(0); /* a fixed body on a joint: nothing turns it */
+  PetscCheck(rate > 0 && !b->Cor, b->comm, PETSC_ERR_PLIB, "body %s: a steady drive needs a rate", b->name);
+  PetscCheck(b->frame_patch[0] && port == b->nports, b->comm, PETSC_ERR_USER_INPUT, "linearized analysis: body %s turns on a driven revolute at its port %s, not at its frame patch: its frame does not turn steadily with the hub; join the hub at the frame patch (-%sframe_patch %s)", b->name, part->ports[port].name, b->prefix, part->ports[port].name);
+  PetscCheck(!b->damped, b->comm, PETSC_ERR_USER_INPUT, "linearized analysis: body %s, a rotor on a driven revolute, with structural damping: not implemented about a spin (as -%sspin)", b->name, b->prefix);
+  for (PetscInt k = 0; k < 3; k++) c[k] = cgiven ? cgiven[k] : b->pose.position[k]; /* the frame patch's point: P */
+  for (PetscInt k = 0; k < 3; k++) {
+    PetscReal wb = 0, cb = 0;
+    for (PetscInt i = 0; i < 3; i++) {
+      wb += b->pose.rotation[3 * i + k] * w[i];                        /* R^T w */
+      cb += b->pose.rotation[3 * i + k] * (c[i] - b->pose.position[i]); /* R^T (c - r_P) */
+    }
+    b->spin[k]        = wb;
+    b->spin_axis[k]   = wb / rate;
+    b->spin_center[k] = b->origin[k] + cb;
+  }
+  b->spinning = PETSC_TRUE;
   PetscFunctionReturn(0);
 }

@@ -309,6 +309,7 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
       PhlexPart p    = sys->joints[k]->side[side].part;
       PetscReal rate = -1.0;
       if (p && PhlexPartAnalysisOp(p, spinrate)) PetscCall((*p->analysisops->spinrate)(p, PETSC_FALSE, &rate));
+      if (rate >= 0 && p->frame.w >= 0) continue; /* a rotor in its hub's co-rotating frame (linearised analysis): its drive holds its frame */
       PetscCheck(rate < 0, sys->comm, PETSC_ERR_USER_INPUT, "joint %s: body %s turns on a prescribed spin (-%sspin), in its own rotating frame; it cannot be jointed to other parts (model the hub as a driven revolute joint and the body as floating)", sys->joints[k]->name, p->name, p->prefix);
     }
   PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &ops));
