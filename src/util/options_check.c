@@ -367,6 +367,8 @@ static const struct {
   unsigned    analyses;
 } cat_setup[] = {
   {"phlex_jacobian_aij",              5}, /* the system's Jacobian (transient, linearized) */
+  {"snes_phlexcondensed_balance",     1}, /* SNES phlexcondensed */
+  {"snes_phlexcondensed_guess_order", 1},
   {"snes_phlexreduced_forcing",       1}, /* SNES phlexreduced */
   {"snes_phlexreduced_velocity_rtol", 1},
 };
