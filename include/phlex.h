@@ -6,6 +6,7 @@
 #include <petscts.h>
 #include <petscdmplex.h>
 #include <slepceps.h>
+#include <slepcpep.h>
 
 typedef struct _p_PhlexScene   *PhlexScene;
 typedef struct _p_PhlexPart    *PhlexPart;  /* any part of a mechanism: flexible body, rigid body, lumped mass, ground */
@@ -88,6 +89,7 @@ PETSC_EXTERN void           PhlexOptionsOriginFree(void);
 PETSC_EXTERN PetscErrorCode PhlexInterruptPush(void);
 PETSC_EXTERN PetscErrorCode PhlexInterruptCheck(MPI_Comm, const char[]);
 PETSC_EXTERN PetscErrorCode PhlexInterruptPending(MPI_Comm, int *);
+PETSC_EXTERN PetscBool      PhlexInterruptLocal(void);
 PETSC_EXTERN int            PhlexInterruptExitCode(void);
 
 /* profile.c: scalar time profiles f(t) multiplying an input */

@@ -190,6 +190,8 @@ struct _p_PhlexFlexible {
                                            drift by as much (0: never) */
   PetscReal           pc_rate_B[9];     /* the node-wise block Bvv + Bvu / shift in the factored operator (0: none) */
   PetscInt            pc_rate_count;    /* refactorizations for the rate */
+  PetscReal           pc_rate_B_restart[9]; /* a restart's pc_rate_B, put in at its first Jacobian (checkpoint) */
+  PetscBool           pc_rate_restart;      /* pc_rate_B_restart is pending */
   PetscBool           gyroscopic;       /* with it: the gyroscopic loads kept (constant) */
   const char         *inertia_model;    /* full, constant, constant_without_gyroscopic */
   PetscReal           origin[3];        /* frame origin P (SI mesh coordinates) */
@@ -330,6 +332,8 @@ PETSC_INTERN PetscErrorCode PhlexPartitionerRegister(void);
 
 /* flexible_fe.c: spaces and constant operators */
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible, const PhlexUnits *);
+PETSC_INTERN PetscErrorCode PhlexFlexiblePreconditionerRateGet(PhlexPart, PetscReal[10]);
+PETSC_INTERN PetscErrorCode PhlexFlexiblePreconditionerRateSet(PhlexPart, const PetscReal[10]);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpInertia(PhlexFlexible, const PhlexUnits *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleGetBasis(PhlexFlexible, PetscBool, PhlexElementBasis *);

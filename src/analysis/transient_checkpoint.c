@@ -296,6 +296,15 @@ PetscErrorCode PhlexTransientCheckpointWrite(TS ts, MonitorContext *m, Vec X)
     PetscCall(PhlexSNESReducedGetContractions(snes, rec));
     PetscCall(PhlexCheckpointWriteReals(v, "/solver", "newton_contractions", PHLEX_REDUCED_NCONTRACTIONS, rec));
   }
+  if (sys->nfparts) {
+    /* the frame's rate in each body's factored preconditioner (lagged: refactored when it drifts), so that a restart
+       factors the same operator */
+    PetscReal *r;
+    PetscCall(PetscMalloc1(10 * sys->nfparts, &r));
+    for (PetscInt k = 0; k < sys->nfparts; k++) PetscCall(PhlexFlexiblePreconditionerRateGet(sys->fparts[k], r + 10 * k));
+    PetscCall(PhlexCheckpointWriteReals(v, "/solver", "preconditioner_rate", 10 * sys->nfparts, r));
+    PetscCall(PetscFree(r));
+  }
   PetscCall(PhlexTransientPortsSave(m, v)); /* the sampler of ports.csv */
   PetscCall(PhlexOutputSaveState(m->scene->output, v));
   PetscCall(PhlexCheckpointCommit(comm, tmp, m->ck_file, &v));
@@ -488,6 +497,19 @@ PetscErrorCode PhlexTransientRestart(TS ts, MonitorContext *m, PetscViewer v, co
       PetscCall(PhlexCheckpointReadReals(v, "/solver", "newton_contractions", PHLEX_REDUCED_NCONTRACTIONS, rec));
       PetscCall(TSGetSNES(ts, &snes));
       PetscCall(PhlexSNESReducedSetContractions(snes, rec));
+    }
+  }
+  if (sys->nfparts) {
+    /* absent from the checkpoints of earlier versions: the restart then factors the operator at its own state's rate
+       (the same solution to Newton's tolerance, not the same bytes) */
+    PetscBool has;
+    PetscCall(PetscViewerHDF5HasDataset(v, "/solver/preconditioner_rate", &has));
+    if (has) {
+      PetscReal *r;
+      PetscCall(PetscMalloc1(10 * sys->nfparts, &r));
+      PetscCall(PhlexCheckpointReadReals(v, "/solver", "preconditioner_rate", 10 * sys->nfparts, r));
+      for (PetscInt k = 0; k < sys->nfparts; k++) PetscCall(PhlexFlexiblePreconditionerRateSet(sys->fparts[k], r + 10 * k));
+      PetscCall(PetscFree(r));
     }
   }
   PetscCall(PhlexTransientPortsRestart(m, v, file));

@@ -13,7 +13,87 @@ typedef struct {
   char      detail[256];
 } PhlexMeshHeader;
 
-enum { MESH_OK, MESH_NO_FILE, MESH_NOT_GMSH, MESH_BAD_VERSION, MESH_TRUNCATED, MESH_BAD_NAMES, MESH_IS_DIR };
+enum { MESH_OK, MESH_NO_FILE, MESH_NOT_GMSH, MESH_BAD_VERSION, MESH_TRUNCATED, MESH_BAD_NAMES, MESH_IS_DIR, MESH_HIGH_ORDER };
+
+/* the number of nodes of gmsh's first-order element types (line, triangle, quadrangle, tetrahedron, hexahedron,
+   prism, pyramid, point); 0: any other type, which is of order 2 or more (tet10 is 11, tet20 29, ...) */
+static int FirstOrderNodes(int type)
+{
+  switch (type) {
+  case 1: return 2;
+  case 2: return 3;
+  case 3: return 4;
+  case 4: return 4;
+  case 5: return 8;
+  case 6: return 6;
+  case 7: return 5;
+  case 15: return 1;
+  default: return 0;
+  }
+}
+
+/* the first element type of order 2 or more in the $Elements section (0: none, -1: the section could not be read,
+   which PETSc's reader then reports). PETSc 3.18's gmsh reader keeps only the corner nodes of a 10-node
+   tetrahedron (its -dm_plex_gmsh_highorder gives a P1 coordinate field), so the file itself is read: ASCII and
+   binary, versions 2.2 and 4.1; with first-order elements only, a binary block is skipped by its size. */
+static int HighOrderElementType(FILE *fp, double version, int binary)
+{
+  char line[1024];
+  while (fgets(line, sizeof(line), fp))
+    if (!strncmp(line, "$Elements", 9)) break;
+  if (feof(fp)) return -1;
+  if (version >= 4.0) {
+    unsigned long long nblocks, nelem, tmin, tmax;
+    if (!binary) {
+      if (!fgets(line, sizeof(line), fp) || sscanf(line, "%llu %llu %llu %llu", &nblocks, &nelem, &tmin, &tmax) != 4) return -1;
+    } else {
+      size_t hd[4];
+      if (fread(hd, sizeof(size_t), 4, fp) != 4) return -1;
+      nblocks = hd[0];
+    }
+    for (unsigned long long b = 0; b < nblocks; b++) {
+      int                dim, tag, type, nn;
+      unsigned long long n;
+      if (!binary) {
+        if (!fgets(line, sizeof(line), fp) || sscanf(line, "%d %d %d %llu", &dim, &tag, &type, &n) != 4) return -1;
+      } else {
+        int    it[3];
+        size_t sn;
+        if (fread(it, sizeof(int), 3, fp) != 3 || fread(&sn, sizeof(size_t), 1, fp) != 1) return -1;
+        type = it[2];
+        n    = sn;
+      }
+      nn = FirstOrderNodes(type);
+      if (!nn) return type;
+      if (!binary) {
+        for (unsigned long long e = 0; e < n; e++)
+          if (!fgets(line, sizeof(line), fp)) return -1;
+      } else if (fseek(fp, (long)(n * (unsigned long long)(1 + nn) * sizeof(size_t)), SEEK_CUR)) return -1;
+    }
+    return 0;
+  }
+  {
+    long long nelem;
+    if (!fgets(line, sizeof(line), fp) || sscanf(line, "%lld", &nelem) != 1) return -1;
+    if (!binary) {
+      for (long long e = 0; e < nelem; e++) {
+        int num, type;
+        if (!fgets(line, sizeof(line), fp) || sscanf(line, "%d %d", &num, &type) != 2) return -1;
+        if (!FirstOrderNodes(type)) return type;
+      }
+      return 0;
+    }
+    for (long long e = 0; e < nelem;) {
+      int hd[3], nn;
+      if (fread(hd, sizeof(int), 3, fp) != 3 || hd[1] <= 0) return -1;
+      nn = FirstOrderNodes(hd[0]);
+      if (!nn) return hd[0];
+      if (fseek(fp, (long)hd[1] * (1 + hd[2] + nn) * (long)sizeof(int), SEEK_CUR)) return -1;
+      e += hd[1];
+    }
+    return 0;
+  }
+}
 
 static void ReadHeaderRank0(const char file[], PhlexMeshHeader *h, PhlexPhysicalGroup **groups)
 {
@@ -108,6 +188,15 @@ static void ReadHeaderRank0(const char file[], PhlexMeshHeader *h, PhlexPhysical
     free(buf);
     if (!found) h->status = MESH_TRUNCATED;
   }
+  if (h->status == MESH_OK) {
+    int type;
+    fseek(fp, 0, SEEK_SET);
+    type = HighOrderElementType(fp, h->version, h->binary);
+    if (type > 0) {
+      h->status = MESH_HIGH_ORDER;
+      snprintf(h->detail, sizeof(h->detail), "%d%s", type, type == 8 ? ", the 3-node line" : type == 9 ? ", the 6-node triangle" : type == 11 ? ", the 10-node tetrahedron" : type == 29 ? ", the 20-node tetrahedron" : "");
+    }
+  }
   fclose(fp);
 }
 
@@ -149,6 +238,10 @@ PetscErrorCode PhlexMeshReadPhysicalNames(MPI_Comm comm, const char file[], cons
     SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "%s: mesh file '%s' has a malformed $PhysicalNames section (%s)", what, file, h.detail);
   case MESH_TRUNCATED:
     SETERRQ(comm, PETSC_ERR_FILE_UNEXPECTED, "%s: mesh file '%s' is incomplete (no $EndElements section): was it truncated?", what, file);
+  case MESH_HIGH_ORDER:
+    /* phlex's tetrahedra are affine (one Jacobian per cell: element.c, the stress elimination, the frame integrals);
+       PETSc 3.18's reader would keep the corner nodes only and drop the curved geometry without a word */
+    SETERRQ(comm, PETSC_ERR_SUP, "%s: mesh file '%s' has elements of order 2 or more (gmsh element type %s): phlex's tetrahedra are straight-sided (affine), and the reader would keep their corner nodes only, dropping the curved geometry; mesh with order 1 (gmsh -3 -order 1, Mesh.ElementOrder = 1) and raise the velocity degree instead (-<body>_petscspace_degree 2)", what, file, h.detail);
   default:
     break;
   }

@@ -351,11 +351,42 @@ static PetscErrorCode SetUpCellGeometry(PhlexFlexible b, const PhlexUnits *u)
 }
 
 /* Element loop assembling the velocity operators Mv, K and the body-force vectors (non-dimensional, once). */
+/* The element loops of a large body's assembly take seconds to minutes: they report progress and stop on SIGINT or
+   SIGTERM (issue 43 item 1). Every process splits its local cells into ASSEMBLY_CHUNKS equal chunks and meets the
+   others after each (PhlexProgressPhase: one reduction), so that the processes check the same number of times
+   whatever their cell counts; a process that received the signal skips nothing, it only stops at the next chunk. */
+#define ASSEMBLY_CHUNKS 8
+
+/* after local cell c: the end of a chunk (its share of the local cells) calls the collective check */
+static PetscErrorCode AssemblyChunk(PhlexFlexible b, PhlexProgress *p, const char what[], PetscInt c, PetscInt *chunk)
+{
+  const PetscInt ncells = b->cEnd - b->cStart;
+
+  PetscFunctionBeginUser;
+  while (*chunk < ASSEMBLY_CHUNKS - 1 && (c + 1) * ASSEMBLY_CHUNKS >= (*chunk + 1) * ncells) {
+    (*chunk)++;
+    PetscCall(PhlexProgressPhase(p, b->comm, what, (PetscReal)*chunk / ASSEMBLY_CHUNKS));
+  }
+  PetscFunctionReturn(0);
+}
+
+/* after the loop: the checks a process with fewer cells (or none) has not made yet, then the last */
+static PetscErrorCode AssemblyChunksEnd(PhlexFlexible b, PhlexProgress *p, const char what[], PetscInt chunk)
+{
+  PetscFunctionBeginUser;
+  for (; chunk < ASSEMBLY_CHUNKS - 1; chunk++) PetscCall(PhlexProgressPhase(p, b->comm, what, (PetscReal)(chunk + 1) / ASSEMBLY_CHUNKS));
+  PetscCall(PhlexProgressPhase(p, b->comm, what, 1.0));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode AssembleVelocityOperators(PhlexFlexible b, const PhlexUnits *u)
 {
   const PhlexElementReferenceIntegrals *R = &b->ref;
   const PetscInt                        nv = b->nb_v, nn = nv / 3;
   PetscReal                            *Me, *Ke, fe[PHLEX_MAX_NODES];
+  PhlexProgress                         progress;
+  PetscInt                              chunk = 0;
+  char                                  what[PHLEX_NAME_LEN + 64];
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BodyAssemble, 0, 0, 0, 0));
@@ -366,6 +397,8 @@ static PetscErrorCode AssembleVelocityOperators(PhlexFlexible b, const PhlexUnit
     PetscCall(VecSet(b->fvol[c], 0.0));
   }
   PetscCall(PetscMalloc2(nv * nv, &Me, nv * nv, &Ke));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "assembly of body %s (mass, stiffness)", b->name));
+  PetscCall(PhlexProgressStart(&progress));
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
     const PetscReal     *g   = &b->cell_geom[10 * c];
     const PhlexMaterial *mat = &b->materials[b->cell_material[c]];
@@ -380,7 +413,9 @@ static PetscErrorCode AssembleVelocityOperators(PhlexFlexible b, const PhlexUnit
     PetscCall(MatSetValuesBlocked(b->K, nn, nodes, nn, nodes, Ke, ADD_VALUES));
     for (PetscInt a = 0; a < nv; a++)
       if (idx[a] >= 0) PetscCall(VecSetValue(b->fvol[a % 3], idx[a], fe[a / 3], ADD_VALUES));
+    PetscCall(AssemblyChunk(b, &progress, what, c, &chunk));
   }
+  PetscCall(AssemblyChunksEnd(b, &progress, what, chunk));
   PetscCall(PetscFree2(Me, Ke));
   PetscCall(MatAssemblyBegin(b->Mv, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyBegin(b->K, MAT_FINAL_ASSEMBLY));
@@ -482,9 +517,14 @@ PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible b, const PhlexUnits *u)
   const PetscInt                        nv = b->nb_v, ns = b->nb_s;
   PetscReal                            *Ge, *Mse, *work;
   PetscInt                              perm[3 * PHLEX_MAX_NODES], sidx[3 * PHLEX_MAX_NODES];
+  PhlexProgress                         progress;
+  PetscInt                              chunk = 0;
+  char                                  what[PHLEX_NAME_LEN + 64];
 
   PetscFunctionBeginUser;
   if (b->G) PetscFunctionReturn(0);
+  PetscCall(PetscSNPrintf(what, sizeof(what), "assembly of body %s (coupling, compliance)", b->name));
+  PetscCall(PhlexProgressStart(&progress));
   PetscCall(PetscLogEventBegin(PHLEX_BodyAssemble, 0, 0, 0, 0));
   PetscCall(CreateCouplingMatrix(b, &b->G));
   PetscCall(MatCreateBAIJ(b->comm, ns, b->ns_local, b->ns_local, b->ns_global, b->ns_global, 1, NULL, 0, NULL, &b->Ms));
@@ -510,7 +550,9 @@ PetscErrorCode PhlexFlexibleSetUpMixed(PhlexFlexible b, const PhlexUnits *u)
     }
     PetscCall(MatSetValues(b->G, ns, rows, nv, sidx, work, INSERT_VALUES));
     PetscCall(MatSetValuesBlocked(b->Ms, 1, &brow, 1, &brow, Mse, INSERT_VALUES));
+    PetscCall(AssemblyChunk(b, &progress, what, c, &chunk));
   }
+  PetscCall(AssemblyChunksEnd(b, &progress, what, chunk));
   PetscCall(PetscFree3(Ge, Mse, work));
   PetscCall(MatAssemblyBegin(b->G, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyBegin(b->Ms, MAT_FINAL_ASSEMBLY));

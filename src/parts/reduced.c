@@ -277,6 +277,22 @@ static PetscErrorCode ReducedSetUp(PhlexPart part)
     if (!rank) PetscCall(PetscTestFile(r->file, 'r', &exists));
     PetscCallMPI(MPI_Bcast(&exists, 1, MPIU_BOOL, 0, part->comm));
   }
+  if (!exists && r->file[0]) {
+    /* the file will be written after the build: its directory must exist and be writable, checked before the work
+       (it ended in HDF5's traceback, exit 1, after the build) */
+    char        dir[PETSC_MAX_PATH_LEN], *slash;
+    PetscBool   ok = PETSC_TRUE;
+    PetscMPIInt rank;
+    PetscCall(PetscStrncpy(dir, r->file, sizeof(dir)));
+    slash = strrchr(dir, '/');
+    if (slash == dir) slash[1] = 0;
+    else if (slash) *slash = 0;
+    else PetscCall(PetscStrcpy(dir, "."));
+    PetscCallMPI(MPI_Comm_rank(part->comm, &rank));
+    if (!rank) PetscCall(PetscTestDirectory(dir, 'w', &ok));
+    PetscCallMPI(MPI_Bcast(&ok, 1, MPIU_BOOL, 0, part->comm));
+    PetscCheck(ok, part->comm, PETSC_ERR_USER_INPUT, "body %s: option -%sreduced_file %s: the directory '%s' does not exist or is not writable (the reduced body file is written there after its build)", part->name, part->prefix, r->file, dir);
+  }
   if (exists) PetscCall(PhlexReducedRead(part->comm, r->file, who, prov, part->units, &r->md));
   else {
     PetscCall(PhlexReducedBuild(r->full, &r->red, &r->md));

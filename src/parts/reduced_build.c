@@ -316,7 +316,15 @@ static PetscErrorCode FixedInterfaceModes(PhlexPart part, PetscInt nmodes, Petsc
   PetscCall(PCSetType(pc, PCCHOLESKY));
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscCall(EPSSetFromOptions(eps));
-  PetscCall(EPSSolve(eps));
+  {
+    /* the reduction of a large body: progress lines and a clean stop on SIGINT/SIGTERM (issue 43 item 1) */
+    PhlexProgress progress;
+    PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "body %s (its reduction)", b->name));
+    PetscCall(PhlexProgressStart(&progress));
+    PetscCall(EPSMonitorSet(eps, PhlexProgressEPSMonitor, &progress, NULL));
+    PetscCall(EPSSolve(eps));
+    PetscCall(EPSMonitorCancel(eps));
+  }
   PetscCall(EPSGetConverged(eps, &nconv));
   PetscCheck(nconv >= nmodes, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " fixed-interface modes of the reduction converged (-%sreduction_modes; the eigensolver takes -%sreduction_eps_*)", b->name, nconv, nmodes, b->prefix, b->prefix);
   /* S^{-1} (S symmetric positive definite: B^T A^{-1} B with B of full column rank) */

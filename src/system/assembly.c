@@ -246,6 +246,7 @@ PetscErrorCode PhlexAssemblyClose(PhlexSystem sys, PetscReal t, Vec X, PetscBool
     PetscReal   *G, *A, *L, *z, *s, work[8192], rcond = 1e-10;
     PetscBLASInt m, nn, one = 1, lwork = 8192, info, rank, ld;
     PetscInt     nr;
+    PetscCall(PhlexInterruptCheck(sys->comm, "while closing the joints' loops (the assembly's Newton iterations)"));
     PetscCall(PhlexSystemEvaluate(sys, t, X, NULL));
     PetscCall(RigidGradient(sys, &nr, &G));
     /* the mass metric: a Cholesky factor L of each frame's rigid mass; A = G_v L^{-T} */
@@ -362,6 +363,17 @@ static PetscErrorCode ShortStepJacobian(SNES snes, Vec Y, Mat A, Mat P, void *ct
   PetscFunctionReturn(0);
 }
 
+/* the consistent start's Newton iterations: a clean stop on SIGINT/SIGTERM (issue 43 item 1) */
+static PetscErrorCode ConsistentStartMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx)
+{
+  char where[96];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(where, sizeof(where), "in the consistent start (Newton iteration %" PetscInt_FMT ")", it));
+  PetscCall(PhlexInterruptCheck(PetscObjectComm((PetscObject)snes), where));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexAssemblyConsistentStart - projects the initial velocities onto the constraints (the smallest change of the
   kinetic energy) when they violate them, and solves the initial multipliers lambda0 (non-dimensional, per discrete
@@ -460,6 +472,7 @@ PetscErrorCode PhlexAssemblyConsistentStart(PhlexSystem sys, TS ts, PetscReal t0
     PetscCall(SNESSetJacobian(snes, sys->use_aij ? sys->Jaij : sys->J, P, ShortStepJacobian, &c));
   }
   PetscCall(SNESSetConvergenceTest(snes, PhlexSystemSNESConverged, sys, NULL));
+  PetscCall(SNESMonitorSet(snes, ConsistentStartMonitor, NULL, NULL)); /* SIGINT/SIGTERM stop it at a Newton iteration */
 
   PetscCall(Energy(sys, t0, X, &H0, &K0));
   if (cmax > 1e-12 * PetscMax(zmax, 1e-300)) {

@@ -81,3 +81,12 @@ int PhlexInterruptExitCode(void)
 {
   return 128 + (phlex_signal ? (int)phlex_signal : SIGINT);
 }
+
+/*@C
+  PhlexInterruptLocal - whether this process received SIGINT or SIGTERM (not collective: a loop over local work
+  breaks out on it, then every process meets at PhlexInterruptCheck)
+@*/
+PetscBool PhlexInterruptLocal(void)
+{
+  return phlex_signal ? PETSC_TRUE : PETSC_FALSE;
+}

@@ -105,3 +105,59 @@ PetscErrorCode PhlexProgressEPSMonitor(EPS eps, PetscInt its, PetscInt nconv, Pe
   PetscCall(PetscPrintf(comm, "progress: modes of %s: %" PetscInt_FMT " of %" PetscInt_FMT " converged after %" PetscInt_FMT " iterations, elapsed %s\n", p->what, PetscMin(nconv, nev), nev, its, elapsed));
   PetscFunctionReturn(0);
 }
+
+/*@C
+  PhlexProgressPEPMonitor - PEP monitor (the damped linearized analysis): as PhlexProgressEPSMonitor
+@*/
+PetscErrorCode PhlexProgressPEPMonitor(PEP pep, PetscInt its, PetscInt nconv, PetscScalar *eigr, PetscScalar *eigi, PetscReal *errest, PetscInt nest, void *ctx)
+{
+  PhlexProgress *p = (PhlexProgress *)ctx;
+  MPI_Comm       comm;
+  PetscLogDouble now;
+  PetscInt       nev;
+  char           where[128], elapsed[32];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectGetComm((PetscObject)pep, &comm));
+  PetscCall(PetscSNPrintf(where, sizeof(where), "in the eigensolver of %s (iteration %" PetscInt_FMT ")", p->what, its));
+  PetscCall(PhlexInterruptCheck(comm, where));
+  if (!progress_on) PetscFunctionReturn(0);
+  PetscCall(PetscTime(&now));
+  if (now - p->last < progress_interval) PetscFunctionReturn(0);
+  p->last = now;
+  PetscCall(PEPGetDimensions(pep, &nev, NULL, NULL));
+  FormatDuration((PetscReal)(now - p->start), elapsed, sizeof(elapsed));
+  PetscCall(PetscPrintf(comm, "progress: modes of %s: %" PetscInt_FMT " of %" PetscInt_FMT " converged after %" PetscInt_FMT " iterations, elapsed %s\n", p->what, PetscMin(nconv, nev), nev, its, elapsed));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProgressPhase - in a long phase that is not a time step or an eigensolver iteration (the assembly of a large
+  body, the consistent start, a body's reduction): stops the run if interrupted, prints a progress line when due
+
+  Collective (every process must call it as often: in a loop over local cells, break out on PhlexInterruptLocal()
+  and call this after the loop)
+
+  Input Parameters:
++ p    - the progress clock (PhlexProgressStart)
+. comm - the communicator of the phase
+. what - the phase, e.g. "assembly of body arm"
+- done - the share done (0..1), or a negative number when unknown
+@*/
+PetscErrorCode PhlexProgressPhase(PhlexProgress *p, MPI_Comm comm, const char what[], PetscReal done)
+{
+  PetscLogDouble now;
+  char           where[160], elapsed[32];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(where, sizeof(where), "in the %s", what));
+  PetscCall(PhlexInterruptCheck(comm, where));
+  if (!progress_on) PetscFunctionReturn(0);
+  PetscCall(PetscTime(&now));
+  if (now - p->last < progress_interval) PetscFunctionReturn(0);
+  p->last = now;
+  FormatDuration((PetscReal)(now - p->start), elapsed, sizeof(elapsed));
+  if (done >= 0) PetscCall(PetscPrintf(comm, "progress: %s: %.0f%%, elapsed %s\n", what, (double)(100 * done), elapsed));
+  else PetscCall(PetscPrintf(comm, "progress: %s, elapsed %s\n", what, elapsed));
+  PetscFunctionReturn(0);
+}
