@@ -457,10 +457,15 @@ PetscErrorCode PhlexFlexibleAssembleDamping(PhlexFlexible b, const PhlexUnits *u
   const PhlexElementReferenceIntegrals *ref = &b->ref;
   const PetscInt                        nv = b->nb_v, nn = nv / 3;
   PetscReal                            *Me, *Ke;
+  PhlexProgress                         progress;
+  PetscInt                              chunk = 0;
+  char                                  what[PHLEX_NAME_LEN + 64];
 
   PetscFunctionBeginUser;
   PetscCall(CreateVelocityMatrix(b, R));
   PetscCall(PetscMalloc2(nv * nv, &Me, nv * nv, &Ke));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "assembly of body %s (structural damping)", b->name));
+  PetscCall(PhlexProgressStart(&progress));
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
     const PetscReal     *g   = &b->cell_geom[10 * c];
     const PhlexMaterial *mat = &b->materials[b->cell_material[c]];
@@ -472,7 +477,9 @@ PetscErrorCode PhlexFlexibleAssembleDamping(PhlexFlexible b, const PhlexUnits *u
     for (PetscInt k = 0; k < 9 * nn * nn; k++) Ke[k] += Me[k];
     CellNodeIndices(b, c, nodes);
     PetscCall(MatSetValuesBlocked(*R, nn, nodes, nn, nodes, Ke, ADD_VALUES));
+    PetscCall(AssemblyChunk(b, &progress, what, c, &chunk));
   }
+  PetscCall(AssemblyChunksEnd(b, &progress, what, chunk));
   PetscCall(PetscFree2(Me, Ke));
   PetscCall(MatAssemblyBegin(*R, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(*R, MAT_FINAL_ASSEMBLY));
