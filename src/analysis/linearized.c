@@ -1284,6 +1284,7 @@ static PetscErrorCode SteadyStates(Pencil *p)
 static PetscErrorCode SteadyDrives(PhlexScene scene)
 {
   PetscInt nrot = 0;
+  char     rotors[256] = ""; /* "body on joint, ..." for the refusal of several */
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < scene->njoints; k++) {
@@ -1311,10 +1312,14 @@ static PetscErrorCode SteadyDrives(PhlexScene scene)
       /* the drive turns b relative to a about e3: the body is b (+) or a, the ground b (-) */
       w[i] = (s == 1 ? 1.0 : -1.0) * j->drive_velocity * fmax * e3[i];
     }
-    PetscCall((*body->analysisops->steadydrive)(body, j->side[s].port, w, j->position_given ? j->position : NULL));
+    if (nrot) PetscCall(PetscStrlcat(rotors, ", ", sizeof(rotors)));
+    PetscCall(PetscStrlcat(rotors, body->name, sizeof(rotors)));
+    PetscCall(PetscStrlcat(rotors, " on joint ", sizeof(rotors)));
+    PetscCall(PetscStrlcat(rotors, j->name, sizeof(rotors)));
     nrot++;
+    PetscCheck(nrot <= 1, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has several rotors on driven revolutes (%s); the analysis linearises about one steady spin (its co-rotating frame): one rotor per scene", rotors);
+    PetscCall((*body->analysisops->steadydrive)(body, j->side[s].port, w, j->position_given ? j->position : NULL));
   }
-  PetscCheck(nrot <= 1, scene->comm, PETSC_ERR_USER_INPUT, "linearized analysis: the scene has %" PetscInt_FMT " rotors on driven revolutes; the analysis linearises about one steady spin (its co-rotating frame): one rotor per scene", nrot);
   PetscFunctionReturn(0);
 }
 

@@ -529,7 +529,7 @@ static PetscErrorCode DefaultSolverPreset(PhlexSystem sys, char file[], char why
   PetscCall(BodiesWhole(sys, &whole));
   if (!sys->nfparts) {
     PetscCall(PetscStrcpy(file, "options/solver/rigid.opts"));
-    PetscCall(PetscSNPrintf(why, len, "default without flexible body: dense LU of the frames and impulses"));
+    PetscCall(PetscSNPrintf(why, len, "default without field unknowns (rigid, lumped and reduced parts): dense LU of the discrete unknowns"));
   } else if (!sys->nq && sys->inexact_schur) {
     PetscCall(PetscStrcpy(file, "options/solver/exact_krylov.opts"));
     PetscCall(PetscSNPrintf(why, len, "default for a fixed body with spin or geometric stiffening: its condensed operator is not symmetric"));

@@ -356,6 +356,9 @@ static PetscErrorCode FlexSetUp(PhlexPart part)
       PetscCheck(!b->ports[q].load.loaded || b->ports[q].load.frame != PHLEX_DIRECTION_INERTIAL, b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sspin %s,%s,%s with -%sport_%s_direction inertial: the body lives in the hub's rotating frame, where a direction fixed in space turns; give the load in body directions (it turns with the hub) or model the hub as a driven joint", b->name, b->prefix, w[0], w[1], w[2], b->prefix, b->ports[q].name);
   }
   if (b->ic_steady_spin) {
+    /* the steady stretch is solved as that of a body clamped at its frame patch (K + Cen, the fixed-hub problem):
+       with mean axes the field is free and the problem singular along the axis */
+    PetscCheck(b->frame_patch[0], b->comm, PETSC_ERR_USER_INPUT, "body %s: -%sic_steady_spin needs the body clamped to its frame at a patch (-%sframe_patch <surface>, the hub's side): with -%sframe mean_axes the steady stretch is not defined (the field is free along the spin axis)", b->name, b->prefix, b->prefix, b->prefix);
     /* a steady spin has no load that turns in the rotating frame, nor one that does work */
     PetscBool loaded = (PetscBool)(b->has_body_force || b->frame_loaded);
     char      g[3][32];

@@ -75,6 +75,7 @@ static PetscErrorCode ReducedSetFromOptions(PhlexPart part)
   PetscCall((*r->full->ops.setfromoptions)(r->full));
   r->fb = b  = (PhlexFlexible)r->full->data;
   PetscCheck(!(b->port_rate_given && b->port_rate_exact), part->comm, PETSC_ERR_SUP, "body %s: -%sport_rate exact is not implemented for a reduced body (its ports turn at the first-order rate w + B_r^T v); use -%sport_rate first_order or -%stype flexible", part->name, part->prefix, part->prefix, part->prefix);
+  PetscCheck(!b->ic_steady_spin, part->comm, PETSC_ERR_SUP, "body %s: -%sic_steady_spin is not implemented for a reduced body (its steady stretch is solved on the full field); use -%stype flexible, or start it from rest", part->name, part->prefix, part->prefix);
   r->nmodes  = 10;
   r->expect_rtol  = 1e-6;
   r->nexpect_held = r->nexpect_full = 64;

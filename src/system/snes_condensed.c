@@ -287,13 +287,20 @@ static PetscErrorCode InitialGuess(SNES_Condensed *c, Vec x)
    e.p = r.p - dv.(A p): one product with A and three dot products; alpha is of the order of the tolerance. */
 static PetscErrorCode BalanceCorrection(SNES_Condensed *c, Vec v0, Vec dv)
 {
-  PetscBool   preonly;
+  PetscBool   preonly; /* a direct solve (preonly with a factorization) needs none; preonly with another PC does */
   Mat         A;
   PetscScalar rp, dAp, pAp;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectTypeCompare((PetscObject)c->ksp, KSPPREONLY, &preonly));
-  if (!c->balance || preonly) PetscFunctionReturn(0);
+  if (preonly) { /* one application of the PC: exact only if it is a factorization */
+    PC        pc;
+    PetscBool factor;
+    PetscCall(KSPGetPC(c->ksp, &pc));
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &factor, PCLU, PCCHOLESKY, PCQR, PCSVD, ""));
+    if (factor) PetscFunctionReturn(0);
+  }
+  if (!c->balance) PetscFunctionReturn(0);
   if (!c->p) {
     PetscCall(VecDuplicate(dv, &c->p));
     PetscCall(VecDuplicate(dv, &c->Ap));
