@@ -80,29 +80,37 @@ PetscErrorCode PhlexProgressStep(PhlexProgress *p, MPI_Comm comm, PetscInt step,
   PetscFunctionReturn(0);
 }
 
-/*@C
-  PhlexProgressEPSMonitor - EPS monitor: the converged eigenpairs of the body being solved, when due; stops the run
-  if interrupted (context: a PhlexProgress whose what names the body)
-@*/
-PetscErrorCode PhlexProgressEPSMonitor(EPS eps, PetscInt its, PetscInt nconv, PetscScalar *eigr, PetscScalar *eigi, PetscReal *errest, PetscInt nest, void *ctx)
+/* an eigensolver's iteration (EPS or PEP): stop if interrupted, a progress line when due */
+static PetscErrorCode EigenIteration(PhlexProgress *p, MPI_Comm comm, PetscInt its, PetscInt nconv, PetscInt nev)
 {
-  PhlexProgress *p = (PhlexProgress *)ctx;
-  MPI_Comm       comm;
   PetscLogDouble now;
-  PetscInt       nev;
   char           where[128], elapsed[32];
 
   PetscFunctionBeginUser;
-  PetscCall(PetscObjectGetComm((PetscObject)eps, &comm));
   PetscCall(PetscSNPrintf(where, sizeof(where), "in the eigensolver of %s (iteration %" PetscInt_FMT ")", p->what, its));
   PetscCall(PhlexInterruptCheck(comm, where));
   if (!progress_on) PetscFunctionReturn(0);
   PetscCall(PetscTime(&now));
   if (now - p->last < progress_interval) PetscFunctionReturn(0);
   p->last = now;
-  PetscCall(EPSGetDimensions(eps, &nev, NULL, NULL));
   FormatDuration((PetscReal)(now - p->start), elapsed, sizeof(elapsed));
   PetscCall(PetscPrintf(comm, "progress: modes of %s: %" PetscInt_FMT " of %" PetscInt_FMT " converged after %" PetscInt_FMT " iterations, elapsed %s\n", p->what, PetscMin(nconv, nev), nev, its, elapsed));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProgressEPSMonitor - EPS monitor: the converged eigenpairs of the body being solved, when due; stops the run
+  if interrupted (context: a PhlexProgress whose what names the body)
+@*/
+PetscErrorCode PhlexProgressEPSMonitor(EPS eps, PetscInt its, PetscInt nconv, PetscScalar *eigr, PetscScalar *eigi, PetscReal *errest, PetscInt nest, void *ctx)
+{
+  MPI_Comm comm;
+  PetscInt nev;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectGetComm((PetscObject)eps, &comm));
+  PetscCall(EPSGetDimensions(eps, &nev, NULL, NULL));
+  PetscCall(EigenIteration((PhlexProgress *)ctx, comm, its, nconv, nev));
   PetscFunctionReturn(0);
 }
 
@@ -111,23 +119,13 @@ PetscErrorCode PhlexProgressEPSMonitor(EPS eps, PetscInt its, PetscInt nconv, Pe
 @*/
 PetscErrorCode PhlexProgressPEPMonitor(PEP pep, PetscInt its, PetscInt nconv, PetscScalar *eigr, PetscScalar *eigi, PetscReal *errest, PetscInt nest, void *ctx)
 {
-  PhlexProgress *p = (PhlexProgress *)ctx;
-  MPI_Comm       comm;
-  PetscLogDouble now;
-  PetscInt       nev;
-  char           where[128], elapsed[32];
+  MPI_Comm comm;
+  PetscInt nev;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectGetComm((PetscObject)pep, &comm));
-  PetscCall(PetscSNPrintf(where, sizeof(where), "in the eigensolver of %s (iteration %" PetscInt_FMT ")", p->what, its));
-  PetscCall(PhlexInterruptCheck(comm, where));
-  if (!progress_on) PetscFunctionReturn(0);
-  PetscCall(PetscTime(&now));
-  if (now - p->last < progress_interval) PetscFunctionReturn(0);
-  p->last = now;
   PetscCall(PEPGetDimensions(pep, &nev, NULL, NULL));
-  FormatDuration((PetscReal)(now - p->start), elapsed, sizeof(elapsed));
-  PetscCall(PetscPrintf(comm, "progress: modes of %s: %" PetscInt_FMT " of %" PetscInt_FMT " converged after %" PetscInt_FMT " iterations, elapsed %s\n", p->what, PetscMin(nconv, nev), nev, its, elapsed));
+  PetscCall(EigenIteration((PhlexProgress *)ctx, comm, its, nconv, nev));
   PetscFunctionReturn(0);
 }
 
