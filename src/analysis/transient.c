@@ -509,7 +509,7 @@ static PetscErrorCode BodiesWhole(PhlexSystem sys, PetscBool *whole)
   PetscFunctionReturn(0);
 }
 
-/* The default preset: the fastest correct one for the scene on its processes (issue 43, BENCHMARKS.md section 37).
+/* The default preset: the fastest correct one for the scene on its processes (issue 43, BENCHMARKS.md section 38).
    No flexible body: rigid.opts. Fixed flexible bodies alone (no discrete unknowns): exact_krylov.opts with spin or
    stiffening (its condensed operator is not symmetric: LU), else exact_serial.opts on one process (CHOLMOD: its
    triangular solves run near the bandwidth bound, a step about 1.25-1.7 x faster than MUMPS's, section 19) and
