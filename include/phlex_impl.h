@@ -214,6 +214,8 @@ PETSC_INTERN PetscErrorCode PhlexProgressStart(PhlexProgress *);
 PETSC_INTERN PetscErrorCode PhlexProgressStep(PhlexProgress *, MPI_Comm, PetscInt, PetscReal, PetscReal, const char[]);
 PETSC_INTERN PetscErrorCode PhlexProgressEPSMonitor(EPS, PetscInt, PetscInt, PetscScalar *, PetscScalar *, PetscReal *, PetscInt, void *);
 PETSC_INTERN PetscErrorCode PhlexProgressPEPMonitor(PEP, PetscInt, PetscInt, PetscScalar *, PetscScalar *, PetscReal *, PetscInt, void *);
+PETSC_INTERN PetscErrorCode PhlexProgressEPSSolve(EPS, const char[]);
+PETSC_INTERN PetscErrorCode PhlexProgressPEPSolve(PEP, const char[]);
 PETSC_INTERN PetscErrorCode PhlexProgressPhase(PhlexProgress *, MPI_Comm, const char[], PetscReal);
 
 /* flexible_modes.c: the eigensolver of the modal analysis with its defaults (also read by -help) */

@@ -997,15 +997,7 @@ static PetscErrorCode SolvePencil(Pencil *p, EPS eps, PetscInt nev, PetscInt nme
     PetscCall(PetscOptionsHasName(NULL, "linearized_", "-eps_target", &given));
     if (!given) PetscCall(EPSSetTarget(eps, nmech ? -1e-6 : 0.0));
   }
-  {
-    /* progress lines and a clean stop on SIGINT/SIGTERM inside a long eigensolve (issue 43 item 1) */
-    PhlexProgress progress;
-    PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "the linearized assembly"));
-    PetscCall(PhlexProgressStart(&progress));
-    PetscCall(EPSMonitorSet(eps, PhlexProgressEPSMonitor, &progress, NULL));
-    PetscCall(EPSSolve(eps));
-    PetscCall(EPSMonitorCancel(eps));
-  }
+  PetscCall(PhlexProgressEPSSolve(eps, "the linearized assembly"));
   PetscCall(EPSGetConverged(eps, &nconv));
   if (nconv < want) {
     PetscInt N;
@@ -1130,15 +1122,7 @@ static PetscErrorCode SolveGyroscopic(Pencil *p, PEP pep, PetscInt nev, PetscInt
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
   PetscCall(PEPSetOperators(pep, 3, A));
   PetscCall(PEPSetDimensions(pep, 2 * nev, PETSC_DEFAULT, PETSC_DEFAULT));
-  {
-    /* progress lines and a clean stop on SIGINT/SIGTERM inside a long eigensolve (issue 43 item 1) */
-    PhlexProgress progress;
-    PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "the linearized assembly"));
-    PetscCall(PhlexProgressStart(&progress));
-    PetscCall(PEPMonitorSet(pep, PhlexProgressPEPMonitor, &progress, NULL));
-    PetscCall(PEPSolve(pep));
-    PetscCall(PEPMonitorCancel(pep));
-  }
+  PetscCall(PhlexProgressPEPSolve(pep, "the linearized assembly"));
   PetscCall(PEPGetConverged(pep, &nconv));
   PetscCall(PetscMalloc6(nconv, &mag, nconv, &om, nconv, &gr, nconv, &res, nconv, &idx, nconv, &perm));
   PetscCall(MatCreateVecs(p->A, &xr, NULL));

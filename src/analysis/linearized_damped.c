@@ -336,15 +336,7 @@ PetscErrorCode PhlexLinearizedSolveDamped(Pencil *p, PEP pep, PetscInt nev, Pets
   /* the target: 0, unless one is given; where the mechanism moves (A0 singular at 0) the caller has set it */
   PetscCall(PetscOptionsHasName(NULL, "linearized_", "-pep_target", &given));
   if (!given && !nmech) PetscCall(PEPSetTarget(pep, 0.0));
-  {
-    /* progress lines and a clean stop on SIGINT/SIGTERM inside a long eigensolve (issue 43 item 1) */
-    PhlexProgress progress;
-    PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "the damped linearized assembly"));
-    PetscCall(PhlexProgressStart(&progress));
-    PetscCall(PEPMonitorSet(pep, PhlexProgressPEPMonitor, &progress, NULL));
-    PetscCall(PEPSolve(pep));
-    PetscCall(PEPMonitorCancel(pep));
-  }
+  PetscCall(PhlexProgressPEPSolve(pep, "the damped linearized assembly"));
   PetscCall(PEPGetConverged(pep, &nconv));
   PetscCall(PetscMalloc6(nconv, &mag, nconv, &re, nconv, &im, nconv, &res, nconv, &perm, nconv, &keep));
   PetscCall(MatCreateVecs(p->A, &xr, NULL));

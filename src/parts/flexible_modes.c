@@ -352,7 +352,6 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   const PhlexUnits *units = part->units;
   PetscBool         mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
   EPS           eps;
-  PhlexProgress progress;
   PetscReal omega = FrequencyScale(b, units), sigma, ftarget = -1;
   const PetscReal rigid_below = 1e-6 * omega * omega; /* |lambda| below: a rigid mode */
   PetscBool free_body = (!b->frame_patch[0] || b->floating) ? PETSC_TRUE : PETSC_FALSE, flg;
@@ -407,10 +406,11 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     }
   }
   PetscCall(ShiftedOperatorStorage(b, eps, A, B, resid != NULL));
-  PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "body %s", part->name));
-  PetscCall(PhlexProgressStart(&progress));
-  PetscCall(EPSMonitorSet(eps, PhlexProgressEPSMonitor, &progress, NULL));
-  PetscCall(EPSSolve(eps));
+  {
+    char what[PHLEX_NAME_LEN + 8];
+    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s", part->name));
+    PetscCall(PhlexProgressEPSSolve(eps, what));
+  }
   PetscCall(EPSGetDimensions(eps, &want, NULL, NULL));
   PetscCall(EPSGetConverged(eps, &n));
   /* a modal analysis that has fewer pairs than asked for says so (a transient's initial mode and the convergence

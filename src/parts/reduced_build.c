@@ -317,13 +317,9 @@ static PetscErrorCode FixedInterfaceModes(PhlexPart part, PetscInt nmodes, Petsc
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscCall(EPSSetFromOptions(eps));
   {
-    /* the reduction of a large body: progress lines and a clean stop on SIGINT/SIGTERM (issue 43 item 1) */
-    PhlexProgress progress;
-    PetscCall(PetscSNPrintf(progress.what, sizeof(progress.what), "body %s (its reduction)", b->name));
-    PetscCall(PhlexProgressStart(&progress));
-    PetscCall(EPSMonitorSet(eps, PhlexProgressEPSMonitor, &progress, NULL));
-    PetscCall(EPSSolve(eps));
-    PetscCall(EPSMonitorCancel(eps));
+    char what[PHLEX_NAME_LEN + 32];
+    PetscCall(PetscSNPrintf(what, sizeof(what), "body %s (its reduction)", b->name));
+    PetscCall(PhlexProgressEPSSolve(eps, what));
   }
   PetscCall(EPSGetConverged(eps, &nconv));
   PetscCheck(nconv >= nmodes, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " fixed-interface modes of the reduction converged (-%sreduction_modes; the eigensolver takes -%sreduction_eps_*)", b->name, nconv, nmodes, b->prefix, b->prefix);

@@ -130,6 +130,43 @@ PetscErrorCode PhlexProgressPEPMonitor(PEP pep, PetscInt its, PetscInt nconv, Pe
 }
 
 /*@C
+  PhlexProgressEPSSolve - EPSSolve with progress lines and a clean stop on SIGINT/SIGTERM (issue 43 item 1); what names
+  the problem in the lines ("body bar", "the linearized assembly")
+
+  Collective
+@*/
+PetscErrorCode PhlexProgressEPSSolve(EPS eps, const char what[])
+{
+  PhlexProgress progress;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(progress.what, what, sizeof(progress.what)));
+  PetscCall(PhlexProgressStart(&progress));
+  PetscCall(EPSMonitorSet(eps, PhlexProgressEPSMonitor, &progress, NULL));
+  PetscCall(EPSSolve(eps));
+  PetscCall(EPSMonitorCancel(eps)); /* the context lives on this stack */
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProgressPEPSolve - PEPSolve as PhlexProgressEPSSolve
+
+  Collective
+@*/
+PetscErrorCode PhlexProgressPEPSolve(PEP pep, const char what[])
+{
+  PhlexProgress progress;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrncpy(progress.what, what, sizeof(progress.what)));
+  PetscCall(PhlexProgressStart(&progress));
+  PetscCall(PEPMonitorSet(pep, PhlexProgressPEPMonitor, &progress, NULL));
+  PetscCall(PEPSolve(pep));
+  PetscCall(PEPMonitorCancel(pep));
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexProgressPhase - in a long phase that is not a time step or an eigensolver iteration (the assembly of a large
   body, the consistent start, a body's reduction): stops the run if interrupted, prints a progress line when due
 
