@@ -15,9 +15,11 @@
 #   PRESET=options/solver/iterative.opts
 #   EXTRA=                 options appended (e.g. -condensed_ksp_rtol 1e-8)
 #
-# Prints one line per P: DOFs, DOFs per process, CG iterations per step, KSPSolve per step (the solves only: the
+# Prints two lines per P: DOFs, DOFs per process, CG iterations per step, KSPSolve per step (the solves only: the
 # GAMG set-up is PCSetUp's, printed apart), peak RSS of the largest process (/usr/bin/time -v of the launcher is not
-# that: phlex's own -memory_view line is used when present), and the efficiency T(1)/T(P) of the solve per step.
+# that: phlex's own -memory_view line is used when present), and the efficiency T(1)/T(P) of the solve per step;
+# then the communication of a step (the steps less GAMG's set-up, from -log_view): global reductions, messages and
+# bytes sent per process (counts do not depend on the machine: oversubscribed runs give them too).
 # Meshes: meshes/bench/bar_h<h>.msh, made by `make -C meshes bench/bar_h<h>.msh` (gmsh) when missing; each process
 # count's mesh is read by rank 0 and distributed (it must fit there once).
 # Not measured on the development machine beyond 2 processes (it has 2 cores): see README.md "Running on a cluster".
@@ -60,6 +62,23 @@ per = float(ksp.group(2)) / max(1, int(ksp.group(1))) if ksp else float("nan")
 print("P %d | velocity DOFs %d (%d per process) | CG its per step %s | KSPSolve per step %.3g s | PCSetUp %s s | max RSS %s B%s"
       % (P, n, n // P, "%.1f" % (sum(its) / len(its)) if its else "-", per, pcs.group(1) if pcs else "-",
          mem.group(1) if mem else "-", " | efficiency %.2f" % (t1 / per) if t1 > 0 else ""))
+# communication per step, from the "Phlex Transient" stage's event lines (-log_view: Mess is the count of messages
+# sent by all processes, AvgLen their mean length in bytes, Reduct the global reductions): the events that repeat
+# every step (the CG solve, the stress passes, the energy monitor) over the steps; the one-time set-up inside the
+# first step (GAMG's PCSetUp, the operator's assembly) is left out. One process counts no reductions.
+stage = txt.split("--- Event Stage 3: Phlex Transient")[1].split("--- Event Stage")[0] if "--- Event Stage 3: Phlex Transient" in txt else ""
+def ev(name):
+    m = re.search(r"^%s\s+(\d+)\s+\S+\s+\S+\s+\S+\s+\S+\s+\S+\s+(\S+)\s+(\S+)\s+(\S+)" % name, stage, re.M)
+    return (float(m.group(2)), float(m.group(3)), float(m.group(4))) if m else (0.0, 0.0, 0.0)
+m = re.search(r"^TSStep\s+(\d+)", stage, re.M)
+steps = int(m.group(1)) if m else 0
+if steps:
+    rows = [ev(e) for e in ("KSPSolve", "PhlexStressMaps", "PhlexMonEnergy")]
+    msg = sum(x[0] for x in rows) / steps
+    byt = sum(x[0] * x[1] for x in rows) / steps
+    red = sum(x[2] for x in rows) / steps
+    print("P %d | per step: %.0f reductions (CG %.0f), %.0f messages per process, %.0f kB sent per process (mean %.0f B)"
+          % (P, red, rows[0][2] / steps, msg / P, byt / P / 1e3, byt / msg if msg else 0.0))
 open("/tmp/phlex_weak_t1", "w").write(repr(per) if P == 1 else repr(t1))
 PY
   t1=$(cat /tmp/phlex_weak_t1)
