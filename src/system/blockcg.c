@@ -21,6 +21,7 @@
 #include <phlex_impl.h>
 #include <petscblaslapack.h>
 #include <petsc/private/kspimpl.h>
+#include <petsc/private/pcimpl.h>
 
 /* a dense matrix on the first s columns of a column-major array with nloc local rows */
 static PetscErrorCode DenseOn(MPI_Comm comm, PetscInt nloc, PetscInt N, PetscInt s, PetscScalar *a, Mat *M)
@@ -192,6 +193,11 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscIn
   PetscCall(MatGetLocalSize(B, &nloc, NULL));
   PetscCall(MatGetSize(B, &N, &k));
   *its = *colits = 0;
+  {
+    PCType type;
+    PetscCall(PCGetType(pc, &type));
+    PetscCall(PetscInfo(ksp, "block CG: preconditioner %s applied to a block %s\n", type, pc->ops->matapply ? "natively (PCMatApply)" : "column by column (no PCMatApply of its own)"));
+  }
   PetscCall(PetscMalloc5(nloc * k, &Xj, nloc * k, &Rj, nloc * k, &Zj, nloc * k, &P, nloc * k, &Praw));
   PetscCall(PetscMalloc5(k * k, &G, k * k, &Gf, k * k, &alpha, k * k, &beta, k, &piv));
   PetscCall(PetscMalloc3(k, &nrm, k, &tol, k, &J));

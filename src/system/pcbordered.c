@@ -276,7 +276,7 @@ static PetscErrorCode ReadBodyOptions(MPI_Comm comm, const char prefix[], const 
   PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", package, package, len, NULL));
   PetscCall(PetscOptionsBool("-block_cg", "With an inner CG (ksp_type cg): solve for the border basis A^{-1} W (12 columns for a floating frame, 6 per jointed port) by block CG, all columns at once (one sparse product and one block preconditioner application per iteration), instead of one CG solve per column (KSPMatSolve); each column to the KSP's tolerance against its own right-hand side", "PCPHLEXBORDERED", *block_cg, block_cg, NULL));
   PetscCall(PetscOptionsReal("-block_cg_check", "With block CG: also solve for the basis column by column (KSPMatSolve), print the largest relative difference of a column and stop (exit code 2) when it exceeds this value (0: no check; a test's option)", "PCPHLEXBORDERED", *check, check, NULL));
-  PetscCheck(*check >= 0, comm, PETSC_ERR_USER_INPUT, "-%sblock_cg_check %g: must be >= 0 (0: no check)", prefix ? prefix : "", (double)*check);
+  PetscCheck(*check >= 0, comm, PETSC_ERR_USER_INPUT, "-%sblock_cg_check must be >= 0 (0: no check), got %g", prefix ? prefix : "", (double)*check);
   PetscOptionsEnd();
   PetscFunctionReturn(0);
 }
