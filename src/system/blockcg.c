@@ -162,7 +162,9 @@ PetscErrorCode PhlexBlockCGApplies(KSP ksp, PetscBool *applies)
   Input Parameters:
 + ksp        - a set-up KSPCG (PhlexBlockCGApplies)
 . B          - dense, the right-hand sides
-- collective - see above
+. collective - see above
+. matapply   - the preconditioner applied to the block by PCMatApply (else by PCApply column by column)
+- what       - what is solved for, for the progress lines and the interrupt message ("border basis of body bar")
 
   Output Parameters:
 + X          - dense, the solutions (same layout as B)
@@ -170,7 +172,7 @@ PetscErrorCode PhlexBlockCGApplies(KSP ksp, PetscBool *applies)
 - colits     - the sum over the columns of the iterations each took to converge (the column iterations done as a
                block; the sequential solves' total is comparable)
 @*/
-PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscInt *its, PetscInt *colits)
+PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBool matapply, const char what[], PetscInt *its, PetscInt *colits)
 {
   MPI_Comm           comm;
   Mat                A, Pm = NULL, Qm = NULL, Rm = NULL, Zm = NULL;
@@ -182,6 +184,7 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscIn
   const PetscScalar *ba, *qa;
   PetscBLASInt      *piv;
   PetscBool          converged = PETSC_FALSE, stopped = PETSC_FALSE;
+  PhlexProgress      progress;
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BlockCG, ksp, 0, 0, 0));
@@ -193,10 +196,11 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscIn
   PetscCall(MatGetLocalSize(B, &nloc, NULL));
   PetscCall(MatGetSize(B, &N, &k));
   *its = *colits = 0;
+  PetscCall(PhlexProgressStart(&progress));
   {
     PCType type;
     PetscCall(PCGetType(pc, &type));
-    PetscCall(PetscInfo(ksp, "block CG: preconditioner %s applied to a block %s\n", type, pc->ops->matapply ? "natively (PCMatApply)" : "column by column (no PCMatApply of its own)"));
+    PetscCall(PetscInfo(ksp, "block CG: preconditioner %s applied to a block %s\n", type, !matapply ? "column by column (PCApply: -block_cg_pc_block 0)" : (pc->ops->matapply ? "natively (PCMatApply)" : "column by column (PCMatApply: none of its own)")));
   }
   PetscCall(PetscMalloc5(nloc * k, &Xj, nloc * k, &Rj, nloc * k, &Zj, nloc * k, &P, nloc * k, &Praw));
   PetscCall(PetscMalloc5(k * k, &G, k * k, &Gf, k * k, &alpha, k * k, &beta, k, &piv));
@@ -221,7 +225,21 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscIn
       PetscCall(DenseOn(comm, nloc, N, nJ, Zj, &Zm));
       nR = nJ;
     }
-    PetscCall(PCMatApply(pc, Rm, Zm));
+    if (matapply) PetscCall(PCMatApply(pc, Rm, Zm));
+    else {
+      /* column by column, on vectors placed on the columns */
+      Vec r, z;
+      PetscCall(MatCreateVecs(A, &z, &r));
+      for (c = 0; c < nJ; c++) {
+        PetscCall(VecPlaceArray(r, Rj + nloc * c));
+        PetscCall(VecPlaceArray(z, Zj + nloc * c));
+        PetscCall(PCApply(pc, r, z));
+        PetscCall(VecResetArray(r));
+        PetscCall(VecResetArray(z));
+      }
+      PetscCall(VecDestroy(&r));
+      PetscCall(VecDestroy(&z));
+    }
     PetscCall(ColumnNorms(comm, ntype, nloc, nJ, Rj, Zj, nrm));
     if (!it)
       for (c = 0; c < nJ; c++) tol[c] = PetscMax(rtol * nrm[c], atol);
@@ -259,11 +277,11 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscIn
       break;
     }
     if (it >= maxit) break;
-    /* SIGINT/SIGTERM between the iterations (issue 43 item 1) */
+    /* SIGINT/SIGTERM between the iterations (issue 43 item 1), a progress line when due */
     if (collective) {
-      char where[128];
-      PetscCall(PetscSNPrintf(where, sizeof(where), "in the block CG of the border basis (iteration %" PetscInt_FMT ")", it));
-      PetscCall(PhlexInterruptCheck(comm, where));
+      char phase[192];
+      PetscCall(PetscSNPrintf(phase, sizeof(phase), "block CG of the %s (iteration %" PetscInt_FMT ", %" PetscInt_FMT " of %" PetscInt_FMT " columns converged)", what, it, k - nJ, k));
+      PetscCall(PhlexProgressPhase(&progress, comm, phase, -1));
     } else if (PhlexInterruptLocal()) {
       stopped = PETSC_TRUE;
       break;

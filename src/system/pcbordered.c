@@ -42,6 +42,7 @@ typedef struct {
   Vec               *fseq, *xseq; /* per block on its owner: sequential vectors placed on the rows of r and z */
   char             (*lu_package)[64]; /* per block: -<prefix>bordered_[<body>_]lu_mat_solver_type (empty: the Cholesky's) */
   PetscBool         *block_cg;   /* per block: -<prefix>bordered_[<body>_]block_cg, the basis by block CG (blockcg.c) where its KSP is CG */
+  PetscBool         *block_pc;   /* per block: -<prefix>bordered_[<body>_]block_cg_pc_block, its preconditioner applied to the block (PCMatApply) */
   PetscReal         *block_check; /* per block: -<prefix>bordered_[<body>_]block_cg_check (0: off) */
   PetscInt          *bcg_its, *bcg_colits, *seq_its; /* per block, the last basis: block CG iterations, column iterations; sequential CG iterations (check) */
   PetscInt           nfactor;
@@ -269,12 +270,13 @@ static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A
 /* under prefix: -lu_mat_solver_type, the package of the LU that a body's operator takes where Cholesky was asked for
    and the operator is not symmetric (BlockFactorType); -block_cg and -block_cg_check, how its border basis is solved
    for with an iterative (CG) inner solver */
-static PetscErrorCode ReadBodyOptions(MPI_Comm comm, const char prefix[], const char title[], char package[], size_t len, PetscBool *block_cg, PetscReal *check)
+static PetscErrorCode ReadBodyOptions(MPI_Comm comm, const char prefix[], const char title[], char package[], size_t len, PetscBool *block_cg, PetscBool *block_pc, PetscReal *check)
 {
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, prefix, title, NULL);
   PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", package, package, len, NULL));
   PetscCall(PetscOptionsBool("-block_cg", "With an inner CG (ksp_type cg): solve for the border basis A^{-1} W (12 columns for a floating frame, 6 per jointed port) by block CG, all columns at once (one sparse product and one block preconditioner application per iteration), instead of one CG solve per column (KSPMatSolve); each column to the KSP's tolerance against its own right-hand side", "PCPHLEXBORDERED", *block_cg, block_cg, NULL));
+  PetscCall(PetscOptionsBool("-block_cg_pc_block", "With block CG: apply the inner preconditioner to the block at once (PCMatApply; GAMG and MG: the grid transfers as block products, the smoothers column by column) instead of column by column (PCApply)", "PCPHLEXBORDERED", *block_pc, block_pc, NULL));
   PetscCall(PetscOptionsReal("-block_cg_check", "With block CG: also solve for the basis column by column (KSPMatSolve), print the largest relative difference of a column and stop (exit code 2) when it exceeds this value (0: no check; a test's option)", "PCPHLEXBORDERED", *check, check, NULL));
   PetscCheck(*check >= 0, comm, PETSC_ERR_USER_INPUT, "-%sblock_cg_check must be >= 0 (0: no check), got %g", prefix ? prefix : "", (double)*check);
   PetscOptionsEnd();
@@ -293,6 +295,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->ksp, PetscMax(pb->nb, 1), &pb->Y, PetscMax(pb->nb, 1), &pb->Astate, PetscMax(pb->nb, 1), &pb->Wstate, PetscMax(pb->nb, 1), &pb->beta));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->lu_package));
+  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->block_pc));
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->block_cg, PetscMax(pb->nb, 1), &pb->block_check, PetscMax(pb->nb, 1), &pb->bcg_its, PetscMax(pb->nb, 1), &pb->bcg_colits, PetscMax(pb->nb, 1), &pb->seq_its));
   PetscCall(PetscCalloc4(PetscMax(pb->nb, 1), &pb->owner, PetscMax(pb->nb, 1), &pb->Aseq, PetscMax(pb->nb, 1), &pb->fseq, PetscMax(pb->nb, 1), &pb->xseq));
   PetscCall(BorderedOwners(pc, pb));
@@ -328,7 +331,8 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
       const char *kprefix;
       PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
       pb->block_cg[i] = PETSC_TRUE;
-      PetscCall(ReadBodyOptions(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i]), &pb->block_cg[i], &pb->block_check[i]));
+      pb->block_pc[i] = PETSC_TRUE;
+      PetscCall(ReadBodyOptions(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i]), &pb->block_cg[i], &pb->block_pc[i], &pb->block_check[i]));
     }
   }
   PetscCall(RefuseSharedSuperLUDist(pc, pb));
@@ -388,7 +392,13 @@ static PetscErrorCode BlockBasis(PC pc, PC_Bordered *pb, PetscInt i, Mat Wl, Mat
     PetscCall(KSPMatSolve(ksp, Wl, Yl));
     PetscFunctionReturn(0);
   }
-  PetscCall(PhlexBlockCG(ksp, Wl, Yl, (PetscBool)(pb->owner[i] < 0), &pb->bcg_its[i], &pb->bcg_colits[i]));
+  {
+    const char *bname;
+    char        what[128];
+    PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &bname));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "border basis of body %s", bname));
+    PetscCall(PhlexBlockCG(ksp, Wl, Yl, (PetscBool)(pb->owner[i] < 0), pb->block_pc[i], what, &pb->bcg_its[i], &pb->bcg_colits[i]));
+  }
   if (pb->block_check[i] > 0 && !PhlexInterruptLocal()) {
     Mat                Ys;
     PetscInt           k, nloc, lda, lds, before, after;
@@ -647,6 +657,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscCall(PetscFree5(pb->ksp, pb->Y, pb->Astate, pb->Wstate, pb->beta));
   PetscCall(PetscFree(pb->is));
   PetscCall(PetscFree(pb->lu_package));
+  PetscCall(PetscFree(pb->block_pc));
   PetscCall(PetscFree5(pb->block_cg, pb->block_check, pb->bcg_its, pb->bcg_colits, pb->seq_its));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
   PetscCall(BorderedCopiesFree(pb));
@@ -713,7 +724,7 @@ PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const nam
   PC          inner;
   const char *prefix;
   char        common[256], title[512], lu_package[64] = "";
-  PetscBool   block_cg = PETSC_TRUE;
+  PetscBool   block_cg = PETSC_TRUE, block_pc = PETSC_TRUE;
   PetscReal   check    = 0;
 
   PetscFunctionBeginUser;
@@ -731,7 +742,7 @@ PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const nam
     PetscCall(PetscStrlcat(title, names[i], sizeof(title)));
   }
   PetscCall(PetscStrlcat(title, ")", sizeof(title)));
-  PetscCall(ReadBodyOptions(PETSC_COMM_SELF, common, title, lu_package, sizeof(lu_package), &block_cg, &check));
+  PetscCall(ReadBodyOptions(PETSC_COMM_SELF, common, title, lu_package, sizeof(lu_package), &block_cg, &block_pc, &check));
   PetscCall(KSPDestroy(&ksp));
   PetscFunctionReturn(0);
 }

@@ -375,6 +375,8 @@ static const struct {
   {"reduced_bordered_block_cg_check", 1},
   {"fieldsplit_1_bordered_block_cg",  1},
   {"fieldsplit_1_bordered_block_cg_check", 1},
+  {"reduced_bordered_block_cg_pc_block",     1},
+  {"fieldsplit_1_bordered_block_cg_pc_block", 1},
 };
 
 static PetscErrorCode CatalogueBuild(MPI_Comm comm, Catalogue *cat)
