@@ -116,6 +116,8 @@ PETSC_INTERN PetscErrorCode PhlexBorderCreateShells(PhlexSystem);
 /* pcbordered.c */
 PETSC_INTERN PetscErrorCode PhlexPCRegister(void);
 PETSC_INTERN PetscErrorCode PhlexPCBorderedHelp(PC, PetscInt, const char *const[]);
+PETSC_INTERN PetscErrorCode PhlexBlockCGApplies(KSP, PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexBlockCG(KSP, Mat, Mat, PetscBool, PetscBool, const char[], PetscInt *, PetscInt *);
 PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
 /* snes_condensed.c: SNES phlexcondensed, the theta-method stage of fixed linear bodies by exact elimination */
 PETSC_INTERN PetscErrorCode PhlexSNESRegister(void);

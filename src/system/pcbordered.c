@@ -41,6 +41,10 @@ typedef struct {
   Mat               *Aseq;   /* per block on its owner: A_i's rows there, the diagonal block of its MPIAIJ matrix */
   Vec               *fseq, *xseq; /* per block on its owner: sequential vectors placed on the rows of r and z */
   char             (*lu_package)[64]; /* per block: -<prefix>bordered_[<body>_]lu_mat_solver_type (empty: the Cholesky's) */
+  PetscBool         *block_cg;   /* per block: -<prefix>bordered_[<body>_]block_cg, the basis by block CG (blockcg.c) where its KSP is CG */
+  PetscBool         *block_pc;   /* per block: -<prefix>bordered_[<body>_]block_cg_pc_block, its preconditioner applied to the block (PCMatApply) */
+  PetscReal         *block_check; /* per block: -<prefix>bordered_[<body>_]block_cg_check (0: off) */
+  PetscInt          *bcg_its, *bcg_colits, *seq_its; /* per block, the last basis: block CG iterations, column iterations; sequential CG iterations (check) */
   PetscInt           nfactor;
   PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
   char             **copy_from, **copy_to;
@@ -263,13 +267,18 @@ static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A
   PetscFunctionReturn(0);
 }
 
-/* -lu_mat_solver_type under prefix: the package of the LU that a body's operator takes where Cholesky was asked for
-   and the operator is not symmetric (BlockFactorType) */
-static PetscErrorCode ReadLUPackage(MPI_Comm comm, const char prefix[], const char title[], char package[], size_t len)
+/* under prefix: -lu_mat_solver_type, the package of the LU that a body's operator takes where Cholesky was asked for
+   and the operator is not symmetric (BlockFactorType); -block_cg and -block_cg_check, how its border basis is solved
+   for with an iterative (CG) inner solver */
+static PetscErrorCode ReadBodyOptions(MPI_Comm comm, const char prefix[], const char title[], char package[], size_t len, PetscBool *block_cg, PetscBool *block_pc, PetscReal *check)
 {
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, prefix, title, NULL);
   PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", package, package, len, NULL));
+  PetscCall(PetscOptionsBool("-block_cg", "With an inner CG (ksp_type cg): solve for the border basis A^{-1} W (12 columns for a floating frame, 6 per jointed port) by block CG, all columns at once (one sparse product and one block preconditioner application per iteration), instead of one CG solve per column (KSPMatSolve); each column to the KSP's tolerance against its own right-hand side", "PCPHLEXBORDERED", *block_cg, block_cg, NULL));
+  PetscCall(PetscOptionsBool("-block_cg_pc_block", "With block CG: apply the inner preconditioner to the block at once (PCMatApply; GAMG and MG: the grid transfers as block products, the smoothers column by column) instead of column by column (PCApply)", "PCPHLEXBORDERED", *block_pc, block_pc, NULL));
+  PetscCall(PetscOptionsReal("-block_cg_check", "With block CG: also solve for the basis column by column (KSPMatSolve), print the largest relative difference of a column and stop (exit code 2) when it exceeds this value (0: no check; a test's option)", "PCPHLEXBORDERED", *check, check, NULL));
+  PetscCheck(*check >= 0, comm, PETSC_ERR_USER_INPUT, "-%sblock_cg_check must be >= 0 (0: no check), got %g", prefix ? prefix : "", (double)*check);
   PetscOptionsEnd();
   PetscFunctionReturn(0);
 }
@@ -286,6 +295,8 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->ksp, PetscMax(pb->nb, 1), &pb->Y, PetscMax(pb->nb, 1), &pb->Astate, PetscMax(pb->nb, 1), &pb->Wstate, PetscMax(pb->nb, 1), &pb->beta));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->lu_package));
+  PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->block_pc));
+  PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->block_cg, PetscMax(pb->nb, 1), &pb->block_check, PetscMax(pb->nb, 1), &pb->bcg_its, PetscMax(pb->nb, 1), &pb->bcg_colits, PetscMax(pb->nb, 1), &pb->seq_its));
   PetscCall(PetscCalloc4(PetscMax(pb->nb, 1), &pb->owner, PetscMax(pb->nb, 1), &pb->Aseq, PetscMax(pb->nb, 1), &pb->fseq, PetscMax(pb->nb, 1), &pb->xseq));
   PetscCall(BorderedOwners(pc, pb));
   PetscCall(PetscMalloc2(PetscMax(pb->m * pb->m, 1), &pb->S, PetscMax(pb->m, 1), &pb->S_piv));
@@ -319,7 +330,9 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
     {
       const char *kprefix;
       PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
-      PetscCall(ReadLUPackage(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i])));
+      pb->block_cg[i] = PETSC_TRUE;
+      pb->block_pc[i] = PETSC_TRUE;
+      PetscCall(ReadBodyOptions(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i]), &pb->block_cg[i], &pb->block_pc[i], &pb->block_check[i]));
     }
   }
   PetscCall(RefuseSharedSuperLUDist(pc, pb));
@@ -361,6 +374,67 @@ static PetscErrorCode BlockFactorType(PC pc, PC_Bordered *pb, PetscInt i, Mat A)
   PetscCall(PCSetType(inner, PCLU));
   if (package[0]) PetscCall(PCFactorSetMatSolverType(inner, package));
   PetscCall(PetscInfo(pc, "block %s: not symmetric, LU instead of Cholesky, with %s\n", name, package[0] ? package : "PETSc's default package"));
+  PetscFunctionReturn(0);
+}
+
+/* Y = A_i^{-1} W for block i's basis (Wl, Yl: the local matrices of a block whole on its process): block CG
+   (blockcg.c) where its KSP is CG and -<prefix>bordered_[<body>_]block_cg is on, else KSPMatSolve (one MatMatSolve
+   for preonly + a factorization; PETSc 3.18 solves column by column for a Krylov method). With
+   -..._block_cg_check tol, the columns solved one by one too and compared */
+static PetscErrorCode BlockBasis(PC pc, PC_Bordered *pb, PetscInt i, Mat Wl, Mat Yl)
+{
+  PetscBool applies = PETSC_FALSE;
+  KSP       ksp = pb->ksp[i];
+
+  PetscFunctionBeginUser;
+  if (pb->block_cg[i]) PetscCall(PhlexBlockCGApplies(ksp, &applies));
+  if (!applies) {
+    PetscCall(KSPMatSolve(ksp, Wl, Yl));
+    PetscFunctionReturn(0);
+  }
+  {
+    const char *bname;
+    char        what[128];
+    PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &bname));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "border basis of body %s", bname));
+    PetscCall(PhlexBlockCG(ksp, Wl, Yl, (PetscBool)(pb->owner[i] < 0), pb->block_pc[i], what, &pb->bcg_its[i], &pb->bcg_colits[i]));
+  }
+  if (pb->block_check[i] > 0 && !PhlexInterruptLocal()) {
+    Mat                Ys;
+    PetscInt           k, nloc, lda, lds, before, after;
+    PetscReal         *d, dmax = 0;
+    const PetscScalar *ya, *sa;
+    const char        *name;
+    MPI_Comm           comm = PetscObjectComm((PetscObject)ksp);
+    PetscCall(MatDuplicate(Yl, MAT_DO_NOT_COPY_VALUES, &Ys));
+    PetscCall(KSPGetTotalIterations(ksp, &before));
+    PetscCall(KSPMatSolve(ksp, Wl, Ys));
+    PetscCall(KSPGetTotalIterations(ksp, &after));
+    pb->seq_its[i] = after - before;
+    PetscCall(MatGetSize(Yl, NULL, &k));
+    PetscCall(MatGetLocalSize(Yl, &nloc, NULL));
+    PetscCall(MatDenseGetLDA(Yl, &lda));
+    PetscCall(MatDenseGetLDA(Ys, &lds));
+    PetscCall(PetscCalloc1(2 * k, &d));
+    PetscCall(MatDenseGetArrayRead(Yl, &ya));
+    PetscCall(MatDenseGetArrayRead(Ys, &sa));
+    for (PetscInt j = 0; j < k; j++)
+      for (PetscInt n = 0; n < nloc; n++) {
+        const PetscReal e = PetscAbsScalar(ya[lda * j + n] - sa[lds * j + n]), r = PetscAbsScalar(sa[lds * j + n]);
+        d[j] += e * e;
+        d[k + j] += r * r;
+      }
+    PetscCall(MatDenseRestoreArrayRead(Ys, &sa));
+    PetscCall(MatDenseRestoreArrayRead(Yl, &ya));
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, d, (PetscMPIInt)(2 * k), MPIU_REAL, MPIU_SUM, comm));
+    for (PetscInt j = 0; j < k; j++) dmax = PetscMax(dmax, d[k + j] > 0 ? PetscSqrtReal(d[j] / d[k + j]) : PetscSqrtReal(d[j]));
+    PetscCall(PetscFree(d));
+    PetscCall(MatDestroy(&Ys));
+    PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
+    PetscCall(PetscPrintf(comm, "border basis of %s: %" PetscInt_FMT " columns by block CG in %" PetscInt_FMT " iterations (%" PetscInt_FMT " column iterations), by sequential CG in %" PetscInt_FMT "; largest relative difference of a column %.2e\n", name, k, pb->bcg_its[i], pb->bcg_colits[i], pb->seq_its[i], (double)dmax));
+    PetscCall(PetscPrintf(comm, "border basis of %s: block CG against sequential CG within %g: %s\n", name, (double)pb->block_check[i], dmax <= pb->block_check[i] ? "PASS" : "FAIL"));
+    PetscCheck(dmax <= pb->block_check[i], comm, PETSC_ERR_USER_INPUT, "body %s: the border basis by block CG differs from the sequential CG's by %.3e of a column, more than -block_cg_check %g", name, (double)dmax, (double)pb->block_check[i]);
+  }
   PetscFunctionReturn(0);
 }
 
@@ -426,7 +500,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
           PetscCall(MatDenseGetLocalMatrix(bd->W[i], &Wl));
           PetscCall(MatDenseGetLocalMatrix(pb->Y[i], &Yl));
         }
-        PetscCall(KSPMatSolve(pb->ksp[i], Wl, Yl));
+        PetscCall(BlockBasis(pc, pb, i, Wl, Yl));
       }
       PetscCall(PetscLogEventEnd(PHLEX_BorderedBasis, pb->ksp[i], 0, 0, 0));
     }
@@ -583,6 +657,8 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscCall(PetscFree5(pb->ksp, pb->Y, pb->Astate, pb->Wstate, pb->beta));
   PetscCall(PetscFree(pb->is));
   PetscCall(PetscFree(pb->lu_package));
+  PetscCall(PetscFree(pb->block_pc));
+  PetscCall(PetscFree5(pb->block_cg, pb->block_check, pb->bcg_its, pb->bcg_colits, pb->seq_its));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
   PetscCall(BorderedCopiesFree(pb));
   pb->bd = NULL;
@@ -614,6 +690,7 @@ static PetscErrorCode PCView_Bordered(PC pc, PetscViewer viewer)
     PetscCall((*pb->bd->blockprefix)(pb->bd->ctx, i, &name));
     if (pb->owner[i] < 0) {
       PetscCall(PetscViewerASCIIPrintf(viewer, "  solver for the sparse block of %s:\n", name));
+      if (pb->bcg_its[i]) PetscCall(PetscViewerASCIIPrintf(viewer, "  its border basis (last computed) by block CG: %" PetscInt_FMT " iterations, %" PetscInt_FMT " column iterations\n", pb->bcg_its[i], pb->bcg_colits[i]));
       PetscCall(PetscViewerASCIIPushTab(viewer));
       PetscCall(KSPView(pb->ksp[i], viewer));
       PetscCall(PetscViewerASCIIPopTab(viewer));
@@ -647,6 +724,8 @@ PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const nam
   PC          inner;
   const char *prefix;
   char        common[256], title[512], lu_package[64] = "";
+  PetscBool   block_cg = PETSC_TRUE, block_pc = PETSC_TRUE;
+  PetscReal   check    = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
@@ -663,7 +742,7 @@ PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const nam
     PetscCall(PetscStrlcat(title, names[i], sizeof(title)));
   }
   PetscCall(PetscStrlcat(title, ")", sizeof(title)));
-  PetscCall(ReadLUPackage(PETSC_COMM_SELF, common, title, lu_package, sizeof(lu_package)));
+  PetscCall(ReadBodyOptions(PETSC_COMM_SELF, common, title, lu_package, sizeof(lu_package), &block_cg, &block_pc, &check));
   PetscCall(KSPDestroy(&ksp));
   PetscFunctionReturn(0);
 }

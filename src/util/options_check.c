@@ -371,6 +371,12 @@ static const struct {
   {"snes_phlexcondensed_guess_order", 1},
   {"snes_phlexreduced_forcing",       1}, /* SNES phlexreduced */
   {"snes_phlexreduced_velocity_rtol", 1},
+  {"reduced_bordered_block_cg",       1}, /* PC phlexbordered, at its set-up (SNES phlexreduced's, the field split's) */
+  {"reduced_bordered_block_cg_check", 1},
+  {"fieldsplit_1_bordered_block_cg",  1},
+  {"fieldsplit_1_bordered_block_cg_check", 1},
+  {"reduced_bordered_block_cg_pc_block",     1},
+  {"fieldsplit_1_bordered_block_cg_pc_block", 1},
 };
 
 static PetscErrorCode CatalogueBuild(MPI_Comm comm, Catalogue *cat)
