@@ -57,6 +57,7 @@ struct _p_PhlexOutput {
   void       **writer_ctx;
   PetscErrorCode (**writer_save)(void *, PetscViewer); /* records writer k's state in a checkpoint */
   PetscBool    keep_tmp;                  /* a checkpoint refers to the temporary files: an error keeps them */
+  PetscBool   *had_tmp;                   /* per file (rank 0): its temporary file existed before this run (a checkpoint's) */
   PetscLogDouble series_flushed;          /* wall time of the series' last flush (PhlexOutputFlushSeries) */
   PetscViewer  restart;                   /* the checkpoint a restarted run continues (HDF5, read), or NULL */
   char         restart_dir[PETSC_MAX_PATH_LEN]; /* where the interrupted run's series and field segments are */
