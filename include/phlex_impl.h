@@ -218,6 +218,10 @@ PETSC_INTERN PetscErrorCode PhlexProgressPEPMonitor(PEP, PetscInt, PetscInt, Pet
 PETSC_INTERN PetscErrorCode PhlexProgressEPSSolve(EPS, const char[]);
 PETSC_INTERN PetscErrorCode PhlexProgressPEPSolve(PEP, const char[]);
 PETSC_INTERN PetscErrorCode PhlexProgressPhase(PhlexProgress *, MPI_Comm, const char[], PetscReal);
+PETSC_INTERN PetscErrorCode PhlexProgressChunk(PhlexProgress *, MPI_Comm, const char[], PetscInt, PetscInt, PetscInt *);
+PETSC_INTERN PetscErrorCode PhlexProgressChunksEnd(PhlexProgress *, MPI_Comm, const char[], PetscInt);
+PETSC_INTERN void           PhlexProgressSetInSteps(PetscBool);
+PETSC_INTERN PetscErrorCode PhlexProgressCheck(MPI_Comm, const char[]);
 
 /* flexible_modes.c: the eigensolver of the modal analysis with its defaults (also read by -help) */
 PETSC_INTERN PetscErrorCode PhlexModesEPSCreate(MPI_Comm, EPS *, PetscReal *, PetscBool *);
