@@ -57,6 +57,7 @@ struct _p_PhlexOutput {
   void       **writer_ctx;
   PetscErrorCode (**writer_save)(void *, PetscViewer); /* records writer k's state in a checkpoint */
   PetscBool    keep_tmp;                  /* a checkpoint refers to the temporary files: an error keeps them */
+  PetscBool   *had_tmp;                   /* per file (rank 0): its temporary file existed before this run (a checkpoint's) */
   PetscLogDouble series_flushed;          /* wall time of the series' last flush (PhlexOutputFlushSeries) */
   PetscViewer  restart;                   /* the checkpoint a restarted run continues (HDF5, read), or NULL */
   char         restart_dir[PETSC_MAX_PATH_LEN]; /* where the interrupted run's series and field segments are */
@@ -217,6 +218,10 @@ PETSC_INTERN PetscErrorCode PhlexProgressPEPMonitor(PEP, PetscInt, PetscInt, Pet
 PETSC_INTERN PetscErrorCode PhlexProgressEPSSolve(EPS, const char[]);
 PETSC_INTERN PetscErrorCode PhlexProgressPEPSolve(PEP, const char[]);
 PETSC_INTERN PetscErrorCode PhlexProgressPhase(PhlexProgress *, MPI_Comm, const char[], PetscReal);
+PETSC_INTERN PetscErrorCode PhlexProgressChunk(PhlexProgress *, MPI_Comm, const char[], PetscInt, PetscInt, PetscInt *);
+PETSC_INTERN PetscErrorCode PhlexProgressChunksEnd(PhlexProgress *, MPI_Comm, const char[], PetscInt);
+PETSC_INTERN void           PhlexProgressSetInSteps(PetscBool);
+PETSC_INTERN PetscErrorCode PhlexProgressCheck(MPI_Comm, const char[]);
 
 /* flexible_modes.c: the eigensolver of the modal analysis with its defaults (also read by -help) */
 PETSC_INTERN PetscErrorCode PhlexModesEPSCreate(MPI_Comm, EPS *, PetscReal *, PetscBool *);

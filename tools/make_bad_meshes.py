@@ -7,6 +7,8 @@ outputs.  Called from meshes/Makefile; standard library only.
 
   bad_2d.msh            2D triangle mesh (highest dimension 2), from meshes/bad_2d.geo
   bad_hex.msh           hexahedral bar (transfinite + Recombine), from meshes/bad_hex.geo
+  bad_prism.msh         the bar in prisms (a triangulated end face extruded in 4 layers), from meshes/bad_prism.geo
+  bad_physical_names.msh  a msh 4.1 header whose $PhysicalNames entry has no quoted name (the reader stops there)
   bad_inverted.msh      bar_h0.05.msh with the last two nodes of one tetrahedron swapped
   bad_degenerate.msh    hand-made msh 4.1 cube of 6 tets + 1 zero-volume (flat) tet
   bad_empty_group.msh   bar_h0.05.msh plus $PhysicalNames entry 2 9 "empty" (no elements)
@@ -125,6 +127,17 @@ def make_bad_2d(meshdir, gmsh):
 
 def make_bad_hex(meshdir, gmsh):
     run_gmsh(gmsh, meshdir, "bad_hex.geo", 3, [("nx", 10), ("n", 2)], "bad_hex.msh")
+
+
+def make_bad_prism(meshdir, gmsh):
+    run_gmsh(gmsh, meshdir, "bad_prism.geo", 3, [], "bad_prism.msh")
+
+
+def make_bad_physical_names(meshdir, gmsh):
+    text = ("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$PhysicalNames\n2\n2 1 \"clamp\"\n3 1 bar\n"
+            "$EndPhysicalNames\n")
+    write_file(os.path.join(meshdir, "bad_physical_names.msh"), text)
+    print("# bad_physical_names.msh: $PhysicalNames entry '3 1 bar' without quotes")
 
 
 def make_bad_inverted(meshdir, gmsh):
@@ -376,6 +389,8 @@ def make_stress_sliver(meshdir, gmsh, target=1e-3, count=5):
 MAKERS = {
     "bad_2d": make_bad_2d,
     "bad_hex": make_bad_hex,
+    "bad_prism": make_bad_prism,
+    "bad_physical_names": make_bad_physical_names,
     "bad_inverted": make_bad_inverted,
     "bad_degenerate": make_bad_degenerate,
     "bad_empty_group": make_bad_empty_group,

@@ -28,7 +28,9 @@ typedef struct {
   PetscReal   scale;        /* |M| (the at-rest checks are relative to it) */
   PetscBool   coriolis;     /* -linearized_coriolis: the Coriolis part kept (a quadratic eigenproblem) */
   PetscBool   damped;       /* a body or a force element dissipates: a quadratic eigenproblem with damping */
+  PhlexProgress progress;   /* the clock of the pencil's build: its steps check the interrupt flag, report progress */
 } Pencil;
+PETSC_INTERN PetscErrorCode PhlexLinearizedPencilPhase(Pencil *, const char[], PetscReal);
 
 typedef struct {
   PetscInt   n, nmech;

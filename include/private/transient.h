@@ -37,6 +37,7 @@ typedef struct {
   /* watchdogs: stop a run whose numbers went wrong (0: off) */
   PetscReal   watch_balance, watch_gap, watch_orth;
   PetscReal   watch_energy;    /* stop when the energy created (H - H0 - W + D) exceeds this times max(E0, the work) */
+  PetscReal   expect_drift_max; /* -expect_energy_drift_max (-1: not given): refused at step 0 when H0 is no scale */
   PetscReal   E0abs;           /* |kinetic| + |strain| + |potential| at the start: the energy's scale (H0 may cancel to 0) */
   PetscReal   V0, max_dV;      /* the potential at the start, the largest it exchanged since (a pendulum released at rest) */
   PetscReal   watch_deform;    /* stop when a body's elastic displacement exceeds this times its size */

@@ -289,6 +289,19 @@ static PetscErrorCode BodiesOperator(PhlexSystem sys, PetscInt which, Mat *S)
   PetscFunctionReturn(0);
 }
 
+/* The pencil's build (the field operators, the borders, the discrete rows) takes seconds to minutes on a large body:
+   each of its steps checks the interrupt flag and reports progress (issue 43 item 1), as the assembly's element
+   loops do; what it is in names the step */
+PetscErrorCode PhlexLinearizedPencilPhase(Pencil *p, const char step[], PetscReal done)
+{
+  char what[128];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(what, sizeof(what), "assembly of the linearized pencil (%s)", step));
+  PetscCall(PhlexProgressPhase(&p->progress, p->sys->comm, what, done));
+  PetscFunctionReturn(0);
+}
+
 /* The field operators: the bodies' velocity masses M and condensed stiffnesses K = G^T Ms^{-1} G (the stress
    eliminated cell by cell, so that the self-equilibrated stresses of the mixed form, each a zero eigenvalue, are
    gone), from the part contract; about a stressed or spinning steady state (a body with -spin, or with
@@ -306,6 +319,8 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
   Mat         Kst = NULL, Gyr = NULL, Rd = NULL;
 
   PetscFunctionBeginUser;
+  PetscCall(PhlexProgressStart(&p->progress));
+  PetscCall(PhlexLinearizedPencilPhase(p, "the field operators", 0.0));
   PetscCall(MatCreateVecs(sys->Jvv, &x, &y1));
   PetscCall(VecDuplicate(y1, &y2));
   PetscCall(VecDuplicate(y1, &yu1));
@@ -321,13 +336,16 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
   PetscCall(EvaluateJacobian(p, 2.0));
   PetscCall(MatMult(sys->Jvv, x, y2));
   if (xu) PetscCall(MatMult(sys->Jvu, xu, yu2));
+  PetscCall(PhlexLinearizedPencilPhase(p, "the Jacobian at the linearisation point", 0.2));
   /* the bodies' own mass and condensed stiffness (taken apart they would lose digits to cancellation), at the state */
   PetscCall(MatDestroy(&p->Mvv));
   PetscCall(MatDestroy(&p->K));
   PetscCall(MatDestroy(&p->Gyr));
   PetscCall(MatDestroy(&p->Rf));
   PetscCall(BodiesOperator(sys, 1, &p->Mvv));
+  PetscCall(PhlexLinearizedPencilPhase(p, "the bodies' mass", 0.4));
   PetscCall(BodiesOperator(sys, 2, &p->K));
+  PetscCall(PhlexLinearizedPencilPhase(p, "the bodies' stiffness", 0.6));
   PetscCall(PhlexSystemCondensedOperator(sys, 3, &Kst));
   PetscCall(PhlexSystemCondensedOperator(sys, 4, &Gyr));
   if (Kst) {
@@ -339,6 +357,7 @@ static PetscErrorCode BuildFieldOperators(Pencil *p)
   if (Gyr) PetscCall(ToAIJ(Gyr, &p->Gyr));
   PetscCall(PhlexSystemCondensedOperator(sys, 5, &Rd));
   if (Rd) PetscCall(ToAIJ(Rd, &p->Rf));
+  PetscCall(PhlexLinearizedPencilPhase(p, "the stiffening, spin and damping operators", 0.8));
   PetscCall(MatSetOption(p->K, MAT_SYMMETRIC, PETSC_TRUE));
   PetscCall(MatNorm(p->Mvv, NORM_FROBENIUS, &nm));
   p->scale = nm;
@@ -617,7 +636,10 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
   PetscCall(PetscMalloc2(PetscMax(nq * nq, 1), &DE, PetscMax(nq * nq, 1), &DA));
   if (p->ne) PetscCall(PetscCalloc1(nqv * nqv, &Kq));
   PetscCall(PetscCalloc1(PetscMax(nqv * nqv, 1), &Rq));
+  PetscCall(PhlexProgressStart(&p->progress));
+  PetscCall(PhlexLinearizedPencilPhase(p, "the borders", 0.0));
   PetscCall(Borders(p, &BE, &BA, DE, DA));
+  PetscCall(PhlexLinearizedPencilPhase(p, "the borders", 1.0));
   for (PetscInt k = 0; k < nq * nq; k++) dmax = PetscMax(dmax, PetscAbsReal(DE[k]));
   dmax = PetscMax(dmax, p->scale);
   /* at rest: no A part among the velocities but the damping of a part that dissipates (a reduced body's), no
@@ -653,6 +675,7 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
     PetscInt           rs, re, ld;
     const PetscScalar *be, *ba;
     PetscReal          amax = 0, emax = 0;
+    PetscInt           chunk = 0;
     PetscCall(MatGetOwnershipRange(BE, &rs, &re));
     nvl = re - rs;
     PetscCall(MatCreateAIJ(sys->comm, nvl, Ql, PETSC_DETERMINE, nQ, nQ, NULL, nQ, NULL, &AvQ));
@@ -663,6 +686,7 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
     PetscCall(MatDenseGetArrayRead(BE, &be));
     PetscCall(MatDenseGetArrayRead(BA, &ba));
     for (PetscInt r = 0; r < nvl; r++) {
+      PetscCall(PhlexProgressChunk(&p->progress, sys->comm, "assembly of the linearized pencil (the discrete unknowns' columns)", r, nvl, &chunk));
       for (PetscInt j = 0; j < nq; j++) {
         const PetscInt  jj = p->qmap[j];
         const PetscReal e = PetscRealPart(be[j * ld + r]), a = PetscRealPart(ba[j * ld + r]);
@@ -682,6 +706,7 @@ static PetscErrorCode BuildPencil(Pencil *p, PetscInt *nmech)
     }
     PetscCall(MatDenseRestoreArrayRead(BE, &be));
     PetscCall(MatDenseRestoreArrayRead(BA, &ba));
+    PetscCall(PhlexProgressChunksEnd(&p->progress, sys->comm, "assembly of the linearized pencil (the discrete unknowns' columns)", chunk));
     PetscCall(MatAssemblyBegin(AvQ, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyBegin(BvQ, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(AvQ, MAT_FINAL_ASSEMBLY));

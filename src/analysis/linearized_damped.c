@@ -138,6 +138,7 @@ PetscErrorCode PhlexLinearizedElementOperators(Pencil *p, const PetscReal *DE, c
   const PetscInt     stride = 1 + 2 * nel; /* a gathered field column: its pencil index, W_K's and W_C's values */
 
   PetscFunctionBeginUser;
+  PetscCall(PhlexLinearizedPencilPhase(p, "the force elements' rows", 0.0));
   PetscCallMPI(MPI_Comm_rank(sys->comm, &rank));
   PetscCallMPI(MPI_Comm_size(sys->comm, &size));
   PetscCall(PetscMalloc5(nel * nel, &M1, nel * nel, &M2, PetscMax(nel * nqv, 1), &WKd, PetscMax(nel * nqv, 1), &WCd, PetscMax(nqv * nel, 1), &BVd));
@@ -187,6 +188,7 @@ PetscErrorCode PhlexLinearizedElementOperators(Pencil *p, const PetscReal *DE, c
       PetscCall(VecRestoreArrayRead(WCf[a], &wc[a]));
     }
     PetscCall(PetscFree2(wk, wc));
+    PetscCall(PhlexLinearizedPencilPhase(p, "the force elements' rows", 0.5));
     PetscCall(PetscMalloc2(size, &counts, size, &displs));
     {
       PetscMPIInt mine = (PetscMPIInt)(stride * nsend);

@@ -348,6 +348,12 @@ static PetscErrorCode MonitorEnergy(TS ts, PetscInt step, PetscReal t, Vec X, vo
     m->H0 = m->Hprev = m->Hmax = H;
     m->E0abs = PetscAbsReal(kin) + PetscAbsReal(strain) + PetscAbsReal(pot);
     m->V0    = pot;
+    /* a relative drift needs H0 > 0: refused here, before any step and before anything is committed */
+    if (m->expect_drift_max >= 0 && !(H > 0)) {
+      char v[32];
+      PhlexFormatReal(m->expect_drift_max, v, sizeof(v));
+      SETERRQ(m->scene->comm, PETSC_ERR_USER_INPUT, "-expect_energy_drift_max %s needs a nonzero initial energy (H0 = %g J, no scale for a relative drift): bound the drift in joules with -expect_energy_drift_abs_max", v, (double)(H * m->scene->units.energy));
+    }
   } else {
     m->work_total += dt * power;
     m->dissipated_total += dt * dissipated;
@@ -1162,6 +1168,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
 
   /* monitor and outputs */
   m.scene    = scene;
+  m.expect_drift_max = o.drift_max;
   m.sys      = sys;
   m.interval = scene->output->interval;
   PetscCall(PetscObjectTypeCompareAny((PetscObject)ts, &m.theta, TSTHETA, TSCN, TSBEULER, ""));
@@ -1217,6 +1224,8 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(PhlexTransientRestart(ts, &m, checkpoint, restart, X));
     PetscCall(PetscViewerDestroy(&checkpoint));
     scene->output->restart = NULL;
+    /* the H0 the checkpoint carries (the first run's step 0, where the check is made without -restart) */
+    PetscCheck(o.drift_max < 0 || m.H0 > 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_energy_drift_max needs a nonzero initial energy: the run continued from '%s' (option -restart) started with H0 = %g J; bound the drift in joules with -expect_energy_drift_abs_max", restart, (double)(m.H0 * scene->units.energy));
   }
   PetscCall(PetscTime(&m.ck_last));
 
@@ -1231,7 +1240,9 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(TSGetStepNumber(ts, &s0));
     m.progress.done0 = PetscMin(1.0, PetscMax(tmax < PETSC_MAX_REAL ? t0 / tmax : 0.0, smax < PETSC_MAX_INT ? (PetscReal)s0 / smax : 0.0));
   }
+  PhlexProgressSetInSteps(PETSC_TRUE); /* the loops inside the steps do not check: a run stops between steps */
   PetscCall(TSSolve(ts, X));
+  PhlexProgressSetInSteps(PETSC_FALSE);
   PetscCall(PetscLogStagePop());
   PetscCall(TSGetStepNumber(ts, &nsteps));
   PetscCall(TSGetSolveTime(ts, &tfinal));
@@ -1300,7 +1311,6 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   PetscCall(PhlexOutputCommit(scene->output));
 
   if (o.drift_max >= 0) {
-    PetscCheck(m.H0 > 0, scene->comm, PETSC_ERR_USER_INPUT, "-expect_energy_drift_max needs a nonzero initial energy");
     PetscCall(PhlexExpectMax(scene->comm, "energy drift (max |H - H0| / H0)", "-expect_energy_drift_max", m.max_drift / m.H0, o.drift_max, PETSC_TRUE));
   }
   if (o.drift_abs_max >= 0) PetscCall(PhlexExpectMax(scene->comm, "energy drift (max |H - H0|, J)", "-expect_energy_drift_abs_max", m.max_drift * u->energy, o.drift_abs_max, PETSC_TRUE));

@@ -147,6 +147,8 @@ static void ReadHeaderRank0(const char file[], PhlexMeshHeader *h, PhlexPhysical
     if (!strncmp(line, "$PhysicalNames", 14)) {
       if (!fgets(line, sizeof(line), fp) || sscanf(line, "%d", &ngroups) != 1 || ngroups < 0) {
         h->status = MESH_BAD_NAMES;
+        line[strcspn(line, "\r\n")] = 0;
+        snprintf(h->detail, sizeof(h->detail), "its count '%.200s' is not a number of names", feof(fp) ? "" : line);
         fclose(fp);
         return;
       }
@@ -156,7 +158,8 @@ static void ReadHeaderRank0(const char file[], PhlexMeshHeader *h, PhlexPhysical
         char *q0, *q1;
         if (!fgets(line, sizeof(line), fp) || sscanf(line, "%d %d", &dim, &tag) != 2 || !(q0 = strchr(line, '"')) || !(q1 = strchr(q0 + 1, '"'))) {
           h->status = MESH_BAD_NAMES;
-          snprintf(h->detail, sizeof(h->detail), "%.200s", line);
+          line[strcspn(line, "\r\n")] = 0; /* the entry in the one-line message, without its line end */
+          snprintf(h->detail, sizeof(h->detail), "entry '%.200s'", line);
           fclose(fp);
           return;
         }

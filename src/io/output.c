@@ -177,22 +177,29 @@ PetscErrorCode PhlexOutputFile(PhlexOutput out, const char name[], char tmp[])
   if (k == out->maxfiles) {
     char(*tmp)[PETSC_MAX_PATH_LEN], (*fin)[PETSC_MAX_PATH_LEN];
     PetscViewer   *csv;
+    PetscBool     *had;
     const PetscInt n = PetscMax(16, 2 * out->maxfiles);
-    PetscCall(PetscMalloc3(n, &tmp, n, &fin, n, &csv));
+    PetscCall(PetscMalloc4(n, &tmp, n, &fin, n, &csv, n, &had));
     if (k) {
       PetscCall(PetscArraycpy(tmp, out->tmp, k));
       PetscCall(PetscArraycpy(fin, out->final, k));
       PetscCall(PetscArraycpy(csv, out->csv, k));
+      PetscCall(PetscArraycpy(had, out->had_tmp, k));
     }
-    PetscCall(PetscFree3(out->tmp, out->final, out->csv));
+    PetscCall(PetscFree4(out->tmp, out->final, out->csv, out->had_tmp));
     out->tmp      = tmp;
     out->final    = fin;
     out->csv      = csv;
+    out->had_tmp  = had;
     out->maxfiles = n;
   }
   out->csv[k] = NULL;
   PetscCall(PetscSNPrintf(out->final[k], PETSC_MAX_PATH_LEN, "%s/%s", out->dir, name));
   PetscCall(PetscSNPrintf(out->tmp[k], PETSC_MAX_PATH_LEN, "%s/.%s.tmp", out->dir, name));
+  {
+    struct stat st;
+    out->had_tmp[k] = stat(out->tmp[k], &st) ? PETSC_FALSE : PETSC_TRUE; /* rank 0's answer is the one used */
+  }
   PetscCall(PetscStrcpy(tmp, out->tmp[k]));
   out->nfiles++;
   PetscFunctionReturn(0);
@@ -309,7 +316,12 @@ PetscErrorCode PhlexOutputAbort(PhlexOutput out)
   if (!out) return 0;
   MPI_Comm_rank(out->comm, &rank);
   Unlock(out);
-  if (rank == 0 && out->keep_tmp && out->nfiles) {
+  if (rank == 0 && out->keep_tmp && out->nfiles && PhlexExitCode() == PHLEX_EXIT_INPUT) {
+    /* refused input (a restart's checks come after its series were continued into their temporary files): nothing
+       of this run stays; the temporary files an interrupted run left for -restart stay as they were */
+    for (PetscInt k = 0; k < out->nfiles; k++)
+      if (!out->had_tmp[k]) (void)remove(out->tmp[k]);
+  } else if (rank == 0 && out->keep_tmp && out->nfiles) {
     /* a checkpoint continues them (-restart) */
     fprintf(stderr, "phlex: the partial series and fields in '%s' were kept for the checkpoint (continue with -restart)\n", out->dir);
   } else if (rank == 0 && !out->keep_tmp) {
@@ -614,7 +626,7 @@ PetscErrorCode PhlexOutputDestroy(PhlexOutput *out)
   PetscFunctionBeginUser;
   if (!*out) PetscFunctionReturn(0);
   Unlock(*out);
-  PetscCall(PetscFree3((*out)->tmp, (*out)->final, (*out)->csv));
+  PetscCall(PetscFree4((*out)->tmp, (*out)->final, (*out)->csv, (*out)->had_tmp));
   PetscCall(PetscFree2((*out)->writer_ctx, (*out)->writer_save));
   PetscCall(PetscFree3((*out)->restart_csv, (*out)->restart_csv_length, (*out)->restart_csv_used));
   PetscCall(PetscFree(*out));

@@ -7,6 +7,7 @@
 #include <phlex_impl.h>
 #include <yaml.h>
 #include <errno.h>
+#include <sys/stat.h>
 #include <ctype.h>
 #include <strings.h>
 
@@ -272,6 +273,21 @@ int PhlexSceneFilesCheck(int argc, char **argv)
   for (int i = 1; i + 1 < argc; i++) {
     const int yaml_option = !strcmp(argv[i], "-options_file_yaml");
     if (!yaml_option && strcmp(argv[i], "-options_file")) continue;
+    {
+      /* PETSc would stop with its traceback (exit 83) on a directory or a plain options file it cannot open (a
+         scene file's is CheckYAML's) */
+      struct stat st;
+      FILE       *fp;
+      const int   yaml = yaml_option || EndsWith(argv[i + 1], ".yaml") || EndsWith(argv[i + 1], ".yml");
+      if (stat(argv[i + 1], &st) == 0 && S_ISDIR(st.st_mode)) {
+        if (IsRankZero()) fprintf(stderr, "phlex: error: option %s '%s' names a directory, not %s\n", argv[i], argv[i + 1], yaml ? "a scene file" : "an options file");
+        return PHLEX_EXIT_INPUT;
+      }
+      if (!yaml && !(fp = fopen(argv[i + 1], "rb"))) {
+        if (IsRankZero()) fprintf(stderr, "phlex: error: cannot read the options file '%s' (option %s): %s\n", argv[i + 1], argv[i], strerror(errno));
+        return PHLEX_EXIT_INPUT;
+      } else if (!yaml) fclose(fp);
+    }
     if (yaml_option || EndsWith(argv[i + 1], ".yaml") || EndsWith(argv[i + 1], ".yml")) {
       const int code = CheckYAML(argv[i], argv[i + 1]);
       if (code) return code;

@@ -352,32 +352,9 @@ static PetscErrorCode SetUpCellGeometry(PhlexFlexible b, const PhlexUnits *u)
 
 /* Element loop assembling the velocity operators Mv, K and the body-force vectors (non-dimensional, once). */
 /* The element loops of a large body's assembly take seconds to minutes: they report progress and stop on SIGINT or
-   SIGTERM (issue 43 item 1). Every process splits its local cells into ASSEMBLY_CHUNKS equal chunks and meets the
-   others after each (PhlexProgressPhase: one reduction), so that the processes check the same number of times
-   whatever their cell counts; a process that received the signal skips nothing, it only stops at the next chunk. */
-#define ASSEMBLY_CHUNKS 8
-
-/* after local cell c: the end of a chunk (its share of the local cells) calls the collective check */
-static PetscErrorCode AssemblyChunk(PhlexFlexible b, PhlexProgress *p, const char what[], PetscInt c, PetscInt *chunk)
-{
-  const PetscInt ncells = b->cEnd - b->cStart;
-
-  PetscFunctionBeginUser;
-  while (*chunk < ASSEMBLY_CHUNKS - 1 && (c + 1) * ASSEMBLY_CHUNKS >= (*chunk + 1) * ncells) {
-    (*chunk)++;
-    PetscCall(PhlexProgressPhase(p, b->comm, what, (PetscReal)*chunk / ASSEMBLY_CHUNKS));
-  }
-  PetscFunctionReturn(0);
-}
-
-/* after the loop: the checks a process with fewer cells (or none) has not made yet, then the last */
-static PetscErrorCode AssemblyChunksEnd(PhlexFlexible b, PhlexProgress *p, const char what[], PetscInt chunk)
-{
-  PetscFunctionBeginUser;
-  for (; chunk < ASSEMBLY_CHUNKS - 1; chunk++) PetscCall(PhlexProgressPhase(p, b->comm, what, (PetscReal)(chunk + 1) / ASSEMBLY_CHUNKS));
-  PetscCall(PhlexProgressPhase(p, b->comm, what, 1.0));
-  PetscFunctionReturn(0);
-}
+   SIGTERM (issue 43 item 1), in eight chunks of the local cells (PhlexProgressChunk, progress.c) */
+#define AssemblyChunk(b, p, what, c, chunk) PhlexProgressChunk(p, (b)->comm, what, c, (b)->cEnd - (b)->cStart, chunk)
+#define AssemblyChunksEnd(b, p, what, chunk) PhlexProgressChunksEnd(p, (b)->comm, what, chunk)
 
 static PetscErrorCode AssembleVelocityOperators(PhlexFlexible b, const PhlexUnits *u)
 {

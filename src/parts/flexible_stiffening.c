@@ -118,17 +118,25 @@ PetscErrorCode PhlexFlexibleCouplingUpdate(PhlexFlexible b, Vec u)
   const PetscInt     nv = b->nb_v, ns = b->nb_s;
   const PetscScalar *ua;
   PetscReal         *Ge, *work, ue[3 * PHLEX_MAX_NODES];
+  PhlexProgress      progress;
+  PetscInt           chunk = 0;
+  char               what[PHLEX_NAME_LEN + 64];
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BodyAssemble, 0, 0, 0, 0));
   PetscCall(PetscMalloc2(ns * nv, &Ge, ns * nv, &work));
   PetscCall(ToLocal(b, u, b->uloc, &ua));
+  /* outside the time steps (the steady state of a linearised analysis): checks the interrupt flag, reports progress */
+  PetscCall(PetscSNPrintf(what, sizeof(what), "stiffening of body %s (G(u))", b->name));
+  PetscCall(PhlexProgressStart(&progress));
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
     const PetscReal *g = &b->cell_geom[10 * c];
     CellValues(b, c, ua, ue);
     PhlexElementCouplingDeformed(&b->basis_v, &b->basis_s, g[0], &g[1], ue, Ge);
     PetscCall(SetCouplingBlock(b, b->Gres, c, Ge, work));
+    PetscCall(PhlexProgressChunk(&progress, b->comm, what, c, b->cEnd - b->cStart, &chunk));
   }
+  PetscCall(PhlexProgressChunksEnd(&progress, b->comm, what, chunk));
   PetscCall(VecRestoreArrayRead(b->uloc, &ua));
   PetscCall(PetscFree2(Ge, work));
   PetscCall(MatAssemblyBegin(b->Gres, MAT_FINAL_ASSEMBLY));
@@ -150,7 +158,9 @@ PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible b, Vec u, Vec s, Ve
   const PetscInt     nv = b->nb_v, ns = b->nb_s, nn = nv / 3;
   const PetscScalar *ua, *va, *sa;
   PetscReal         *Ge, *Je, *Ke, *Kc, *Nc, *W, *C, *Mse, *work, A[36], ue[3 * PHLEX_MAX_NODES], ve[3 * PHLEX_MAX_NODES];
-  PetscInt           rstart;
+  PetscInt           rstart, chunk = 0;
+  PhlexProgress      progress;
+  char               what[PHLEX_NAME_LEN + 64];
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BodyAssemble, 0, 0, 0, 0));
@@ -163,6 +173,8 @@ PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible b, Vec u, Vec s, Ve
   PetscCall(ToLocal(b, u, b->uloc, &ua));
   PetscCall(ToLocal(b, v, b->vloc, &va));
   PetscCall(VecGetArrayRead(s, &sa));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "stiffening of body %s (K_sigma, the Jacobian's blocks)", b->name));
+  PetscCall(PhlexProgressStart(&progress));
   for (PetscInt c = 0; c < b->cEnd - b->cStart; c++) {
     const PetscReal     *g   = &b->cell_geom[10 * c];
     const PhlexMaterial *mat = &b->materials[b->cell_material[c]];
@@ -202,7 +214,9 @@ PetscErrorCode PhlexFlexibleStiffeningJacobian(PhlexFlexible b, Vec u, Vec s, Ve
     PetscCall(MatSetValuesBlocked(b->Ksig, nn, nodes, nn, nodes, Ke, ADD_VALUES));
     PetscCall(MatSetValuesBlocked(b->Kaij, nn, nodes, nn, nodes, Kc, ADD_VALUES));
     PetscCall(MatSetValuesBlocked(b->Nsu, nn, nodes, nn, nodes, Nc, ADD_VALUES));
+    PetscCall(PhlexProgressChunk(&progress, b->comm, what, c, b->cEnd - b->cStart, &chunk));
   }
+  PetscCall(PhlexProgressChunksEnd(&progress, b->comm, what, chunk));
   PetscCall(VecRestoreArrayRead(s, &sa));
   PetscCall(VecRestoreArrayRead(b->uloc, &ua));
   PetscCall(VecRestoreArrayRead(b->vloc, &va));
@@ -236,10 +250,14 @@ PetscErrorCode PhlexFlexibleStressOfDisplacement(PhlexFlexible b, Vec u, Vec s)
   const PetscScalar *ua;
   PetscScalar       *sa;
   PetscReal         *Mse, be[6 * 4], A[36], ue[3 * PHLEX_MAX_NODES];
-  PetscInt           rstart;
+  PetscInt           rstart, chunk = 0;
+  PhlexProgress      progress;
+  char               what[PHLEX_NAME_LEN + 64];
 
   PetscFunctionBeginUser;
   PetscCall(SetUpWorkspace(b));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "stiffening of body %s (the stress of a displacement)", b->name));
+  PetscCall(PhlexProgressStart(&progress));
   PetscCall(PetscMalloc1(ns * ns, &Mse));
   PetscCall(VecGetOwnershipRange(s, &rstart, NULL));
   PetscCall(ToLocal(b, u, b->uloc, &ua));
@@ -254,7 +272,9 @@ PetscErrorCode PhlexFlexibleStressOfDisplacement(PhlexFlexible b, Vec u, Vec s)
     PetscCheck(!PhlexDenseCholesky(ns, Mse), PETSC_COMM_SELF, PETSC_ERR_PLIB, "body %s: compliance mass of cell %" PetscInt_FMT " is not positive definite", b->name, c);
     PhlexDenseCholeskySolve(ns, Mse, 1, be);
     for (PetscInt j = 0; j < ns; j++) sa[b->cell_soff[c] - rstart + j] = be[j];
+    PetscCall(PhlexProgressChunk(&progress, b->comm, what, c, b->cEnd - b->cStart, &chunk));
   }
+  PetscCall(PhlexProgressChunksEnd(&progress, b->comm, what, chunk));
   PetscCall(VecRestoreArray(s, &sa));
   PetscCall(VecRestoreArrayRead(b->uloc, &ua));
   PetscCall(PetscFree(Mse));

@@ -545,6 +545,18 @@ static PetscErrorCode ResultantsToGlobal(PhlexFlexible b, Vec f)
 }
 
 /* MatMult of the shell B: y (stress field) = Ms^{-1} G v (v velocity field) */
+/* each application of a map is a loop over the rank's cells: outside the time steps (a conversion to AIJ applies it
+   once per column, a solver many times) it checks the interrupt flag first (issue 43 item 1; PhlexProgressCheck) */
+static PetscErrorCode StressMapsCheck(PhlexFlexible b)
+{
+  char what[PHLEX_NAME_LEN + 32];
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(what, sizeof(what), "stress maps of body %s", b->name));
+  PetscCall(PhlexProgressCheck(b->comm, what));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode MatMult_StressRate(Mat A, Vec v, Vec y)
 {
   PhlexFlexible      b;
@@ -554,6 +566,7 @@ static PetscErrorCode MatMult_StressRate(Mat A, Vec v, Vec y)
 
   PetscFunctionBeginUser;
   PetscCall(MapBegin(A, &b));
+  PetscCall(StressMapsCheck(b));
   nv = b->ref.nv;
   nn = b->ref.ns;
   PetscCall(VelocitiesToLocal(b, v));
@@ -578,6 +591,7 @@ static PetscErrorCode MatMult_Resultant(Mat A, Vec sigma, Vec f)
 
   PetscFunctionBeginUser;
   PetscCall(MapBegin(A, &b));
+  PetscCall(StressMapsCheck(b));
   nv = b->ref.nv;
   nn = b->ref.ns;
   PetscCall(VecSet(b->smap_floc, 0.0));
@@ -605,6 +619,7 @@ static PetscErrorCode MatMult_CondensedStiffness(Mat A, Vec v, Vec y)
 
   PetscFunctionBeginUser;
   PetscCall(MapBegin(A, &b));
+  PetscCall(StressMapsCheck(b));
   nv = b->ref.nv;
   nn = b->ref.ns;
   PetscCall(VelocitiesToLocal(b, v));

@@ -608,10 +608,19 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, const PhlexReduction *red, Phle
   } else {
     /* the normal modes of the field on its own space: clamped at the frame patch (a floating body's frame patch is its
        field's Dirichlet part: the modes of the field, not those of the body with its frame), free on mean axes */
-    if (!mean_axes) b->floating = PETSC_FALSE;
-    PetscCall(PhlexFlexibleComputeModes(part, nmodes, &nconv, &nrigid, &lambda, &vecs, NULL, NULL));
-    b->floating = floating;
-    {
+    if (!nmodes) {
+      /* no normal mode asked: the attachment modes alone (none without ports: refused below, before any eigensolve,
+         which would stop in SLEPc on nev = 0) */
+      model->nnormal = 0;
+      lambda1        = 1.0; /* as with modes: the attachment modes' shift, non-dimensional */
+      PetscCall(PetscMalloc1(1, &model->lambda_full));
+      PetscCall(PetscMalloc1(PetscMax(6 * b->nports, 1), &Phi));
+    } else {
+      if (!mean_axes) b->floating = PETSC_FALSE;
+      PetscCall(PhlexFlexibleComputeModes(part, nmodes, &nconv, &nrigid, &lambda, &vecs, NULL, NULL));
+      b->floating = floating;
+    }
+    if (nmodes) {
       const PetscInt r0 = mean_axes ? 6 : 0; /* ComputeModes puts the frame's six rigid modes (zero fields) first */
       PetscCheck(nconv - r0 >= nmodes, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " normal modes of the reduction converged (-%sreduction_modes)", b->name, nconv - r0, nmodes, b->prefix);
       model->nnormal = nmodes;

@@ -55,7 +55,7 @@ static PetscErrorCode LayoutSub(PhlexLayout L, PetscInt n, const PetscInt fields
   for (PetscInt i = 0; i < n; i++) {
     /* a field split from the solver options (a preset for scenes with field unknowns, say) */
     PetscCheck(fields[i] >= 0 && fields[i] < L->nf, L->comm, PETSC_ERR_USER_INPUT, "the solver options split the unknowns by field %" PetscInt_FMT ", but this scene's unknowns have %" PetscInt_FMT " field%s (the first: %s): is -solver_options_file a preset for other kinds of bodies? (a scene of rigid, lumped and reduced parts only takes options/solver/rigid.opts)", fields[i], L->nf, L->nf == 1 ? "" : "s", L->names[0]);
-    PetscCheck(i == 0 || fields[i] > fields[i - 1], L->comm, PETSC_ERR_ARG_WRONG, "fields of a split must be listed in increasing order");
+    PetscCheck(i == 0 || fields[i] > fields[i - 1], L->comm, PETSC_ERR_ARG_WRONG, "the solver options split the unknowns by field %" PetscInt_FMT " after field %" PetscInt_FMT ": the fields of a split (-[<prefix>]pc_fieldsplit_<k>_fields) must be listed in increasing order", fields[i], fields[i - 1]);
     PetscCall(PetscStrcpy(s->names[i], L->names[fields[i]]));
     s->nlocal[i]     = L->nlocal[fields[i]];
     s->bs[i]         = L->bs[fields[i]];

@@ -450,7 +450,11 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectQuery((PetscObject)pc->pmat, "phlex_border", (PetscObject *)&c));
-  PetscCheck(c, PetscObjectComm((PetscObject)pc), PETSC_ERR_ARG_WRONG, "PC phlexbordered works on phlex's {velocity, discrete} split (or the whole system without a flexible body); this preconditioning matrix carries no border data");
+  if (!c) {
+    const char *prefix;
+    PetscCall(PCGetOptionsPrefix(pc, &prefix));
+    SETERRQ(PetscObjectComm((PetscObject)pc), PETSC_ERR_ARG_WRONG, "-%spc_type phlexbordered: PC phlexbordered works on phlex's {velocity, discrete} split (or the whole system without a flexible body); this preconditioning matrix carries no border data", prefix ? prefix : "");
+  }
   PetscCall(PetscContainerGetPointer(c, (void **)&bd));
   if (!pb->bd) {
     pb->bd = bd;

@@ -196,3 +196,72 @@ PetscErrorCode PhlexProgressPhase(PhlexProgress *p, MPI_Comm comm, const char wh
   else PetscCall(PetscPrintf(comm, "progress: %s, elapsed %s\n", what, elapsed));
   PetscFunctionReturn(0);
 }
+
+/* Loops over the local cells of a long phase outside the time steps (the assembly's element loops, the stiffening's
+   and the stress maps', the linearised pencil's rows) check the interrupt flag and report progress: every process
+   splits its n local items into PHLEX_PROGRESS_CHUNKS equal chunks and meets the others after each (PhlexProgressPhase:
+   one reduction), so that the processes check the same number of times whatever their counts; a process that
+   received the signal skips nothing, it stops at the next chunk. Inside the time steps (TSSolve) these loops run in
+   every Newton iteration and do not check: a run stops at the end of its step (README, exit codes 130/143), where a
+   checkpoint can be written. */
+#define PHLEX_PROGRESS_CHUNKS 8
+static PetscBool in_steps = PETSC_FALSE;
+
+/*@C
+  PhlexProgressSetInSteps - marks the time steps (TSSolve): the loops' chunk checks are then off
+
+  Not collective
+@*/
+void PhlexProgressSetInSteps(PetscBool flg)
+{
+  in_steps = flg;
+}
+
+/*@C
+  PhlexProgressChunk - after item i of n local items of a long loop: at the end of a chunk, the collective check
+  (PhlexProgressPhase) with the share done
+
+  Collective (every process calls PhlexProgressChunksEnd after its loop, which makes the checks it has not made)
+@*/
+PetscErrorCode PhlexProgressChunk(PhlexProgress *p, MPI_Comm comm, const char what[], PetscInt i, PetscInt n, PetscInt *chunk)
+{
+  PetscFunctionBeginUser;
+  if (in_steps) PetscFunctionReturn(0);
+  while (*chunk < PHLEX_PROGRESS_CHUNKS - 1 && (i + 1) * PHLEX_PROGRESS_CHUNKS >= (*chunk + 1) * n) {
+    (*chunk)++;
+    PetscCall(PhlexProgressPhase(p, comm, what, (PetscReal)*chunk / PHLEX_PROGRESS_CHUNKS));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProgressChunksEnd - after a loop of PhlexProgressChunk: the checks a process with fewer items (or none) has not
+  made yet, then the last (100 %)
+
+  Collective
+@*/
+PetscErrorCode PhlexProgressChunksEnd(PhlexProgress *p, MPI_Comm comm, const char what[], PetscInt chunk)
+{
+  PetscFunctionBeginUser;
+  if (in_steps) PetscFunctionReturn(0);
+  for (; chunk < PHLEX_PROGRESS_CHUNKS - 1; chunk++) PetscCall(PhlexProgressPhase(p, comm, what, (PetscReal)(chunk + 1) / PHLEX_PROGRESS_CHUNKS));
+  PetscCall(PhlexProgressPhase(p, comm, what, 1.0));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexProgressCheck - outside the time steps: stops the run if interrupted ("in the <what>"); for a loop that is
+  one application of an operator (the stress maps' cell kernels, applied many times by a conversion or a solver)
+
+  Collective
+@*/
+PetscErrorCode PhlexProgressCheck(MPI_Comm comm, const char what[])
+{
+  char where[160];
+
+  PetscFunctionBeginUser;
+  if (in_steps) PetscFunctionReturn(0);
+  PetscCall(PetscSNPrintf(where, sizeof(where), "in the %s", what));
+  PetscCall(PhlexInterruptCheck(comm, where));
+  PetscFunctionReturn(0);
+}
