@@ -58,6 +58,7 @@ struct _p_PhlexOutput {
   PetscErrorCode (**writer_save)(void *, PetscViewer); /* records writer k's state in a checkpoint */
   PetscBool    keep_tmp;                  /* a checkpoint refers to the temporary files: an error keeps them */
   PetscBool   *had_tmp;                   /* per file (rank 0): its temporary file existed before this run (a checkpoint's) */
+  PetscBool    wrote_checkpoint;          /* this run wrote a checkpoint that refers to its temporary files */
   PetscLogDouble series_flushed;          /* wall time of the series' last flush (PhlexOutputFlushSeries) */
   PetscViewer  restart;                   /* the checkpoint a restarted run continues (HDF5, read), or NULL */
   char         restart_dir[PETSC_MAX_PATH_LEN]; /* where the interrupted run's series and field segments are */
@@ -221,6 +222,7 @@ PETSC_INTERN PetscErrorCode PhlexProgressPhase(PhlexProgress *, MPI_Comm, const 
 PETSC_INTERN PetscErrorCode PhlexProgressChunk(PhlexProgress *, MPI_Comm, const char[], PetscInt, PetscInt, PetscInt *);
 PETSC_INTERN PetscErrorCode PhlexProgressChunksEnd(PhlexProgress *, MPI_Comm, const char[], PetscInt);
 PETSC_INTERN void           PhlexProgressSetInSteps(PetscBool);
+PETSC_INTERN PetscBool      PhlexProgressInSteps(void);
 PETSC_INTERN PetscErrorCode PhlexProgressCheck(MPI_Comm, const char[]);
 
 /* flexible_modes.c: the eigensolver of the modal analysis with its defaults (also read by -help) */

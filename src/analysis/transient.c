@@ -1240,9 +1240,13 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
     PetscCall(TSGetStepNumber(ts, &s0));
     m.progress.done0 = PetscMin(1.0, PetscMax(tmax < PETSC_MAX_REAL ? t0 / tmax : 0.0, smax < PETSC_MAX_INT ? (PetscReal)s0 / smax : 0.0));
   }
-  PhlexProgressSetInSteps(PETSC_TRUE); /* the loops inside the steps do not check: a run stops between steps */
-  PetscCall(TSSolve(ts, X));
-  PhlexProgressSetInSteps(PETSC_FALSE);
+  {
+    PetscErrorCode ierr;
+    PhlexProgressSetInSteps(PETSC_TRUE); /* the loops inside the steps do not check: a run stops between steps */
+    ierr = TSSolve(ts, X);
+    PhlexProgressSetInSteps(PETSC_FALSE); /* also when TSSolve failed */
+    PetscCall(ierr);
+  }
   PetscCall(PetscLogStagePop());
   PetscCall(TSGetStepNumber(ts, &nsteps));
   PetscCall(TSGetSolveTime(ts, &tfinal));

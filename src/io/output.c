@@ -316,7 +316,7 @@ PetscErrorCode PhlexOutputAbort(PhlexOutput out)
   if (!out) return 0;
   MPI_Comm_rank(out->comm, &rank);
   Unlock(out);
-  if (rank == 0 && out->keep_tmp && out->nfiles && PhlexExitCode() == PHLEX_EXIT_INPUT) {
+  if (rank == 0 && out->keep_tmp && !out->wrote_checkpoint && out->nfiles && PhlexExitCode() == PHLEX_EXIT_INPUT) {
     /* refused input (a restart's checks come after its series were continued into their temporary files): nothing
        of this run stays; the temporary files an interrupted run left for -restart stay as they were */
     for (PetscInt k = 0; k < out->nfiles; k++)
@@ -484,7 +484,8 @@ PetscErrorCode PhlexOutputSaveState(PhlexOutput out, PetscViewer viewer)
   PetscCallMPI(MPI_Bcast(dir, sizeof(dir), MPI_CHAR, 0, out->comm));
   PetscCall(PhlexCheckpointWriteString(viewer, "/output", "dir", dir));
   for (PetscInt w = 0; w < out->nwriters; w++) PetscCall((*out->writer_save[w])(out->writer_ctx[w], viewer));
-  out->keep_tmp = PETSC_TRUE;
+  out->keep_tmp         = PETSC_TRUE;
+  out->wrote_checkpoint = PETSC_TRUE;
   PetscFunctionReturn(0);
 }
 

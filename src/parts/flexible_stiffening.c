@@ -256,7 +256,7 @@ PetscErrorCode PhlexFlexibleStressOfDisplacement(PhlexFlexible b, Vec u, Vec s)
 
   PetscFunctionBeginUser;
   PetscCall(SetUpWorkspace(b));
-  PetscCall(PetscSNPrintf(what, sizeof(what), "stiffening of body %s (the stress of a displacement)", b->name));
+  PetscCall(PetscSNPrintf(what, sizeof(what), "the stress of a displacement of body %s", b->name));
   PetscCall(PhlexProgressStart(&progress));
   PetscCall(PetscMalloc1(ns * ns, &Mse));
   PetscCall(VecGetOwnershipRange(s, &rstart, NULL));

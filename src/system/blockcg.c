@@ -241,6 +241,7 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBo
       PetscCall(VecDestroy(&z));
     }
     PetscCall(ColumnNorms(comm, ntype, nloc, nJ, Rj, Zj, nrm));
+    for (c = 0; c < nJ; c++) PetscCheck(!PetscIsInfOrNanReal(nrm[c]), comm, PETSC_ERR_NOT_CONVERGED, "block CG of the %s: the residual norm of column %" PetscInt_FMT " is not a number at iteration %" PetscInt_FMT, what, J[c], it);
     if (!it)
       for (c = 0; c < nJ; c++) tol[c] = PetscMax(rtol * nrm[c], atol);
     /* beta = -G^{-1} Q^T Z_J, before the converged columns leave */
@@ -278,7 +279,9 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBo
     }
     if (it >= maxit) break;
     /* SIGINT/SIGTERM between the iterations (issue 43 item 1), a progress line when due */
-    if (collective) {
+    if (PhlexProgressInSteps()) {
+      /* inside a time step (the basis renewed with the operator): the step's end stops the run, after its checkpoint */
+    } else if (collective) {
       char phase[192];
       PetscCall(PetscSNPrintf(phase, sizeof(phase), "block CG of the %s (iteration %" PetscInt_FMT ", %" PetscInt_FMT " of %" PetscInt_FMT " columns converged)", what, it, k - nJ, k));
       PetscCall(PhlexProgressPhase(&progress, comm, phase, -1));
@@ -333,6 +336,13 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBo
   PetscCall(PetscFree5(G, Gf, alpha, beta, piv));
   PetscCall(PetscFree3(nrm, tol, J));
   PetscCall(PetscLogEventEnd(PHLEX_BlockCG, ksp, 0, 0, 0));
-  PetscCheck(converged || stopped || !ksp->errorifnotconverged, comm, PETSC_ERR_NOT_CONVERGED, "block CG of the border basis: %" PetscInt_FMT " of %" PetscInt_FMT " columns not converged in %" PetscInt_FMT " iterations (-ksp_max_it)", nJ, k, *its);
+  /* what KSPGetConvergedReason and KSPGetIterationNumber answer after it, as after a KSPSolve */
+  ksp->its    = *its;
+  ksp->reason = converged ? KSP_CONVERGED_RTOL : (stopped ? KSP_CONVERGED_ITERATING : KSP_DIVERGED_ITS);
+  if (!converged && !stopped && ksp->errorifnotconverged) {
+    const char *prefix;
+    PetscCall(KSPGetOptionsPrefix(ksp, &prefix));
+    SETERRQ(comm, PETSC_ERR_NOT_CONVERGED, "block CG of the %s: %" PetscInt_FMT " of %" PetscInt_FMT " columns not converged in %" PetscInt_FMT " iterations (-%sksp_max_it)", what, nJ, k, *its, prefix ? prefix : "");
+  }
   PetscFunctionReturn(0);
 }

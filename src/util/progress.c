@@ -218,6 +218,17 @@ void PhlexProgressSetInSteps(PetscBool flg)
 }
 
 /*@C
+  PhlexProgressInSteps - whether the time steps are running (PhlexProgressSetInSteps): checks inside a step are left
+  to the step's end, where the monitor writes the checkpoint before it stops the run
+
+  Not collective
+@*/
+PetscBool PhlexProgressInSteps(void)
+{
+  return in_steps;
+}
+
+/*@C
   PhlexProgressChunk - after item i of n local items of a long loop: at the end of a chunk, the collective check
   (PhlexProgressPhase) with the share done
 
