@@ -279,9 +279,9 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBo
     }
     if (it >= maxit) break;
     /* SIGINT/SIGTERM between the iterations (issue 43 item 1), a progress line when due */
-    if (PhlexProgressInSteps()) {
-      /* inside a time step (the basis renewed with the operator): the step's end stops the run, after its checkpoint */
-    } else if (collective) {
+    /* also inside a time step (the first step's set-up, or the basis renewed with the operator): a basis can take
+       minutes on a large body; a signal here stops the run without a checkpoint of this step (README) */
+    if (collective) {
       char phase[192];
       PetscCall(PetscSNPrintf(phase, sizeof(phase), "block CG of the %s (iteration %" PetscInt_FMT ", %" PetscInt_FMT " of %" PetscInt_FMT " columns converged)", what, it, k - nJ, k));
       PetscCall(PhlexProgressPhase(&progress, comm, phase, -1));

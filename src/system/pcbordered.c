@@ -493,7 +493,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
       /* SIGINT/SIGTERM between the factorizations (a sparse factorization itself cannot be interrupted: MUMPS,
          CHOLMOD): before each one on the PC's communicator, the blocks whole on one process all done (renew[] is
          the same on every process, so every process checks as often; issue 43 item 1) */
-      if (renew[i] && pass == 1 && pb->owner[i] < 0 && !PhlexProgressInSteps()) PetscCall(PhlexInterruptCheck(PetscObjectComm((PetscObject)pc), "between the factorizations of the bodies' operators"));
+      if (renew[i] && pass == 1 && pb->owner[i] < 0) PetscCall(PhlexInterruptCheck(PetscObjectComm((PetscObject)pc), "between the factorizations of the bodies' operators"));
       if (!renew[i] || (pass == 0) != (pb->owner[i] >= 0) || (pb->owner[i] >= 0 && !mine)) continue;
       /* logged on the solver's communicator (-log_sync: a barrier there, on one process for a body whole on it) */
       PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pb->ksp[i], 0, 0, 0));
@@ -513,7 +513,7 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
   {
     PetscBool any = PETSC_FALSE;
     for (PetscInt i = 0; i < pb->nb; i++) any = (PetscBool)(any || renew[i]);
-    if (any && !PhlexProgressInSteps()) PetscCall(PhlexInterruptCheck(PetscObjectComm((PetscObject)pc), "after the factorizations of the bodies' operators"));
+    if (any) PetscCall(PhlexInterruptCheck(PetscObjectComm((PetscObject)pc), "after the factorizations of the bodies' operators"));
   }
   PetscCall(PetscFree2(renew, Achanged));
   if (pb->ncopy) PetscCall(BorderedCopiesUsed(pb));
