@@ -480,6 +480,11 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
     PetscCall(PhlexFlexibleCouplingUpdate(b, X->u));
     G = b->Gres;
   }
+  if (!X->p && !b->G) {
+    /* the generic path's first residual: G and Ms, deferred at set-up (FlexFieldOperators) */
+    PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
+    G = b->G;
+  }
   if (!X->p) {
     /* F_u = T u' - v */
     PetscCall(VecAXPBYPCZ(F->u, T, -1.0, 0.0, Xdot->u, X->v));
@@ -708,12 +713,24 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   if (!b->Sv) {
     MatNullSpace   nsp;
     const PetscInt n = b->nv_local, N = b->nv_global;
-    PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
+    /* the assembled coupling G and compliance mass Ms (3.0 kB per velocity DOF) multiply only Newton on the whole state
+       and a displaced initial state: assembled when one of them asks (FlexMixedOperators, FlexResidual, the stress
+       initial condition), not here, so that they never coexist with the AIJ copies below on the stages of SNES
+       phlexcondensed and phlexreduced, which apply B, G^T and K cell by cell (BENCHMARKS.md section 40: the set-up's
+       peak). A body with geometric stiffening or spin builds on G; -phlex_check_stress_maps compares with it. */
+    if (b->stiffening || b->spinning || b->check_stress_maps) PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
+    else if (!b->smap_created) {
+      PetscCall(PhlexFlexibleCreateStressMaps(b));
+      b->smap_created = PETSC_TRUE;
+    }
     /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv */
     PetscCall(AIJCopies(b));
     PetscCall(MassProductSetUp(b));
     PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
-    PetscCall(MatAXPY(b->Sv, 1.0, b->Mvaij, DIFFERENT_NONZERO_PATTERN));
+    /* K and Mv have the same pattern (the P2 node couplings, full 3 x 3 blocks): PETSc finds it and adds in place;
+       DIFFERENT_NONZERO_PATTERN built the sum as a new matrix beside Sv (0.95 kB per velocity DOF at the set-up's peak,
+       BENCHMARKS.md section 40) */
+    PetscCall(MatAXPY(b->Sv, 1.0, b->Mvaij, UNKNOWN_NONZERO_PATTERN));
     PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_TRUE));
     PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
     PetscCall(MatSetNearNullSpace(b->Sv, nsp));
@@ -882,13 +899,29 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   const PetscInt n = b->nv_local, nq = part->nq, nin = b->border_nin;
   PetscReal      Arr[324];
 
-  PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift), converted = PETSC_FALSE;
+  PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift);
 
   PetscFunctionBeginUser;
   if (new_shift && !b->Mvaij) {
-    /* released (FlexMixedOperators): converted for this rebuild only */
-    PetscCall(AIJCopies(b));
-    converted = PETSC_TRUE;
+    /* released (FlexMixedOperators: a fixed body without stiffening or spin): K and Mv converted to AIJ for this
+       rebuild only, one after the other (the operations and their order as below), so that one AIJ copy exists at a
+       time beside Sv and Jvv (BENCHMARKS.md section 40) */
+    PetscCheck(!b->floating && !b->stiffening && !b->spinning, b->comm, PETSC_ERR_PLIB, "body %s: AIJ copies released", b->name);
+    b->shift = shift;
+    PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
+    PetscCall(MatCopy(b->Kaij, b->Sv, b->kpattern));
+    PetscCall(MatDestroy(&b->Kaij));
+    PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    PetscCall(MatCopy(b->Mvaij, b->Jvv, b->damped ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
+    PetscCall(MatScale(b->Jvv, shift));
+    if (b->damped) PetscCall(MatAXPY(b->Jvv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN));
+    PetscCall(MatAssemblyBegin(b->Jvv, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(b->Jvv, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatScale(b->Sv, 1.0 / shift));
+    PetscCall(MatAXPY(b->Sv, shift, b->Mvaij, SUBSET_NONZERO_PATTERN));
+    if (b->damped) PetscCall(MatAXPY(b->Sv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN)); /* shift Mv + K / shift + R */
+    PetscCall(MatDestroy(&b->Mvaij));
+    PetscFunctionReturn(0);
   }
   if (new_shift) {
     b->shift = shift;
@@ -916,10 +949,6 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
     PetscCall(MatAXPY(b->Sv, shift, b->Mvs ? b->Mvs : b->Mvaij, b->Mvs ? SAME_NONZERO_PATTERN : SUBSET_NONZERO_PATTERN));
     if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cor, SAME_NONZERO_PATTERN));
     if (b->damped) PetscCall(MatAXPY(b->Sv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN)); /* shift Mv + K / shift + R */
-  }
-  if (converted) {
-    PetscCall(MatDestroy(&b->Mvaij));
-    PetscCall(MatDestroy(&b->Kaij));
   }
   if (!b->floating) {
     /* the displacement columns K_sigma + Cen: K_sigma changes with the state, Cen with the spin rate (which resets

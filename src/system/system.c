@@ -181,10 +181,14 @@ PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem sys)
     PetscCall(MatNestSetSubMat(sys->J, S, S, sys->Jss));
     PetscCall(MatNestSetSubMat(sys->J, V, S, sys->Jvs));
   }
-  if (!sys->mixed_released && !sys->state_dependent_fields) {
-    PetscCall(MatDestroy(&sys->Jsv));
-    PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
-    PetscCall(MatNestSetSubMat(sys->J, S, V, sys->Jsv));
+  if (!sys->state_dependent_fields) {
+    if (!sys->mixed_released) {
+      PetscCall(MatDestroy(&sys->Jsv));
+      PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+      PetscCall(MatNestSetSubMat(sys->J, S, V, sys->Jsv));
+    }
+    /* also when the coupling block was never built: a residual or a displaced initial state may have assembled a
+       body's G and Ms since */
     for (PetscInt i = 0; i < sys->nfparts; i++)
       if (sys->fparts[i]->fieldops->mixedoperators) PetscCall((*sys->fparts[i]->fieldops->mixedoperators)(sys->fparts[i], PETSC_FALSE));
     sys->mixed_released = PETSC_TRUE;
@@ -400,8 +404,20 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
        they would hold 1.1 GB) */
     PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_STRESS, &sys->Jss));
     PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, &sys->Jvs));
-    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
-    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+    /* the coupling block G: the bodies assemble G only when Newton on the whole state (or a displaced initial state)
+       asks for it (FlexFieldOperators); until then a placeholder, built by PhlexSystemCompleteJacobian() */
+    {
+      PetscBool all = PETSC_TRUE;
+      for (PetscInt i = 0; i < sys->nfparts; i++)
+        if (!ops[i].G) all = PETSC_FALSE;
+      if (all) {
+        for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
+        PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+      } else {
+        PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+        sys->mixed_released = PETSC_TRUE;
+      }
+    }
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvv;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvu;
