@@ -778,6 +778,14 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SAME_NONZERO_PATTERN));
       PetscCall(PetscObjectSetName((PetscObject)b->Jvu, "velocity-displacement block"));
     }
+    if (!b->floating && !b->stiffening && !b->spinning && !b->check_stress_maps) {
+      /* a fixed body's AIJ copies of Mv and K (0.95 kB per velocity DOF each): Sv, Jvv and Mvp hold what the steps
+         multiply. Converted again, one at a time, for the rebuild at a new step size (FlexJacobian), and kept from
+         Newton on the whole state or a linearised analysis's operators on (FlexMixedOperators; ops.M, ops.K are NULL
+         until then): not beside the rest of the set-up (BENCHMARKS.md section 40) */
+      PetscCall(MatDestroy(&b->Mvaij));
+      PetscCall(MatDestroy(&b->Kaij));
+    }
   }
   ops->G         = b->stiffening ? b->Gu : b->G;
   ops->Gt        = b->stiffening ? b->Gut : NULL; /* NULL: the system transposes G if the generic path needs G^T */

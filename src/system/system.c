@@ -785,6 +785,8 @@ PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, PetscInt which, Mat
   PetscCall(PetscMalloc1(PetscMax(sys->nfparts, 1), &m));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
+    /* the masses and stiffnesses in AIJ: a fixed body frees its copies at the set-up (FlexFieldOperators) */
+    if ((which == 1 || which == 2) && sys->fparts[i]->fieldops->mixedoperators) PetscCall((*sys->fparts[i]->fieldops->mixedoperators)(sys->fparts[i], PETSC_TRUE));
     PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
     m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : (which == 2 ? ops.K : (which == 3 ? ops.Kstate : (which == 4 ? ops.Gyro : ops.R))));
   }
