@@ -901,6 +901,46 @@ static PetscErrorCode InertialLoadsJacobian(PhlexPart part, PetscReal Arr[324])
   PetscFunctionReturn(0);
 }
 
+/* a fixed body's velocity block of the whole-state Jacobian without spin: shift Mv (+ R), from the AIJ copy of Mv */
+static PetscErrorCode ShiftedMass(PhlexFlexible b, PetscReal shift)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatCopy(b->Mvaij, b->Jvv, b->damped ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
+  PetscCall(MatScale(b->Jvv, shift));
+  if (b->damped) PetscCall(MatAXPY(b->Jvv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN));
+  PetscCall(MatAssemblyBegin(b->Jvv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(b->Jvv, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+/* the whole-state Jacobian's velocity block shift Mv (+ R) of a fixed body without spin or stiffening (0.95 kB per
+   velocity DOF): SNES phlexcondensed's stage never multiplies it (its operator is Sv), so the transient analysis frees
+   it once that stage solves the steps; built again at the current shift if Newton on the whole state is asked for
+   later (PhlexSystemCompleteJacobian) */
+static PetscErrorCode FlexVelocityBlock(PhlexPart part, PetscBool keep)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscBool     converted = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  if (b->floating || b->stiffening || b->spinning || !b->Sv) PetscFunctionReturn(0);
+  if (!keep) {
+    PetscCall(MatDestroy(&b->Jvv));
+    PetscFunctionReturn(0);
+  }
+  if (b->Jvv) PetscFunctionReturn(0);
+  if (!b->Mvaij) {
+    PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    converted = PETSC_TRUE;
+  }
+  /* as FlexFieldOperators made it, then as FlexJacobian fills it at the shift last seen */
+  if (b->damped) PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, &b->Jvv));
+  else PetscCall(MatDuplicate(b->Mvaij, MAT_COPY_VALUES, &b->Jvv));
+  if (b->shift > 0) PetscCall(ShiftedMass(b, b->shift));
+  if (converted) PetscCall(MatDestroy(&b->Mvaij));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexPartVec *X, PetscReal *D, PetscInt ldD)
 {
   PhlexFlexible  b = (PhlexFlexible)part->data;
@@ -920,11 +960,7 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
     PetscCall(MatCopy(b->Kaij, b->Sv, b->kpattern));
     PetscCall(MatDestroy(&b->Kaij));
     PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
-    PetscCall(MatCopy(b->Mvaij, b->Jvv, b->damped ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
-    PetscCall(MatScale(b->Jvv, shift));
-    if (b->damped) PetscCall(MatAXPY(b->Jvv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN));
-    PetscCall(MatAssemblyBegin(b->Jvv, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(b->Jvv, MAT_FINAL_ASSEMBLY));
+    if (b->Jvv) PetscCall(ShiftedMass(b, shift)); /* NULL: released (FlexVelocityBlock) */
     PetscCall(MatScale(b->Sv, 1.0 / shift));
     PetscCall(MatAXPY(b->Sv, shift, b->Mvaij, SUBSET_NONZERO_PATTERN));
     if (b->damped) PetscCall(MatAXPY(b->Sv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN)); /* shift Mv + K / shift + R */
@@ -933,7 +969,7 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
   }
   if (new_shift) {
     b->shift = shift;
-    if (!b->floating) {
+    if (!b->floating && b->Jvv) {
       PetscCall(MatCopy(b->Mvaij, b->Jvv, (b->spinning || b->damped) ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
       PetscCall(MatScale(b->Jvv, shift));
       if (b->spinning) PetscCall(MatAXPY(b->Jvv, 1.0, b->Cor, SUBSET_NONZERO_PATTERN));
@@ -1306,6 +1342,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->fieldops->evaluatebegin            = FlexEvaluateBegin;
   part->fieldops->fieldoperators           = FlexFieldOperators;
   part->fieldops->mixedoperators           = FlexMixedOperators;
+  part->fieldops->velocityblock            = FlexVelocityBlock;
   part->fieldops->bordermult               = FlexBorderMult;
   part->fieldops->bordermulttransposelocal = FlexBorderMultTransposeLocal;
   part->fieldops->borderbasis              = FlexBorderBasis;
