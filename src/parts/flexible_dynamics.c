@@ -723,10 +723,19 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       PetscCall(PhlexFlexibleCreateStressMaps(b));
       b->smap_created = PETSC_TRUE;
     }
-    /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv */
-    PetscCall(AIJCopies(b));
+    /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv. A fixed body
+       without stiffening or spin keeps neither AIJ copy (below): K's is freed once Sv holds it, before Mv's is made */
+    const PetscBool lean = (PetscBool)(!b->floating && !b->stiffening && !b->spinning && !b->check_stress_maps);
+    if (lean) {
+      PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
+      PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
+      PetscCall(MatDestroy(&b->Kaij));
+      PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    } else {
+      PetscCall(AIJCopies(b));
+      PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
+    }
     PetscCall(MassProductSetUp(b));
-    PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
     /* K and Mv have the same pattern (the P2 node couplings, full 3 x 3 blocks): PETSc finds it and adds in place;
        DIFFERENT_NONZERO_PATTERN built the sum as a new matrix beside Sv (0.95 kB per velocity DOF at the set-up's peak,
        BENCHMARKS.md section 40) */
@@ -778,7 +787,7 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SAME_NONZERO_PATTERN));
       PetscCall(PetscObjectSetName((PetscObject)b->Jvu, "velocity-displacement block"));
     }
-    if (!b->floating && !b->stiffening && !b->spinning && !b->check_stress_maps) {
+    if (lean) {
       /* a fixed body's AIJ copies of Mv and K (0.95 kB per velocity DOF each): Sv, Jvv and Mvp hold what the steps
          multiply. Converted again, one at a time, for the rebuild at a new step size (FlexJacobian), and kept from
          Newton on the whole state or a linearised analysis's operators on (FlexMixedOperators; ops.M, ops.K are NULL
