@@ -159,6 +159,11 @@ typedef struct {
                                                              AIJ M and K): fieldoperators then hands out NULL for them;
                                                              PETSC_TRUE: assemble them again if freed. NULL: the part
                                                              keeps what it has */
+  PetscErrorCode (*velocityblock)(PhlexPart, PetscBool); /* PETSC_FALSE: free the whole-state Jacobian's velocity
+                                                            block (a fixed body's shift Mv), which SNES phlexcondensed's
+                                                            stage never multiplies; fieldoperators then hands out NULL
+                                                            for Jvv and Jvc; PETSC_TRUE: build it again at the current
+                                                            shift. NULL: the part keeps it */
   PetscErrorCode (*bordermult)(PhlexPart, const PetscReal *, Vec);               /* y_v += B x_q (its own columns) */
   /* the discrete rows applied to field vectors in two phases (border.c sums every part's and joint's products over
      the processes in one reduction): this process's parts of a Cu^T x_u + Cv^T x_v, its own rows (nq values, set;

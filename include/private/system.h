@@ -63,6 +63,7 @@ struct _p_PhlexSystem {
   Mat       Jvc; /* Jvv + Jvu / shift (block diagonal over the bodies): the velocity block with the displacement eliminated */
   PetscBool state_dependent_fields, inexact_schur; /* a body with geometric stiffening: G(u) and its blocks change with the state */
   PetscBool mixed_released; /* Jsv is a placeholder and the bodies' assembled G and Ms are freed (PhlexSystemReleaseJacobian) */
+  PetscBool vv_released;    /* Jvv is a placeholder, Jvc NULL: the fixed bodies' shift Mv freed (PhlexSystemReleaseVelocityBlock) */
 
   Mat       Sv, Pvq, Ssv, Abd, Cpre;
   IS       *fis[3]; /* per field part: its block in the numbering of the displacement, stress, velocity fields */
@@ -106,6 +107,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemGetFieldBlocks(PhlexSystem, PhlexField, V
 PETSC_INTERN PetscErrorCode PhlexSystemRestoreFieldBlocks(PhlexSystem, PhlexField, Vec, Vec[]);
 PETSC_INTERN PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem);
+PETSC_INTERN PetscErrorCode PhlexSystemReleaseVelocityBlock(PhlexSystem);
 PETSC_INTERN PetscErrorCode PhlexSystemJacobianPmat(PhlexSystem, KSP, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem, PetscInt, Mat *);
 PETSC_INTERN PetscErrorCode PhlexSystemPmat(void *, PetscInt, const PetscInt[], Mat *);

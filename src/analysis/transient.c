@@ -1161,6 +1161,7 @@ PetscErrorCode PhlexSceneSolveTransient(PhlexScene scene)
   }
   /* the stages need neither the whole state's stress blocks nor the assembled G and Ms (the initial state did) */
   if (m.reduced || m.condensed) PetscCall(PhlexSystemReleaseJacobian(sys));
+  if (m.condensed) PetscCall(PhlexSystemReleaseVelocityBlock(sys)); /* nor the fixed bodies' shift Mv */
   /* what the set-up freed (the initial condition's eigensolve, the operators released above) back to the system
      before the first factorization: else the resident size keeps it, and the factor comes on top */
   PetscCall(PhlexReturnFreedMemory());

@@ -480,6 +480,11 @@ static PetscErrorCode FlexResidual(PhlexPart part, PetscReal t, const PhlexPartV
     PetscCall(PhlexFlexibleCouplingUpdate(b, X->u));
     G = b->Gres;
   }
+  if (!X->p && !b->G) {
+    /* the generic path's first residual: G and Ms, deferred at set-up (FlexFieldOperators) */
+    PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
+    G = b->G;
+  }
   if (!X->p) {
     /* F_u = T u' - v */
     PetscCall(VecAXPBYPCZ(F->u, T, -1.0, 0.0, Xdot->u, X->v));
@@ -708,12 +713,33 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
   if (!b->Sv) {
     MatNullSpace   nsp;
     const PetscInt n = b->nv_local, N = b->nv_global;
-    PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
-    /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv */
-    PetscCall(AIJCopies(b));
+    /* the assembled coupling G and compliance mass Ms (3.0 kB per velocity DOF) multiply only Newton on the whole state
+       and a displaced initial state: assembled when one of them asks (FlexMixedOperators, FlexResidual, the stress
+       initial condition), not here, so that they never coexist with the AIJ copies below on the stages of SNES
+       phlexcondensed and phlexreduced, which apply B, G^T and K cell by cell (BENCHMARKS.md section 40: the set-up's
+       peak). A body with geometric stiffening or spin builds on G; -phlex_check_stress_maps compares with it. */
+    if (b->stiffening || b->spinning || b->check_stress_maps) PetscCall(PhlexFlexibleSetUpMixed(b, part->units));
+    else if (!b->smap_created) {
+      PetscCall(PhlexFlexibleCreateStressMaps(b));
+      b->smap_created = PETSC_TRUE;
+    }
+    /* AIJ: taken by every factorisation and by GAMG; its pattern is the union of those of K and Mv. A fixed body
+       without stiffening or spin keeps neither AIJ copy (below): K's is freed once Sv holds it, before Mv's is made */
+    const PetscBool lean = (PetscBool)(!b->floating && !b->stiffening && !b->spinning && !b->check_stress_maps);
+    if (lean) {
+      PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
+      PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
+      PetscCall(MatDestroy(&b->Kaij));
+      PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    } else {
+      PetscCall(AIJCopies(b));
+      PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
+    }
     PetscCall(MassProductSetUp(b));
-    PetscCall(MatDuplicate(b->Kaij, MAT_COPY_VALUES, &b->Sv));
-    PetscCall(MatAXPY(b->Sv, 1.0, b->Mvaij, DIFFERENT_NONZERO_PATTERN));
+    /* K and Mv have the same pattern (the P2 node couplings, full 3 x 3 blocks): PETSc finds it and adds in place;
+       DIFFERENT_NONZERO_PATTERN built the sum as a new matrix beside Sv (0.95 kB per velocity DOF at the set-up's peak,
+       BENCHMARKS.md section 40) */
+    PetscCall(MatAXPY(b->Sv, 1.0, b->Mvaij, UNKNOWN_NONZERO_PATTERN));
     PetscCall(MatSetOption(b->Sv, MAT_SPD, PETSC_TRUE));
     PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
     PetscCall(MatSetNearNullSpace(b->Sv, nsp));
@@ -760,6 +786,14 @@ static PetscErrorCode FlexFieldOperators(PhlexPart part, PhlexFieldOperators *op
       PetscCall(MatZeroEntries(b->Jvu));
       if (b->spinning) PetscCall(MatAXPY(b->Jvu, 1.0, b->Cen, SAME_NONZERO_PATTERN));
       PetscCall(PetscObjectSetName((PetscObject)b->Jvu, "velocity-displacement block"));
+    }
+    if (lean) {
+      /* a fixed body's AIJ copies of Mv and K (0.95 kB per velocity DOF each): Sv, Jvv and Mvp hold what the steps
+         multiply. Converted again, one at a time, for the rebuild at a new step size (FlexJacobian), and kept from
+         Newton on the whole state or a linearised analysis's operators on (FlexMixedOperators; ops.M, ops.K are NULL
+         until then): not beside the rest of the set-up (BENCHMARKS.md section 40) */
+      PetscCall(MatDestroy(&b->Mvaij));
+      PetscCall(MatDestroy(&b->Kaij));
     }
   }
   ops->G         = b->stiffening ? b->Gu : b->G;
@@ -876,23 +910,75 @@ static PetscErrorCode InertialLoadsJacobian(PhlexPart part, PetscReal Arr[324])
   PetscFunctionReturn(0);
 }
 
+/* a fixed body's velocity block of the whole-state Jacobian without spin: shift Mv (+ R), from the AIJ copy of Mv */
+static PetscErrorCode ShiftedMass(PhlexFlexible b, PetscReal shift)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatCopy(b->Mvaij, b->Jvv, b->damped ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
+  PetscCall(MatScale(b->Jvv, shift));
+  if (b->damped) PetscCall(MatAXPY(b->Jvv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN));
+  PetscCall(MatAssemblyBegin(b->Jvv, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(b->Jvv, MAT_FINAL_ASSEMBLY));
+  PetscFunctionReturn(0);
+}
+
+/* the whole-state Jacobian's velocity block shift Mv (+ R) of a fixed body without spin or stiffening (0.95 kB per
+   velocity DOF): SNES phlexcondensed's stage never multiplies it (its operator is Sv), so the transient analysis frees
+   it once that stage solves the steps; built again at the current shift if Newton on the whole state is asked for
+   later (PhlexSystemCompleteJacobian) */
+static PetscErrorCode FlexVelocityBlock(PhlexPart part, PetscBool keep)
+{
+  PhlexFlexible b = (PhlexFlexible)part->data;
+  PetscBool     converted = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  if (b->floating || b->stiffening || b->spinning || !b->Sv) PetscFunctionReturn(0);
+  if (!keep) {
+    PetscCall(MatDestroy(&b->Jvv));
+    PetscFunctionReturn(0);
+  }
+  if (b->Jvv) PetscFunctionReturn(0);
+  if (!b->Mvaij) {
+    PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    converted = PETSC_TRUE;
+  }
+  /* as FlexFieldOperators made it, then as FlexJacobian fills it at the shift last seen */
+  if (b->damped) PetscCall(MatDuplicate(b->Sv, MAT_DO_NOT_COPY_VALUES, &b->Jvv));
+  else PetscCall(MatDuplicate(b->Mvaij, MAT_COPY_VALUES, &b->Jvv));
+  if (b->shift > 0) PetscCall(ShiftedMass(b, b->shift));
+  if (converted) PetscCall(MatDestroy(&b->Mvaij));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexPartVec *X, PetscReal *D, PetscInt ldD)
 {
   PhlexFlexible  b = (PhlexFlexible)part->data;
   const PetscInt n = b->nv_local, nq = part->nq, nin = b->border_nin;
   PetscReal      Arr[324];
 
-  PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift), converted = PETSC_FALSE;
+  PetscBool      new_shift = (PetscBool)(PetscAbsReal(shift - b->shift) > 1e-12 * shift);
 
   PetscFunctionBeginUser;
   if (new_shift && !b->Mvaij) {
-    /* released (FlexMixedOperators): converted for this rebuild only */
-    PetscCall(AIJCopies(b));
-    converted = PETSC_TRUE;
+    /* released (FlexMixedOperators: a fixed body without stiffening or spin): K and Mv converted to AIJ for this
+       rebuild only, one after the other (the operations and their order as below), so that one AIJ copy exists at a
+       time beside Sv and Jvv (BENCHMARKS.md section 40) */
+    PetscCheck(!b->floating && !b->stiffening && !b->spinning, b->comm, PETSC_ERR_PLIB, "body %s: AIJ copies released", b->name);
+    b->shift = shift;
+    PetscCall(MatConvert(b->K, MATAIJ, MAT_INITIAL_MATRIX, &b->Kaij));
+    PetscCall(MatCopy(b->Kaij, b->Sv, b->kpattern));
+    PetscCall(MatDestroy(&b->Kaij));
+    PetscCall(MatConvert(b->Mv, MATAIJ, MAT_INITIAL_MATRIX, &b->Mvaij));
+    if (b->Jvv) PetscCall(ShiftedMass(b, shift)); /* NULL: released (FlexVelocityBlock) */
+    PetscCall(MatScale(b->Sv, 1.0 / shift));
+    PetscCall(MatAXPY(b->Sv, shift, b->Mvaij, SUBSET_NONZERO_PATTERN));
+    if (b->damped) PetscCall(MatAXPY(b->Sv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN)); /* shift Mv + K / shift + R */
+    PetscCall(MatDestroy(&b->Mvaij));
+    PetscFunctionReturn(0);
   }
   if (new_shift) {
     b->shift = shift;
-    if (!b->floating) {
+    if (!b->floating && b->Jvv) {
       PetscCall(MatCopy(b->Mvaij, b->Jvv, (b->spinning || b->damped) ? SUBSET_NONZERO_PATTERN : SAME_NONZERO_PATTERN));
       PetscCall(MatScale(b->Jvv, shift));
       if (b->spinning) PetscCall(MatAXPY(b->Jvv, 1.0, b->Cor, SUBSET_NONZERO_PATTERN));
@@ -916,10 +1002,6 @@ static PetscErrorCode FlexJacobian(PhlexPart part, PetscReal shift, const PhlexP
     PetscCall(MatAXPY(b->Sv, shift, b->Mvs ? b->Mvs : b->Mvaij, b->Mvs ? SAME_NONZERO_PATTERN : SUBSET_NONZERO_PATTERN));
     if (b->spinning) PetscCall(MatAXPY(b->Sv, 1.0, b->Cor, SAME_NONZERO_PATTERN));
     if (b->damped) PetscCall(MatAXPY(b->Sv, 1.0, b->Rd, SUBSET_NONZERO_PATTERN)); /* shift Mv + K / shift + R */
-  }
-  if (converted) {
-    PetscCall(MatDestroy(&b->Mvaij));
-    PetscCall(MatDestroy(&b->Kaij));
   }
   if (!b->floating) {
     /* the displacement columns K_sigma + Cen: K_sigma changes with the state, Cen with the spin rate (which resets
@@ -1269,6 +1351,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->fieldops->evaluatebegin            = FlexEvaluateBegin;
   part->fieldops->fieldoperators           = FlexFieldOperators;
   part->fieldops->mixedoperators           = FlexMixedOperators;
+  part->fieldops->velocityblock            = FlexVelocityBlock;
   part->fieldops->bordermult               = FlexBorderMult;
   part->fieldops->bordermulttransposelocal = FlexBorderMultTransposeLocal;
   part->fieldops->borderbasis              = FlexBorderBasis;

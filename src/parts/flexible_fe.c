@@ -604,6 +604,8 @@ PetscErrorCode PhlexFlexibleSetUpFE(PhlexFlexible b, const PhlexUnits *units)
   PetscCall(SetUpMaterials(b));
   PetscCall(SetUpCellGeometry(b, units));
   PetscCall(SetUpCellDofs(b));
+  /* the materials' compliances (non-dimensional): the cell-by-cell stress maps need them without G and Ms */
+  for (PetscInt m = 0; m < b->nmaterials; m++) PhlexElementCompliance(b->materials[m].youngs_modulus / units->modulus, b->materials[m].poissons_ratio, b->compliance[m]);
   {
     PhlexElementBasis V, S;
     PetscCall(PhlexFlexibleGetBasis(b, PETSC_FALSE, &V));

@@ -217,6 +217,7 @@ static PetscErrorCode SetStressIC(PhlexPart part, Vec u0, Vec s0)
     KSP ksp;
     PC  pc;
     Vec g;
+    PetscCall(PhlexFlexibleSetUpMixed(b, part->units)); /* deferred at set-up (FlexFieldOperators); freed with the release */
     PetscCall(VecDuplicate(s0, &g));
     PetscCall(MatMult(b->G, u0, g));
     PetscCall(KSPCreate(b->comm, &ksp));

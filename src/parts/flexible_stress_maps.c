@@ -799,7 +799,7 @@ PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible b)
   const PetscBool check = b->check_stress_maps;
 
   PetscFunctionBeginUser;
-  PetscCheck(b->Ms && b->G, b->comm, PETSC_ERR_ORDER, "body %s: the stress maps need the mixed operators (PhlexFlexibleSetUpMixed)", b->name);
+  PetscCheck(!check || (b->Ms && b->G), b->comm, PETSC_ERR_ORDER, "body %s: the check of the stress maps needs the mixed operators (PhlexFlexibleSetUpMixed)", b->name);
   if (b->stiffening) {
     if (check) PetscCall(PetscPrintf(b->comm, "body %s: stress maps cell by cell: not used (geometric stiffening assembles G(u))\n", b->name));
     PetscFunctionReturn(0);

@@ -358,6 +358,9 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     Mat Sv;
     PetscCall(PhlexSystemIJacobian(c->ts, tstage, X0, NULL, a, sys->J, sys->J, sys));
     PetscCall(PhlexSystemVelocityOperator(sys, &Sv));
+    /* the rebuild's AIJ copies of Mv and K (freed) back to the system before the preconditioner's set-up allocates
+       (GAMG's hierarchy, a factor): else the resident size keeps them beside it (BENCHMARKS.md sections 20, 40) */
+    PetscCall(PhlexReturnFreedMemory());
     PetscCall(CheckFactorPackage(c->ksp, Sv));
     PetscCall(KSPSetOperators(c->ksp, Sv, Sv));
     c->shift = s;

@@ -181,14 +181,67 @@ PetscErrorCode PhlexSystemReleaseJacobian(PhlexSystem sys)
     PetscCall(MatNestSetSubMat(sys->J, S, S, sys->Jss));
     PetscCall(MatNestSetSubMat(sys->J, V, S, sys->Jvs));
   }
-  if (!sys->mixed_released && !sys->state_dependent_fields) {
-    PetscCall(MatDestroy(&sys->Jsv));
-    PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
-    PetscCall(MatNestSetSubMat(sys->J, S, V, sys->Jsv));
+  if (!sys->state_dependent_fields) {
+    if (!sys->mixed_released) {
+      PetscCall(MatDestroy(&sys->Jsv));
+      PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+      PetscCall(MatNestSetSubMat(sys->J, S, V, sys->Jsv));
+    }
+    /* also when the coupling block was never built: a residual or a displaced initial state may have assembled a
+       body's G and Ms since */
     for (PetscInt i = 0; i < sys->nfparts; i++)
       if (sys->fparts[i]->fieldops->mixedoperators) PetscCall((*sys->fparts[i]->fieldops->mixedoperators)(sys->fparts[i], PETSC_FALSE));
     sys->mixed_released = PETSC_TRUE;
   }
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexSystemReleaseVelocityBlock - frees the whole-state Jacobian's velocity block (each fixed body's shift Mv: 0.95 kB
+  per velocity DOF) once SNES phlexcondensed solves the steps: its stage multiplies the condensed operators only; a
+  placeholder in its place (and no border block Jvc) until PhlexSystemCompleteJacobian() builds it again
+
+  Collective
+@*/
+PetscErrorCode PhlexSystemReleaseVelocityBlock(PhlexSystem sys)
+{
+  const PetscInt V = sys->field[PHLEX_FIELD_VELOCITY];
+
+  PetscFunctionBeginUser;
+  if (!sys->nfparts || sys->vv_released || sys->nq || sys->state_dependent_fields || sys->inexact_schur) PetscFunctionReturn(0);
+  for (PetscInt i = 0; i < sys->nfparts; i++)
+    if (!sys->fparts[i]->fieldops->velocityblock) PetscFunctionReturn(0);
+  PetscCall(MatDestroy(&sys->Jvv));
+  PetscCall(MatDestroy(&sys->Jvc));
+  for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall((*sys->fparts[i]->fieldops->velocityblock)(sys->fparts[i], PETSC_FALSE));
+  PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
+  PetscCall(MatNestSetSubMat(sys->J, V, V, sys->Jvv));
+  sys->vv_released = PETSC_TRUE;
+  PetscFunctionReturn(0);
+}
+
+/* the velocity block, and the border block Jvc that shares it, built again after PhlexSystemReleaseVelocityBlock() */
+static PetscErrorCode RestoreVelocityBlock(PhlexSystem sys)
+{
+  const PetscInt V = sys->field[PHLEX_FIELD_VELOCITY];
+  Mat           *m, *c;
+
+  PetscFunctionBeginUser;
+  if (!sys->vv_released) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc2(sys->nfparts, &m, sys->nfparts, &c));
+  for (PetscInt i = 0; i < sys->nfparts; i++) {
+    PhlexFieldOperators ops;
+    PetscCall((*sys->fparts[i]->fieldops->velocityblock)(sys->fparts[i], PETSC_TRUE));
+    PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
+    m[i] = ops.Jvv;
+    c[i] = ops.Jvc;
+  }
+  PetscCall(MatDestroy(&sys->Jvv));
+  PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
+  PetscCall(PhlexSystemBlockDiagonal(sys, c, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvc));
+  PetscCall(MatNestSetSubMat(sys->J, V, V, sys->Jvv));
+  PetscCall(PetscFree2(m, c));
+  sys->vv_released = PETSC_FALSE;
   PetscFunctionReturn(0);
 }
 
@@ -232,6 +285,7 @@ PetscErrorCode PhlexSystemCompleteJacobian(PhlexSystem sys)
   PetscFunctionBeginUser;
   if (!sys->nfparts) PetscFunctionReturn(0);
   PetscCall(RestoreCoupling(sys));
+  PetscCall(RestoreVelocityBlock(sys));
   if (sys->Ms) PetscFunctionReturn(0);
   PetscCall(PetscMalloc2(sys->nfparts, &ops, sys->nfparts, &m));
   for (PetscInt i = 0; i < sys->nfparts; i++) PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops[i]));
@@ -400,8 +454,20 @@ PetscErrorCode PhlexSystemCreate(PhlexScene scene, PhlexSystem *system)
        they would hold 1.1 GB) */
     PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_STRESS, &sys->Jss));
     PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_STRESS, &sys->Jvs));
-    for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
-    PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+    /* the coupling block G: the bodies assemble G only when Newton on the whole state (or a displaced initial state)
+       asks for it (FlexFieldOperators); until then a placeholder, built by PhlexSystemCompleteJacobian() */
+    {
+      PetscBool all = PETSC_TRUE;
+      for (PetscInt i = 0; i < sys->nfparts; i++)
+        if (!ops[i].G) all = PETSC_FALSE;
+      if (all) {
+        for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].G;
+        PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+      } else {
+        PetscCall(CreatePlaceholder(sys, PHLEX_FIELD_STRESS, PHLEX_FIELD_VELOCITY, &sys->Jsv));
+        sys->mixed_released = PETSC_TRUE;
+      }
+    }
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvv;
     PetscCall(PhlexSystemBlockDiagonal(sys, m, PHLEX_FIELD_VELOCITY, PHLEX_FIELD_VELOCITY, &sys->Jvv));
     for (PetscInt i = 0; i < sys->nfparts; i++) m[i] = ops[i].Jvu;
@@ -769,6 +835,8 @@ PetscErrorCode PhlexSystemCondensedOperator(PhlexSystem sys, PetscInt which, Mat
   PetscCall(PetscMalloc1(PetscMax(sys->nfparts, 1), &m));
   for (PetscInt i = 0; i < sys->nfparts; i++) {
     PhlexFieldOperators ops;
+    /* the masses and stiffnesses in AIJ: a fixed body frees its copies at the set-up (FlexFieldOperators) */
+    if ((which == 1 || which == 2) && sys->fparts[i]->fieldops->mixedoperators) PetscCall((*sys->fparts[i]->fieldops->mixedoperators)(sys->fparts[i], PETSC_TRUE));
     PetscCall((*sys->fparts[i]->fieldops->fieldoperators)(sys->fparts[i], &ops));
     m[i] = which == 0 ? ops.Sv : (which == 1 ? ops.M : (which == 2 ? ops.K : (which == 3 ? ops.Kstate : (which == 4 ? ops.Gyro : ops.R))));
   }
