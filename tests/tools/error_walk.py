@@ -2,7 +2,7 @@
 """Walks phlex's error paths (issue 43 item 2): finds the error sites in the sources, runs inputs that trigger
 them, and checks each run against README's exit-code table.
 
-  python3 tests/tools/error_walk.py [--bin bin/phlex] [--work DIR] [-j 2] [--list-sites] [--untriggered]
+  python3 tests/tools/error_walk.py [--bin bin/phlex] [--work DIR] [-j 2] [--list-sites] [--untriggered] [--min-triggered N]
                                     [--only GLOB] [--inputs FILE]
 
 Error sites: every SETERRQ(comm, PETSC_ERR_X, "format", ...) and PetscCheck(cond, comm, PETSC_ERR_X, "format", ...)
@@ -323,6 +323,8 @@ def main():
     ap.add_argument("--untriggered", action="store_true")
     ap.add_argument("--only", help="the specs (names, error_inputs.txt:<line>) matching this glob pattern")
     ap.add_argument("--inputs", help="another file of extra inputs than tests/tools/error_inputs.txt")
+    ap.add_argument("--min-triggered", type=int, default=0,
+                    help="fail when fewer reachable input-error sites are triggered (a coverage floor for the test)")
     args = ap.parse_args()
     args.work = os.path.abspath(args.work)
     ss = sites(ROOT)
@@ -426,6 +428,9 @@ def main():
     if args.untriggered:
         for n, t in sorted(TIMES.items(), key=lambda x: -x[1])[:8]:
             print("slowest: %s %.1f s" % (n, t))
+    if len(hit_input) < args.min_triggered:
+        failures.append("coverage: %d reachable input-error sites triggered, fewer than --min-triggered %d (an input no "
+                        "longer reaches its site: --untriggered lists them)" % (len(hit_input), args.min_triggered))
     for f in failures:
         print("FAIL " + f)
     print("%d runs failed a check" % len(failures))
