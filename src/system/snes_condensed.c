@@ -49,6 +49,11 @@ typedef struct {
   Vec         dv[3];       /* the last increments dv_{n-1}, dv_{n-2}, dv_{n-3} (newest first) */
   PetscBool   balance;     /* correct an iterative solve's increment so that its residual does no work on the stage velocity */
   Vec         p, Ap;       /* work: the stage velocity v0 + dv and its product with the operator */
+  PetscBool   block_products;   /* an iterative solve's products with the operator by a node-block (BAIJ) copy of it */
+  PetscBool   explicit_restrict; /* multigrid's restrictions by stored transposes of its interpolations */
+  PetscBool   block_symmetric; /* the block copy as its upper triangle (SBAIJ) */
+  Mat         Ablock;      /* the node-block copy of the operator (NULL: the products use the operator itself) */
+  PetscObjectState svstate; /* the state of the operator the copy was taken from */
 } SNES_Condensed;
 
 /* why a scene or an integrator cannot use the condensed stage (empty: it can) */
@@ -332,6 +337,58 @@ static PetscErrorCode KeepIncrement(SNES_Condensed *c, Vec x)
   PetscFunctionReturn(0);
 }
 
+/* Multigrid restricts by products with the transposes of its interpolations; an AIJ product with the transpose
+   scatters into the result and runs at half the speed of a product (0.52 against 1.1 GFlop/s, BENCHMARKS.md section
+   43). After the preconditioner's set-up (the hierarchy is rebuilt with each operator), each level whose restriction
+   is its interpolation gets the stored transpose instead (about 2 % of the operator's memory). */
+static PetscErrorCode ExplicitRestrictions(KSP ksp)
+{
+  PC        pc;
+  PetscBool mg;
+  PetscInt  nlevels;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &mg, PCMG, PCGAMG, ""));
+  if (!mg) PetscFunctionReturn(0);
+  PetscCall(KSPSetUp(ksp));
+  PetscCall(PCMGGetLevels(pc, &nlevels));
+  for (PetscInt l = 1; l < nlevels; l++) {
+    Mat P, R;
+    PetscCall(PCMGGetInterpolation(pc, l, &P));
+    PetscCall(PCMGGetRestriction(pc, l, &R));
+    if (R != P) continue;
+    PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R));
+    PetscCall(PCMGSetRestriction(pc, l, R));
+    PetscCall(MatDestroy(&R));
+  }
+  PetscFunctionReturn(0);
+}
+
+/* The operator handed to the condensed KSP. An iterative solve spends its time in products with the operator: CG's
+   and multigrid's fine-level smoothing and residual. Its P2 velocity unknowns come in node blocks of 3 that couple
+   as dense 3 x 3 blocks, so a BAIJ copy reads one column index per block instead of one per entry (or per inode row):
+   1.7 x faster products at 2.2e5 DOFs (BENCHMARKS.md section 43). The preconditioner is still built from the AIJ
+   operator (GAMG coarsens AIJ). A direct solve (preonly) makes no product, and a matrix not in whole node blocks
+   gains nothing: neither takes the copy. The copy is a snapshot: the state of Sv it was taken at is kept, and a
+   solve with Sv changed since (in place) takes a new one. */
+static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
+{
+  PetscBool preonly;
+  PetscInt  bs;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&c->Ablock));
+  PetscCall(PetscObjectTypeCompare((PetscObject)c->ksp, KSPPREONLY, &preonly));
+  PetscCall(MatGetBlockSize(Sv, &bs));
+  if (c->block_products && !preonly && bs > 1) PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, &c->Ablock));
+  if (c->Ablock) PetscCall(MatSetOption(c->Ablock, MAT_SYMMETRIC, PETSC_TRUE)); /* (MPIBAIJ takes no MAT_SPD in 3.18) */
+  PetscCall(KSPSetOperators(c->ksp, c->Ablock ? c->Ablock : Sv, Sv));
+  if (c->explicit_restrict && !preonly) PetscCall(ExplicitRestrictions(c->ksp));
+  PetscCall(PetscObjectStateGet((PetscObject)Sv, &c->svstate)); /* after the set-up (it may mark Sv) */
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode SNESSolve_Condensed(SNES snes)
 {
   SNES_Condensed    *c   = (SNES_Condensed *)snes->data;
@@ -362,9 +419,15 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
        (GAMG's hierarchy, a factor): else the resident size keeps them beside it (BENCHMARKS.md sections 20, 40) */
     PetscCall(PhlexReturnFreedMemory());
     PetscCall(CheckFactorPackage(c->ksp, Sv));
-    PetscCall(KSPSetOperators(c->ksp, Sv, Sv));
+    PetscCall(SetOperators(c, Sv));
     c->shift = s;
     c->nhist = 0; /* the increments scale with the step: the guess starts again */
+  } else if (c->Ablock) {
+    Mat              Sv;
+    PetscObjectState state;
+    PetscCall(KSPGetOperators(c->ksp, NULL, &Sv));
+    PetscCall(PetscObjectStateGet((PetscObject)Sv, &state));
+    if (state != c->svstate) PetscCall(SetOperators(c, Sv)); /* Sv's values changed in place: a new copy */
   }
   /* the loads b at the stage time (those of a fixed body depend on t only) */
   PetscCall(PhlexSystemEvaluate(sys, tstage, X0, NULL));
@@ -433,6 +496,7 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   for (PetscInt j = 0; j < 3; j++) PetscCall(VecDestroy(&c->dv[j]));
   PetscCall(VecDestroy(&c->p));
   PetscCall(VecDestroy(&c->Ap));
+  PetscCall(MatDestroy(&c->Ablock));
   c->nhist = 0;
   c->shift = 0.0;
   PetscFunctionReturn(0);
@@ -454,6 +518,9 @@ static PetscErrorCode SNESSetFromOptions_Condensed(SNES snes, PetscOptionItems *
   PetscFunctionBeginUser;
   PetscOptionsHeadBegin(PetscOptionsObject, "SNES phlexcondensed options");
   PetscCall(PetscOptionsInt("-snes_phlexcondensed_guess_order", "Initial guess of an iterative condensed solve: the polynomial through this many of the last steps' velocity increments, one step on (0: zero guess, 1: the last increment, 2: linear, 3: quadratic extrapolation); a direct solve takes none", "SNESPHLEXCONDENSED", order, &order, NULL));
+  PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_products", "An iterative condensed solve's products with the operator by a copy in 3 x 3 node blocks (BAIJ; the preconditioner is built from the AIJ operator): faster products for more memory; a direct solve takes none", "SNESPHLEXCONDENSED", c->block_products, &c->block_products, NULL));
+  PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_products_symmetric", "The block copy stores the upper triangle only (SBAIJ)", "SNESPHLEXCONDENSED", c->block_symmetric, &c->block_symmetric, NULL));
+  PetscCall(PetscOptionsBool("-snes_phlexcondensed_explicit_restriction", "Multigrid preconditioners of an iterative condensed solve restrict by stored transposes of their interpolations (faster than products with the transposes)", "SNESPHLEXCONDENSED", c->explicit_restrict, &c->explicit_restrict, NULL));
   PetscCall(PetscOptionsBool("-snes_phlexcondensed_balance", "Correct an iterative condensed solve's velocity increment along the stage velocity so that its residual does no work (the power balance to round-off whatever the Krylov tolerance); a direct solve takes none", "SNESPHLEXCONDENSED", c->balance, &c->balance, NULL));
   PetscOptionsHeadEnd();
   PetscCheck(order >= 0 && order <= 3, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT, "-snes_phlexcondensed_guess_order must be 0, 1, 2 or 3, got %" PetscInt_FMT, order);
