@@ -193,7 +193,7 @@ PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, Pe
 /* mat_block_mult.c: a matrix times a block of vectors */
 PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
 /* mat_block_copy.c: an AIJ matrix copied in node blocks (BAIJ) */
-PETSC_INTERN PetscErrorCode PhlexMatBlockCopy(Mat, PetscBool, Mat *);
+PETSC_INTERN PetscErrorCode PhlexMatBlockCopy(Mat, PetscBool, MatReuse, Mat *);
 
 /* format.c: numbers echoed to the user at full precision */
 PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);

@@ -53,7 +53,8 @@ typedef struct {
   PetscBool   explicit_restrict; /* multigrid's restrictions by stored transposes of its interpolations */
   PetscBool   block_symmetric; /* the block copy as its upper triangle (SBAIJ) */
   Mat         Ablock;      /* the node-block copy of the operator (NULL: the products use the operator itself) */
-  PetscObjectState svstate; /* the state of the operator the copy was taken from */
+  PetscObjectState svstate;   /* the state of the operator the copy was taken from */
+  PetscObjectState svnzstate; /* and of its nonzero pattern */
 } SNES_Condensed;
 
 /* why a scene or an integrator cannot use the condensed stage (empty: it can) */
@@ -370,19 +371,30 @@ static PetscErrorCode ExplicitRestrictions(KSP ksp)
    as dense 3 x 3 blocks, so a BAIJ copy reads one column index per block instead of one per entry (or per inode row):
    1.7 x faster products at 2.2e5 DOFs (BENCHMARKS.md section 43). The preconditioner is still built from the AIJ
    operator (GAMG coarsens AIJ). A direct solve (preonly) makes no product, and a matrix not in whole node blocks
-   gains nothing: neither takes the copy. The copy is a snapshot: the state of Sv it was taken at is kept, and a
-   solve with Sv changed since (in place) takes a new one. */
+   gains nothing: neither takes the copy. The copy is one object for the run, its values refilled in place whenever
+   Sv's change (a new step size; Sv's state is kept): GAMG re-set up on the same pattern keeps its hierarchy and the
+   fine level's residual matrix it was first given, so a new object would leave that residual on the old values
+   (CG then diverged after a change of the step size). A new pattern makes a new copy (and GAMG starts afresh). */
 static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
 {
-  PetscBool preonly;
-  PetscInt  bs;
+  PetscBool        preonly;
+  PetscInt         bs;
+  PetscObjectState nzstate;
 
   PetscFunctionBeginUser;
-  PetscCall(MatDestroy(&c->Ablock));
   PetscCall(PetscObjectTypeCompare((PetscObject)c->ksp, KSPPREONLY, &preonly));
   PetscCall(MatGetBlockSize(Sv, &bs));
-  if (c->block_products && !preonly && bs > 1) PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, &c->Ablock));
-  if (c->Ablock) PetscCall(MatSetOption(c->Ablock, MAT_SYMMETRIC, PETSC_TRUE)); /* (MPIBAIJ takes no MAT_SPD in 3.18) */
+  PetscCall(MatGetNonzeroState(Sv, &nzstate));
+  if (c->Ablock && nzstate != c->svnzstate) PetscCall(MatDestroy(&c->Ablock));
+  if (c->block_products && !preonly && bs > 1) {
+    if (c->Ablock) PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, MAT_REUSE_MATRIX, &c->Ablock));
+    else {
+      PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, MAT_INITIAL_MATRIX, &c->Ablock));
+      if (c->Ablock) PetscCall(MatSetOption(c->Ablock, MAT_SYMMETRIC, PETSC_TRUE)); /* (MPIBAIJ takes no MAT_SPD in 3.18) */
+      else PetscCall(PetscInfo(c->ksp, "the condensed operator is not in whole %" PetscInt_FMT " x %" PetscInt_FMT " blocks: its products use it as it is\n", bs, bs));
+    }
+    c->svnzstate = nzstate;
+  }
   PetscCall(KSPSetOperators(c->ksp, c->Ablock ? c->Ablock : Sv, Sv));
   if (c->explicit_restrict && !preonly) PetscCall(ExplicitRestrictions(c->ksp));
   PetscCall(PetscObjectStateGet((PetscObject)Sv, &c->svstate)); /* after the set-up (it may mark Sv) */
@@ -427,7 +439,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscObjectState state;
     PetscCall(KSPGetOperators(c->ksp, NULL, &Sv));
     PetscCall(PetscObjectStateGet((PetscObject)Sv, &state));
-    if (state != c->svstate) PetscCall(SetOperators(c, Sv)); /* Sv's values changed in place: a new copy */
+    if (state != c->svstate) PetscCall(SetOperators(c, Sv)); /* Sv's values changed in place: the copy refilled */
   }
   /* the loads b at the stage time (those of a fixed body depend on t only) */
   PetscCall(PhlexSystemEvaluate(sys, tstage, X0, NULL));
@@ -519,7 +531,7 @@ static PetscErrorCode SNESSetFromOptions_Condensed(SNES snes, PetscOptionItems *
   PetscOptionsHeadBegin(PetscOptionsObject, "SNES phlexcondensed options");
   PetscCall(PetscOptionsInt("-snes_phlexcondensed_guess_order", "Initial guess of an iterative condensed solve: the polynomial through this many of the last steps' velocity increments, one step on (0: zero guess, 1: the last increment, 2: linear, 3: quadratic extrapolation); a direct solve takes none", "SNESPHLEXCONDENSED", order, &order, NULL));
   PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_products", "An iterative condensed solve's products with the operator by a copy in 3 x 3 node blocks (BAIJ; the preconditioner is built from the AIJ operator): faster products for more memory; a direct solve takes none", "SNESPHLEXCONDENSED", c->block_products, &c->block_products, NULL));
-  PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_products_symmetric", "The block copy stores the upper triangle only (SBAIJ)", "SNESPHLEXCONDENSED", c->block_symmetric, &c->block_symmetric, NULL));
+  PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_products_symmetric", "With -snes_phlexcondensed_block_products: the block copy stores the upper triangle only (SBAIJ; less memory, on several processes two halo exchanges per product)", "SNESPHLEXCONDENSED", c->block_symmetric, &c->block_symmetric, NULL));
   PetscCall(PetscOptionsBool("-snes_phlexcondensed_explicit_restriction", "Multigrid preconditioners of an iterative condensed solve restrict by stored transposes of their interpolations (faster than products with the transposes)", "SNESPHLEXCONDENSED", c->explicit_restrict, &c->explicit_restrict, NULL));
   PetscCall(PetscOptionsBool("-snes_phlexcondensed_balance", "Correct an iterative condensed solve's velocity increment along the stage velocity so that its residual does no work (the power balance to round-off whatever the Krylov tolerance); a direct solve takes none", "SNESPHLEXCONDENSED", c->balance, &c->balance, NULL));
   PetscOptionsHeadEnd();

@@ -51,41 +51,65 @@ static PetscErrorCode BlockPattern(Mat A, PetscInt bs, PetscBool upper, PetscInt
   PetscFunctionReturn(0);
 }
 
+/* the largest local row length of A */
+static PetscErrorCode MaxRowLength(Mat A, PetscInt *maxrow)
+{
+  PetscInt rstart, rend;
+
+  PetscFunctionBeginUser;
+  *maxrow = 0;
+  PetscCall(MatGetOwnershipRange(A, &rstart, &rend));
+  for (PetscInt row = rstart; row < rend; row++) {
+    PetscInt n;
+    PetscCall(MatGetRow(A, row, &n, NULL, NULL));
+    *maxrow = PetscMax(*maxrow, n);
+    PetscCall(MatRestoreRow(A, row, &n, NULL, NULL));
+  }
+  PetscFunctionReturn(0);
+}
+
 /*@C
-  PhlexMatBlockCopy - a BAIJ copy of the AIJ matrix A in blocks of its block size, with A's values (a new matrix),
-  or NULL when A's block size is 1 or its pattern is not made of whole blocks on every process (the caller keeps A)
+  PhlexMatBlockCopy - a BAIJ (symmetric: SBAIJ, the upper triangle) copy of the AIJ matrix A in blocks of its block
+  size, with A's values. MAT_INITIAL_MATRIX: a new matrix, or NULL when A's block size is 1 or its pattern is not
+  made of whole blocks on every process (the caller keeps A); MAT_REUSE_MATRIX: A's values into the copy *B made
+  before from A with the same pattern (the same object, its state raised: whoever holds it sees the new values)
 
   Collective
 @*/
-PetscErrorCode PhlexMatBlockCopy(Mat A, PetscBool symmetric, Mat *B)
+PetscErrorCode PhlexMatBlockCopy(Mat A, PetscBool symmetric, MatReuse reuse, Mat *B)
 {
-  PetscInt     bs, m, n, mb, *dnnz, *onnz, rstart, rend, *bcols, maxrow;
+  PetscInt     bs, m, n, mb, rstart, rend, *bcols, maxrow = 0;
   PetscBool    blocked;
   PetscScalar *vals;
 
   PetscFunctionBeginUser;
-  *B = NULL;
+  if (reuse == MAT_INITIAL_MATRIX) *B = NULL;
   PetscCall(MatGetBlockSize(A, &bs));
-  PetscCall(MatGetLocalSize(A, &m, &n));
-  if (bs < 2 || m % bs || n % bs) PetscFunctionReturn(0);
-  mb = m / bs;
+  if (bs < 2) PetscFunctionReturn(0); /* the same on every process */
   PetscCall(PetscLogEventBegin(PHLEX_MatBlockCopy, A, 0, 0, 0));
-  PetscCall(PetscCalloc2(mb, &dnnz, mb, &onnz));
-  PetscCall(BlockPattern(A, bs, symmetric, dnnz, onnz, &maxrow, &blocked));
-  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &blocked, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)A)));
-  if (!blocked) {
+  if (reuse == MAT_INITIAL_MATRIX) {
+    PetscInt *dnnz, *onnz;
+    PetscCall(MatGetLocalSize(A, &m, &n));
+    blocked = (PetscBool)(m % bs == 0 && n % bs == 0);
+    mb      = m / bs;
+    PetscCall(PetscCalloc2(mb, &dnnz, mb, &onnz));
+    if (blocked) PetscCall(BlockPattern(A, bs, symmetric, dnnz, onnz, &maxrow, &blocked));
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &blocked, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)A)));
+    if (!blocked) {
+      PetscCall(PetscFree2(dnnz, onnz));
+      PetscCall(PetscInfo(A, "not in whole %" PetscInt_FMT " x %" PetscInt_FMT " blocks: no block copy\n", bs, bs));
+      PetscCall(PetscLogEventEnd(PHLEX_MatBlockCopy, A, 0, 0, 0));
+      PetscFunctionReturn(0);
+    }
+    PetscCall(MatCreate(PetscObjectComm((PetscObject)A), B));
+    PetscCall(MatSetSizes(*B, m, n, PETSC_DETERMINE, PETSC_DETERMINE));
+    PetscCall(MatSetBlockSize(*B, bs));
+    PetscCall(MatSetType(*B, symmetric ? MATSBAIJ : MATBAIJ));
+    PetscCall(MatXAIJSetPreallocation(*B, bs, dnnz, onnz, dnnz, onnz));
+    if (symmetric) PetscCall(MatSetOption(*B, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
+    PetscCall(MatSetOption(*B, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
     PetscCall(PetscFree2(dnnz, onnz));
-    PetscCall(PetscInfo(A, "not in whole %" PetscInt_FMT " x %" PetscInt_FMT " blocks: no block copy\n", bs, bs));
-    PetscCall(PetscLogEventEnd(PHLEX_MatBlockCopy, A, 0, 0, 0));
-    PetscFunctionReturn(0);
-  }
-  PetscCall(MatCreate(PetscObjectComm((PetscObject)A), B));
-  PetscCall(MatSetSizes(*B, m, n, PETSC_DETERMINE, PETSC_DETERMINE));
-  PetscCall(MatSetBlockSize(*B, bs));
-  PetscCall(MatSetType(*B, symmetric ? MATSBAIJ : MATBAIJ));
-  PetscCall(MatXAIJSetPreallocation(*B, bs, dnnz, onnz, dnnz, onnz));
-  if (symmetric) PetscCall(MatSetOption(*B, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
-  PetscCall(MatSetOption(*B, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  } else PetscCall(MaxRowLength(A, &maxrow));
   PetscCall(MatGetOwnershipRange(A, &rstart, &rend));
   PetscCall(PetscMalloc2(maxrow / bs + 1, &bcols, bs * maxrow + 1, &vals));
   for (PetscInt row = rstart; row < rend; row += bs) {
@@ -105,7 +129,6 @@ PetscErrorCode PhlexMatBlockCopy(Mat A, PetscBool symmetric, Mat *B)
     PetscCall(MatSetValuesBlocked(*B, 1, &brow, nb, bcols, vals, INSERT_VALUES));
   }
   PetscCall(PetscFree2(bcols, vals));
-  PetscCall(PetscFree2(dnnz, onnz));
   PetscCall(MatAssemblyBegin(*B, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(*B, MAT_FINAL_ASSEMBLY));
   PetscCall(PetscLogEventEnd(PHLEX_MatBlockCopy, A, 0, 0, 0));

@@ -27,6 +27,7 @@ def main():
     ap.add_argument("direct")
     ap.add_argument("--columns", default="kinetic,strain,total")
     ap.add_argument("--tol", type=float, required=True)
+    ap.add_argument("--against", default="the direct preset", help="what the second file is, for the verdict lines")
     a = ap.parse_args()
     it, di = read(a.iterative), read(a.direct)
     if len(it) != len(di) or not di:
@@ -38,7 +39,7 @@ def main():
             sys.exit(2)
         scale = max(abs(float(r[col])) for r in di) or 1.0
         d = max(abs(float(x[col]) - float(y[col])) for x, y in zip(it, di)) / scale
-        print("energy column %s against the direct preset: %s" % (col, "PASS" if d <= a.tol else "FAIL %.3g > %.3g" % (d, a.tol)))
+        print("energy column %s against %s: %s" % (col, a.against, "PASS" if d <= a.tol else "FAIL %.3g > %.3g" % (d, a.tol)))
         print("  %s: max difference %.3g of its max %.6g" % (col, d, scale), file=sys.stderr)
 
 
