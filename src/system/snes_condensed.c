@@ -340,8 +340,10 @@ static PetscErrorCode KeepIncrement(SNES_Condensed *c, Vec x)
 
 /* Multigrid restricts by products with the transposes of its interpolations; an AIJ product with the transpose
    scatters into the result and runs at half the speed of a product (0.52 against 1.1 GFlop/s, BENCHMARKS.md section
-   43). After the preconditioner's set-up (the hierarchy is rebuilt with each operator), each level whose restriction
-   is its interpolation gets the stored transpose instead (about 2 % of the operator's memory). */
+   43). After each set-up of the preconditioner, each level whose restriction is still its interpolation gets the
+   stored transpose instead (about 2 % of the operator's memory). GAMG set up again on the same pattern (a new step
+   size) keeps its interpolations and so these transposes (the same CG iterations as without them after changes of
+   the step, iterative_block_products); a new pattern resets the levels, whose restrictions are then transposed anew. */
 static PetscErrorCode ExplicitRestrictions(KSP ksp)
 {
   PC        pc;
