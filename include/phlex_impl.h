@@ -194,6 +194,15 @@ PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, Pe
 PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
 /* mat_block_copy.c: an AIJ matrix copied in node blocks (BAIJ) */
 PETSC_INTERN PetscErrorCode PhlexMatBlockCopy(Mat, PetscBool, MatReuse, Mat *);
+/* mg_level_products.c: a multigrid hierarchy's transfers and coarse operators in node blocks after its set-up */
+typedef struct {
+  PetscInt nlevels; /* of the hierarchy copied (0: none) */
+  Mat     *P, *Pb;  /* per level: its AIJ interpolation and that one's block copy (NULL: none) */
+  PetscInt count[5]; /* transfers, by block copies, by stored transposes; smoothed coarse levels, by block copies */
+} PhlexMGCopies;
+PETSC_INTERN PetscErrorCode PhlexMGCopiesApply(KSP, PetscBool, PetscBool, PhlexMGCopies *);
+PETSC_INTERN PetscErrorCode PhlexMGCopiesRestore(KSP, PhlexMGCopies *);
+PETSC_INTERN PetscErrorCode PhlexMGCopiesDestroy(PhlexMGCopies *);
 
 /* format.c: numbers echoed to the user at full precision */
 PETSC_INTERN const char *PhlexFormatReal(PetscReal, char[], size_t);

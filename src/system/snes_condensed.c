@@ -50,8 +50,10 @@ typedef struct {
   PetscBool   balance;     /* correct an iterative solve's increment so that its residual does no work on the stage velocity */
   Vec         p, Ap;       /* work: the stage velocity v0 + dv and its product with the operator */
   PetscBool   block_products;   /* an iterative solve's products with the operator by a node-block (BAIJ) copy of it */
-  PetscBool   explicit_restrict; /* multigrid's restrictions by stored transposes of its interpolations */
+  PetscBool   block_levels;     /* multigrid's transfers and coarse operators by node-block copies (mg_level_products.c) */
+  PetscBool   explicit_restrict; /* multigrid's restrictions by stored transposes of its interpolations (those without a block copy) */
   PetscBool   block_symmetric; /* the block copy as its upper triangle (SBAIJ) */
+  PhlexMGCopies mg;        /* multigrid's transfers and coarse operators as block copies (mg_level_products.c) */
   Mat         Ablock;      /* the node-block copy of the operator (NULL: the products use the operator itself) */
   PetscObjectState svstate;   /* the state of the operator the copy was taken from */
   PetscObjectState svnzstate; /* and of its nonzero pattern */
@@ -338,36 +340,6 @@ static PetscErrorCode KeepIncrement(SNES_Condensed *c, Vec x)
   PetscFunctionReturn(0);
 }
 
-/* Multigrid restricts by products with the transposes of its interpolations; an AIJ product with the transpose
-   scatters into the result and runs at half the speed of a product (0.52 against 1.1 GFlop/s, BENCHMARKS.md section
-   43). After each set-up of the preconditioner, each level whose restriction is still its interpolation gets the
-   stored transpose instead (about 2 % of the operator's memory). GAMG set up again on the same pattern (a new step
-   size) keeps its interpolations and so these transposes (the same CG iterations as without them after changes of
-   the step, iterative_block_products); a new pattern resets the levels, whose restrictions are then transposed anew. */
-static PetscErrorCode ExplicitRestrictions(KSP ksp)
-{
-  PC        pc;
-  PetscBool mg;
-  PetscInt  nlevels;
-
-  PetscFunctionBeginUser;
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &mg, PCMG, PCGAMG, ""));
-  if (!mg) PetscFunctionReturn(0);
-  PetscCall(KSPSetUp(ksp));
-  PetscCall(PCMGGetLevels(pc, &nlevels));
-  for (PetscInt l = 1; l < nlevels; l++) {
-    Mat P, R;
-    PetscCall(PCMGGetInterpolation(pc, l, &P));
-    PetscCall(PCMGGetRestriction(pc, l, &R));
-    if (R != P) continue;
-    PetscCall(MatTranspose(P, MAT_INITIAL_MATRIX, &R));
-    PetscCall(PCMGSetRestriction(pc, l, R));
-    PetscCall(MatDestroy(&R));
-  }
-  PetscFunctionReturn(0);
-}
-
 /* The operator handed to the condensed KSP. An iterative solve spends its time in products with the operator: CG's
    and multigrid's fine-level smoothing and residual. Its P2 velocity unknowns come in node blocks of 3 that couple
    as dense 3 x 3 blocks, so a BAIJ copy reads one column index per block instead of one per entry (or per inode row):
@@ -397,8 +369,9 @@ static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
     }
     c->svnzstate = nzstate;
   }
+  PetscCall(PhlexMGCopiesRestore(c->ksp, &c->mg)); /* GAMG's interpolations back for its set-up */
   PetscCall(KSPSetOperators(c->ksp, c->Ablock ? c->Ablock : Sv, Sv));
-  if (c->explicit_restrict && !preonly) PetscCall(ExplicitRestrictions(c->ksp));
+  if (!preonly) PetscCall(PhlexMGCopiesApply(c->ksp, c->block_levels, c->explicit_restrict, &c->mg));
   PetscCall(PetscObjectStateGet((PetscObject)Sv, &c->svstate)); /* after the set-up (it may mark Sv) */
   PetscFunctionReturn(0);
 }
@@ -436,12 +409,12 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscCall(SetOperators(c, Sv));
     c->shift = s;
     c->nhist = 0; /* the increments scale with the step: the guess starts again */
-  } else if (c->Ablock) {
+  } else if (c->Ablock || c->block_levels || c->explicit_restrict) {
     Mat              Sv;
     PetscObjectState state;
     PetscCall(KSPGetOperators(c->ksp, NULL, &Sv));
     PetscCall(PetscObjectStateGet((PetscObject)Sv, &state));
-    if (state != c->svstate) PetscCall(SetOperators(c, Sv)); /* Sv's values changed in place: the copy refilled */
+    if (state != c->svstate) PetscCall(SetOperators(c, Sv)); /* Sv's values changed in place: the copies made again */
   }
   /* the loads b at the stage time (those of a fixed body depend on t only) */
   PetscCall(PhlexSystemEvaluate(sys, tstage, X0, NULL));
@@ -511,6 +484,7 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   PetscCall(VecDestroy(&c->p));
   PetscCall(VecDestroy(&c->Ap));
   PetscCall(MatDestroy(&c->Ablock));
+  PetscCall(PhlexMGCopiesDestroy(&c->mg));
   c->nhist = 0;
   c->shift = 0.0;
   PetscFunctionReturn(0);
@@ -534,7 +508,8 @@ static PetscErrorCode SNESSetFromOptions_Condensed(SNES snes, PetscOptionItems *
   PetscCall(PetscOptionsInt("-snes_phlexcondensed_guess_order", "Initial guess of an iterative condensed solve: the polynomial through this many of the last steps' velocity increments, one step on (0: zero guess, 1: the last increment, 2: linear, 3: quadratic extrapolation); a direct solve takes none", "SNESPHLEXCONDENSED", order, &order, NULL));
   PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_products", "An iterative condensed solve's products with the operator by a copy in 3 x 3 node blocks (BAIJ; the preconditioner is built from the AIJ operator): faster products for more memory; a direct solve takes none", "SNESPHLEXCONDENSED", c->block_products, &c->block_products, NULL));
   PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_products_symmetric", "With -snes_phlexcondensed_block_products: the block copy stores the upper triangle only (SBAIJ; less memory, on several processes two halo exchanges per product)", "SNESPHLEXCONDENSED", c->block_symmetric, &c->block_symmetric, NULL));
-  PetscCall(PetscOptionsBool("-snes_phlexcondensed_explicit_restriction", "Multigrid preconditioners of an iterative condensed solve restrict by stored transposes of their interpolations (faster than products with the transposes)", "SNESPHLEXCONDENSED", c->explicit_restrict, &c->explicit_restrict, NULL));
+  PetscCall(PetscOptionsBool("-snes_phlexcondensed_block_levels", "Multigrid preconditioners of an iterative condensed solve (GAMG) transfer by a node-block (BAIJ) copy of each interpolation, in both directions, and smooth each coarse level with a BAIJ copy of its operator: faster products", "SNESPHLEXCONDENSED", c->block_levels, &c->block_levels, NULL));
+  PetscCall(PetscOptionsBool("-snes_phlexcondensed_explicit_restriction", "Multigrid preconditioners of an iterative condensed solve restrict by stored transposes of their interpolations (faster than products with the transposes; for interpolations without a block copy)", "SNESPHLEXCONDENSED", c->explicit_restrict, &c->explicit_restrict, NULL));
   PetscCall(PetscOptionsBool("-snes_phlexcondensed_balance", "Correct an iterative condensed solve's velocity increment along the stage velocity so that its residual does no work (the power balance to round-off whatever the Krylov tolerance); a direct solve takes none", "SNESPHLEXCONDENSED", c->balance, &c->balance, NULL));
   PetscOptionsHeadEnd();
   PetscCheck(order >= 0 && order <= 3, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT, "-snes_phlexcondensed_guess_order must be 0, 1, 2 or 3, got %" PetscInt_FMT, order);
@@ -555,6 +530,12 @@ static PetscErrorCode SNESView_Condensed(SNES snes, PetscViewer viewer)
   PetscCall(PetscObjectTypeCompare((PetscObject)viewer, PETSCVIEWERASCII, &ascii));
   if (!ascii) PetscFunctionReturn(0);
   PetscCall(PetscViewerASCIIPrintf(viewer, "  theta-method stage by exact elimination of displacement and stress; condensed velocity solve:\n"));
+  if (c->ksp) {
+    PetscBool preonly;
+    PetscCall(PetscObjectTypeCompare((PetscObject)c->ksp, KSPPREONLY, &preonly));
+    if (!preonly) PetscCall(PetscViewerASCIIPrintf(viewer, "  products with the operator: %s\n", c->Ablock ? "its node-block copy" : "itself"));
+    if (c->mg.count[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "  multigrid: of %" PetscInt_FMT " transfers %" PetscInt_FMT " by node-block copies, %" PetscInt_FMT " restricting by stored transposes; of %" PetscInt_FMT " smoothed coarse levels %" PetscInt_FMT " by node-block copies\n", c->mg.count[0], c->mg.count[1], c->mg.count[2], c->mg.count[3], c->mg.count[4]));
+  }
   if (c->ksp) {
     PetscCall(PetscViewerASCIIPushTab(viewer));
     PetscCall(KSPView(c->ksp, viewer));
