@@ -198,6 +198,8 @@ PETSC_INTERN PetscErrorCode PhlexMatBlockCopy(Mat, PetscBool, MatReuse, Mat *);
 typedef struct {
   PetscInt nlevels; /* of the hierarchy copied (0: none) */
   Mat     *P, *Pb;  /* per level: its AIJ interpolation and that one's block copy (NULL: none) */
+  Mat     *A, *Ab;  /* per smoothed coarse level: its AIJ operator and that one's block copy (NULL: none) */
+  PetscObjectState *Anz; /* per level: the AIJ operator's nonzero state when copied */
   PetscInt count[5]; /* transfers, by block copies, by stored transposes; smoothed coarse levels, by block copies */
 } PhlexMGCopies;
 PETSC_INTERN PetscErrorCode PhlexMGCopiesApply(KSP, PetscBool, PetscBool, PhlexMGCopies *);

@@ -10,9 +10,28 @@
    blocks may instead get a stored transpose as its restriction (the gain is the restriction's).
    GAMG set up again on the same pattern (a new step size) keeps its interpolations by default and forms the coarse
    operators again as Galerkin products with them, which need the AIJ P: PhlexMGCopiesRestore puts them back before
-   a set-up; after it, PhlexMGCopiesApply puts the copies of the same P back and copies the new coarse operators
-   (and the levels' residuals, which GAMG leaves on the matrices they were given). */
+   a set-up; after it, PhlexMGCopiesApply puts the copies of the same P back and refills the coarse operators' copies
+   (the levels' residuals, which GAMG leaves on the matrices they were given, are these copies). Only the smoothers
+   of PCMG's levels are given the copies: up-smoothers distinct from them (-pc_mg_distinct_smoothup) as well. A
+   smoother whose Chebyshev bounds are estimated (not GAMG's, -pc_gamg_use_sa_esteig 0 or a preconditioner other
+   than Jacobi) estimates them again on the copy: the same values, a few products more per set-up. */
 #include <phlex_impl.h>
+#include <petsc/private/pcimpl.h> /* whether the preconditioner is set up (after a KSPReset its levels have no transfers) */
+
+/* whether PCMG's levels have up-smoothers of their own (-pc_mg_distinct_smoothup): PCMGGetSmootherUp would make one */
+static PetscErrorCode DistinctSmoothUp(PC pc, PetscBool *distinct)
+{
+  const char  *prefix;
+  PetscOptions options;
+  PetscBool    set;
+
+  PetscFunctionBeginUser;
+  *distinct = PETSC_FALSE;
+  PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  PetscCall(PetscObjectGetOptions((PetscObject)pc, &options));
+  PetscCall(PetscOptionsGetBool(options, prefix, "-pc_mg_distinct_smoothup", distinct, &set));
+  PetscFunctionReturn(0);
+}
 
 static PetscErrorCode IsMG(KSP ksp, PC *pc, PetscBool *mg)
 {
@@ -35,7 +54,7 @@ static PetscErrorCode IsMG(KSP ksp, PC *pc, PetscBool *mg)
 PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transposes, PhlexMGCopies *m)
 {
   PC        pc;
-  PetscBool mg;
+  PetscBool mg, distinct;
   PetscInt  nlevels;
 
   PetscFunctionBeginUser;
@@ -45,10 +64,11 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
   if (!mg) PetscFunctionReturn(0);
   PetscCall(KSPSetUp(ksp));
   PetscCall(PCMGGetLevels(pc, &nlevels));
-  if (nlevels != m->nlevels) { /* a new hierarchy: the copies of the old one's interpolations go */
+  PetscCall(DistinctSmoothUp(pc, &distinct));
+  if (nlevels != m->nlevels) { /* a new hierarchy: the copies of the old one's go */
     PetscCall(PhlexMGCopiesDestroy(m));
     m->nlevels = nlevels;
-    PetscCall(PetscCalloc2(nlevels, &m->P, nlevels, &m->Pb));
+    PetscCall(PetscCalloc5(nlevels, &m->P, nlevels, &m->Pb, nlevels, &m->A, nlevels, &m->Ab, nlevels, &m->Anz));
   }
   m->count[0] = nlevels - 1;
   m->count[3] = PetscMax(nlevels - 2, 0);
@@ -84,18 +104,31 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
     } else if (R != P) m->count[2]++; /* a stored transpose from an earlier set-up, kept by GAMG with P */
     /* level l's smoothing and residual (the finest level's operator is the KSP's own) */
     if (blocks && l < nlevels - 1) {
-      KSP smoother;
-      Mat A, B, Ab = NULL;
+      KSP              smoother;
+      Mat              A, B;
+      PetscObjectState nz;
       PetscCall(PCMGGetSmoother(pc, l, &smoother));
       PetscCall(KSPGetOperators(smoother, &A, &B));
       PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)B, &aij, MATSEQAIJ, MATMPIAIJ, ""));
-      if (aij) PetscCall(PhlexMatBlockCopy(B, PETSC_FALSE, MAT_INITIAL_MATRIX, &Ab));
-      if (Ab) {
-        PetscCall(KSPSetOperators(smoother, Ab, B));
-        PetscCall(PCMGSetResidual(pc, l, PCMGResidualDefault, Ab));
-        PetscCall(MatDestroy(&Ab));
-        m->count[4]++;
+      if (!aij) continue;
+      PetscCall(MatGetNonzeroState(B, &nz));
+      if (B != m->A[l] || nz != m->Anz[l]) { /* a new operator or pattern: a new copy */
+        PetscCall(MatDestroy(&m->Ab[l]));
+        PetscCall(MatDestroy(&m->A[l]));
+        PetscCall(PhlexMatBlockCopy(B, PETSC_FALSE, MAT_INITIAL_MATRIX, &m->Ab[l]));
+        PetscCall(PetscObjectReference((PetscObject)B));
+        m->A[l]   = B;
+        m->Anz[l] = nz;
+      } else if (A != m->Ab[l] && m->Ab[l]) PetscCall(PhlexMatBlockCopy(B, PETSC_FALSE, MAT_REUSE_MATRIX, &m->Ab[l])); /* GAMG formed it again in place */
+      if (!m->Ab[l]) continue;
+      PetscCall(KSPSetOperators(smoother, m->Ab[l], B));
+      if (distinct) {
+        KSP up;
+        PetscCall(PCMGGetSmootherUp(pc, l, &up));
+        PetscCall(KSPSetOperators(up, m->Ab[l], B));
       }
+      PetscCall(PCMGSetResidual(pc, l, PCMGResidualDefault, m->Ab[l]));
+      m->count[4]++;
     }
   }
   PetscFunctionReturn(0);
@@ -116,7 +149,7 @@ PetscErrorCode PhlexMGCopiesRestore(KSP ksp, PhlexMGCopies *m)
   PetscFunctionBeginUser;
   if (!m->nlevels) PetscFunctionReturn(0);
   PetscCall(IsMG(ksp, &pc, &mg));
-  if (!mg) PetscFunctionReturn(0);
+  if (!mg || !pc->setupcalled) PetscFunctionReturn(0); /* reset: GAMG starts afresh */
   PetscCall(PCMGGetLevels(pc, &nlevels));
   if (nlevels != m->nlevels) PetscFunctionReturn(0);
   for (PetscInt l = 1; l < nlevels; l++) {
@@ -130,7 +163,8 @@ PetscErrorCode PhlexMGCopiesRestore(KSP ksp, PhlexMGCopies *m)
 }
 
 /*@C
-  PhlexMGCopiesDestroy - the copies of the interpolations and the AIJ matrices they were taken from, released
+  PhlexMGCopiesDestroy - the copies of the interpolations and coarse operators and the AIJ matrices they were taken
+  from, released
 
   Not collective
 @*/
@@ -140,8 +174,11 @@ PetscErrorCode PhlexMGCopiesDestroy(PhlexMGCopies *m)
   for (PetscInt l = 0; l < m->nlevels; l++) {
     PetscCall(MatDestroy(&m->P[l]));
     PetscCall(MatDestroy(&m->Pb[l]));
+    PetscCall(MatDestroy(&m->A[l]));
+    PetscCall(MatDestroy(&m->Ab[l]));
   }
-  PetscCall(PetscFree2(m->P, m->Pb));
+  PetscCall(PetscFree5(m->P, m->Pb, m->A, m->Ab, m->Anz));
   m->nlevels = 0;
+  PetscCall(PetscArrayzero(m->count, 5));
   PetscFunctionReturn(0);
 }
