@@ -175,7 +175,7 @@ PetscErrorCode PhlexBlockCGApplies(KSP ksp, PetscBool *applies)
 PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBool matapply, const char what[], PetscInt *its, PetscInt *colits)
 {
   MPI_Comm           comm;
-  Mat                A, Pm = NULL, Qm = NULL, Rm = NULL, Zm = NULL;
+  Mat                A, Apc, Pm = NULL, Qm = NULL, Rm = NULL, Zm = NULL;
   PC                 pc;
   KSPNormType        ntype;
   PetscReal          rtol, atol, dtol, *nrm, *tol;
@@ -189,7 +189,15 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBo
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_BlockCG, ksp, 0, 0, 0));
   comm = PetscObjectComm((PetscObject)ksp);
-  PetscCall(KSPGetOperators(ksp, &A, NULL));
+  PetscCall(KSPGetOperators(ksp, &A, &Apc));
+  {
+    /* a node-block (BAIJ) operator on several processes has no product with a dense block in PETSc 3.18 (it would
+       multiply column by column, reading the operator once per column): the block product then by the AIJ matrix
+       it was copied from, the preconditioner's (the same values) */
+    PetscBool mpibaij;
+    PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBAIJ, &mpibaij));
+    if (mpibaij) A = Apc;
+  }
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(KSPGetTolerances(ksp, &rtol, &atol, &dtol, &maxit));
   PetscCall(KSPGetNormType(ksp, &ntype));

@@ -45,6 +45,11 @@ typedef struct {
   PetscBool         *block_pc;   /* per block: -<prefix>bordered_[<body>_]block_cg_pc_block, its preconditioner applied to the block (PCMatApply) */
   PetscReal         *block_check; /* per block: -<prefix>bordered_[<body>_]block_cg_check (0: off) */
   PetscInt          *bcg_its, *bcg_colits, *seq_its; /* per block, the last basis: block CG iterations, column iterations; sequential CG iterations (check) */
+  PetscBool         *block_products; /* per block: -<prefix>bordered_[<body>_]block_products, an iterative solve's products by node-block copies */
+  Mat               *Ablock;  /* per block: the node-block (BAIJ) copy of its operator (NULL: none) */
+  Mat               *Ablock_src; /* per block: the operator it was copied from (referenced) */
+  PetscObjectState  *Ablock_nz; /* per block: and that one's nonzero state then */
+  PhlexMGCopies     *mgc;     /* per block: its multigrid's transfers and coarse levels as block copies */
   PetscInt           nfactor;
   PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
   char             **copy_from, **copy_to;
@@ -270,10 +275,11 @@ static PetscErrorCode BlockSequentialOperator(PC_Bordered *pb, PetscInt i, Mat A
 /* under prefix: -lu_mat_solver_type, the package of the LU that a body's operator takes where Cholesky was asked for
    and the operator is not symmetric (BlockFactorType); -block_cg and -block_cg_check, how its border basis is solved
    for with an iterative (CG) inner solver */
-static PetscErrorCode ReadBodyOptions(MPI_Comm comm, const char prefix[], const char title[], char package[], size_t len, PetscBool *block_cg, PetscBool *block_pc, PetscReal *check)
+static PetscErrorCode ReadBodyOptions(MPI_Comm comm, const char prefix[], const char title[], char package[], size_t len, PetscBool *block_cg, PetscBool *block_pc, PetscReal *check, PetscBool *block_products)
 {
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, prefix, title, NULL);
+  PetscCall(PetscOptionsBool("-block_products", "With an iterative inner solve: its products with the body's operator by a copy in 3 x 3 node blocks (BAIJ), and a multigrid preconditioner's transfers and coarse levels by node-block copies after each of its set-ups (as -snes_phlexcondensed_block_products and _block_levels): faster products for more memory", "PCPHLEXBORDERED", *block_products, block_products, NULL));
   PetscCall(PetscOptionsString("-lu_mat_solver_type", "Solver package of the LU that the body's condensed operator takes where Cholesky was asked for and the operator is not symmetric (its frame's rate factored with it); default: the Cholesky's package, which then needs an LU (cholmod has none: give mumps)", "PCPHLEXBORDERED", package, package, len, NULL));
   PetscCall(PetscOptionsBool("-block_cg", "With an inner CG (ksp_type cg): solve for the border basis A^{-1} W (12 columns for a floating frame, 6 per jointed port) by block CG, all columns at once (one sparse product and one block preconditioner application per iteration), instead of one CG solve per column (KSPMatSolve); each column to the KSP's tolerance against its own right-hand side", "PCPHLEXBORDERED", *block_cg, block_cg, NULL));
   PetscCall(PetscOptionsBool("-block_cg_pc_block", "With block CG: apply the inner preconditioner to the block at once (PCMatApply; GAMG and MG: the grid transfers as block products, the smoothers column by column) instead of column by column (PCApply)", "PCPHLEXBORDERED", *block_pc, block_pc, NULL));
@@ -296,6 +302,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->lu_package));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->block_pc));
+  PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->block_products, PetscMax(pb->nb, 1), &pb->Ablock, PetscMax(pb->nb, 1), &pb->Ablock_src, PetscMax(pb->nb, 1), &pb->Ablock_nz, PetscMax(pb->nb, 1), &pb->mgc));
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->block_cg, PetscMax(pb->nb, 1), &pb->block_check, PetscMax(pb->nb, 1), &pb->bcg_its, PetscMax(pb->nb, 1), &pb->bcg_colits, PetscMax(pb->nb, 1), &pb->seq_its));
   PetscCall(PetscCalloc4(PetscMax(pb->nb, 1), &pb->owner, PetscMax(pb->nb, 1), &pb->Aseq, PetscMax(pb->nb, 1), &pb->fseq, PetscMax(pb->nb, 1), &pb->xseq));
   PetscCall(BorderedOwners(pc, pb));
@@ -332,7 +339,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
       PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
       pb->block_cg[i] = PETSC_TRUE;
       pb->block_pc[i] = PETSC_TRUE;
-      PetscCall(ReadBodyOptions(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i]), &pb->block_cg[i], &pb->block_pc[i], &pb->block_check[i]));
+      PetscCall(ReadBodyOptions(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i]), &pb->block_cg[i], &pb->block_pc[i], &pb->block_check[i], &pb->block_products[i]));
     }
   }
   PetscCall(RefuseSharedSuperLUDist(pc, pb));
@@ -440,6 +447,42 @@ static PetscErrorCode BlockBasis(PC pc, PC_Bordered *pb, PetscInt i, Mat Wl, Mat
   PetscFunctionReturn(0);
 }
 
+/* An iterative inner solve's products with block i's operator by its node-block copy (-block_products; BAIJ reads
+   one column index per 3 x 3 block: SNES phlexcondensed's block products, BENCHMARKS.md sections 43, 44), the KSP's
+   operators then (copy, AIJ): its preconditioner is built from the AIJ one. Called after the KSP was given the AIJ
+   operator, before its set-up: the copy made (a new operator object or pattern) or refilled in place ('changed': the
+   values changed; one object, which GAMG's fine level keeps), and a multigrid preconditioner's interpolations put back
+   for its set-up (PhlexMGCopiesApply copies them again after it). A direct solve (preonly) takes no copy. */
+static PetscErrorCode BlockProductsBefore(PC_Bordered *pb, PetscInt i, PetscBool changed)
+{
+  KSP              ksp = pb->ksp[i];
+  Mat              A;
+  PetscBool        preonly;
+  PetscObjectState nz;
+
+  PetscFunctionBeginUser;
+  if (!pb->block_products[i]) PetscFunctionReturn(0);
+  PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &preonly));
+  if (preonly) PetscFunctionReturn(0);
+  PetscCall(KSPGetOperators(ksp, NULL, &A));
+  PetscCall(MatGetNonzeroState(A, &nz));
+  if (A != pb->Ablock_src[i] || nz != pb->Ablock_nz[i]) { /* a new operator or pattern: a new copy */
+    PetscBool set, flg;
+    PetscCall(MatDestroy(&pb->Ablock[i]));
+    PetscCall(MatDestroy(&pb->Ablock_src[i]));
+    PetscCall(PhlexMatBlockCopy(A, PETSC_FALSE, MAT_INITIAL_MATRIX, &pb->Ablock[i]));
+    PetscCall(MatIsSymmetricKnown(A, &set, &flg));
+    if (pb->Ablock[i] && set) PetscCall(MatSetOption(pb->Ablock[i], MAT_SYMMETRIC, flg));
+    PetscCall(PetscObjectReference((PetscObject)A));
+    pb->Ablock_src[i] = A;
+    pb->Ablock_nz[i]  = nz;
+  } else if (changed && pb->Ablock[i]) PetscCall(PhlexMatBlockCopy(A, PETSC_FALSE, MAT_REUSE_MATRIX, &pb->Ablock[i]));
+  if (!pb->Ablock[i]) PetscFunctionReturn(0); /* not in whole node blocks: its products use it as it is */
+  PetscCall(PhlexMGCopiesRestore(ksp, &pb->mgc[i]));
+  PetscCall(KSPSetOperators(ksp, pb->Ablock[i], A));
+  PetscFunctionReturn(0);
+}
+
 static PetscErrorCode PCSetUp_Bordered(PC pc)
 {
   PC_Bordered       *pb = (PC_Bordered *)pc->data;
@@ -499,7 +542,9 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
       PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pb->ksp[i], 0, 0, 0));
       if (mine) PetscCall(BlockSequentialOperator(pb, i, bd->A[i], Achanged[i]));
       else PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
+      PetscCall(BlockProductsBefore(pb, i, Achanged[i]));
       PetscCall(KSPSetUp(pb->ksp[i]));
+      if (pb->Ablock[i]) PetscCall(PhlexMGCopiesApply(pb->ksp[i], PETSC_TRUE, PETSC_FALSE, &pb->mgc[i]));
       if (pb->Y[i]) {
         Mat Wl = bd->W[i], Yl = pb->Y[i];
         if (mine) {
@@ -651,6 +696,9 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < pb->nb; i++) {
     PetscCall(KSPDestroy(&pb->ksp[i]));
+    PetscCall(MatDestroy(&pb->Ablock[i]));
+    PetscCall(MatDestroy(&pb->Ablock_src[i]));
+    PetscCall(PhlexMGCopiesDestroy(&pb->mgc[i]));
     PetscCall(MatDestroy(&pb->Y[i]));
     PetscCall(PetscFree(pb->beta[i]));
     PetscCall(ISDestroy(&pb->is[i]));
@@ -664,6 +712,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscCall(PetscFree(pb->is));
   PetscCall(PetscFree(pb->lu_package));
   PetscCall(PetscFree(pb->block_pc));
+  PetscCall(PetscFree5(pb->block_products, pb->Ablock, pb->Ablock_src, pb->Ablock_nz, pb->mgc));
   PetscCall(PetscFree5(pb->block_cg, pb->block_check, pb->bcg_its, pb->bcg_colits, pb->seq_its));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
   PetscCall(BorderedCopiesFree(pb));
@@ -677,6 +726,18 @@ static PetscErrorCode PCDestroy_Bordered(PC pc)
   PetscFunctionBeginUser;
   PetscCall(PCReset_Bordered(pc));
   PetscCall(PetscFree(pc->data));
+  PetscFunctionReturn(0);
+}
+
+/* what block i's products use (-block_products): its operator or a copy, its multigrid's transfers and levels */
+static PetscErrorCode BlockProductsView(PC_Bordered *pb, PetscInt i, PetscViewer viewer)
+{
+  const PetscInt *n = pb->mgc[i].count;
+
+  PetscFunctionBeginUser;
+  if (!pb->block_products[i]) PetscFunctionReturn(0);
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  its products with the operator: %s\n", pb->Ablock[i] ? "its node-block copy" : "itself"));
+  if (n[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "  its multigrid: of %" PetscInt_FMT " transfers %" PetscInt_FMT " by node-block copies; of %" PetscInt_FMT " smoothed coarse levels %" PetscInt_FMT " by node-block copies\n", n[0], n[1], n[3], n[4]));
   PetscFunctionReturn(0);
 }
 
@@ -697,6 +758,7 @@ static PetscErrorCode PCView_Bordered(PC pc, PetscViewer viewer)
     if (pb->owner[i] < 0) {
       PetscCall(PetscViewerASCIIPrintf(viewer, "  solver for the sparse block of %s:\n", name));
       if (pb->bcg_its[i]) PetscCall(PetscViewerASCIIPrintf(viewer, "  its border basis (last computed) by block CG: %" PetscInt_FMT " iterations, %" PetscInt_FMT " column iterations\n", pb->bcg_its[i], pb->bcg_colits[i]));
+      PetscCall(BlockProductsView(pb, i, viewer));
       PetscCall(PetscViewerASCIIPushTab(viewer));
       PetscCall(KSPView(pb->ksp[i], viewer));
       PetscCall(PetscViewerASCIIPopTab(viewer));
@@ -707,7 +769,10 @@ static PetscErrorCode PCView_Bordered(PC pc, PetscViewer viewer)
       PetscCall(PetscViewerASCIIPushTab(viewer));
       PetscCall(PetscViewerASCIIPushSynchronized(viewer));
       PetscCall(PetscViewerGetSubViewer(viewer, PETSC_COMM_SELF, &sub));
-      if (rank == pb->owner[i]) PetscCall(KSPView(pb->ksp[i], sub));
+      if (rank == pb->owner[i]) {
+        PetscCall(BlockProductsView(pb, i, sub));
+        PetscCall(KSPView(pb->ksp[i], sub));
+      }
       PetscCall(PetscViewerRestoreSubViewer(viewer, PETSC_COMM_SELF, &sub));
       PetscCall(PetscViewerFlush(viewer));
       PetscCall(PetscViewerASCIIPopSynchronized(viewer));
@@ -730,7 +795,7 @@ PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const nam
   PC          inner;
   const char *prefix;
   char        common[256], title[512], lu_package[64] = "";
-  PetscBool   block_cg = PETSC_TRUE, block_pc = PETSC_TRUE;
+  PetscBool   block_cg = PETSC_TRUE, block_pc = PETSC_TRUE, block_products = PETSC_FALSE;
   PetscReal   check    = 0;
 
   PetscFunctionBeginUser;
@@ -748,7 +813,7 @@ PetscErrorCode PhlexPCBorderedHelp(PC pc, PetscInt nnames, const char *const nam
     PetscCall(PetscStrlcat(title, names[i], sizeof(title)));
   }
   PetscCall(PetscStrlcat(title, ")", sizeof(title)));
-  PetscCall(ReadBodyOptions(PETSC_COMM_SELF, common, title, lu_package, sizeof(lu_package), &block_cg, &block_pc, &check));
+  PetscCall(ReadBodyOptions(PETSC_COMM_SELF, common, title, lu_package, sizeof(lu_package), &block_cg, &block_pc, &check, &block_products));
   PetscCall(KSPDestroy(&ksp));
   PetscFunctionReturn(0);
 }
