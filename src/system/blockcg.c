@@ -192,8 +192,8 @@ PetscErrorCode PhlexBlockCG(KSP ksp, Mat B, Mat X, PetscBool collective, PetscBo
   PetscCall(KSPGetOperators(ksp, &A, &Apc));
   {
     /* a node-block (BAIJ) operator on several processes has no product with a dense block in PETSc 3.18 (it would
-       multiply column by column, reading the operator once per column): the block product then by the AIJ matrix
-       it was copied from, the preconditioner's (the same values) */
+       multiply column by column, reading the operator once per column): the block product then by the
+       preconditioning matrix, which PC phlexbordered (the only caller) makes the AIJ matrix the copy was taken from */
     PetscBool mpibaij;
     PetscCall(PetscObjectTypeCompare((PetscObject)A, MATMPIBAIJ, &mpibaij));
     if (mpibaij) A = Apc;

@@ -339,6 +339,11 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
       PetscCall(KSPGetOptionsPrefix(pb->ksp[i], &kprefix));
       pb->block_cg[i] = PETSC_TRUE;
       pb->block_pc[i] = PETSC_TRUE;
+      char        common[256];
+      /* the options common to every body first (a preset's, read even where the body gives its own: not left
+         unused), then the body's */
+      PetscCall(PetscSNPrintf(common, sizeof(common), "%sbordered_", prefix ? prefix : ""));
+      PetscCall(ReadBodyOptions(PetscObjectComm((PetscObject)pc), common, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i]), &pb->block_cg[i], &pb->block_pc[i], &pb->block_check[i], &pb->block_products[i]));
       PetscCall(ReadBodyOptions(PetscObjectComm((PetscObject)pc), kprefix, "PC phlexbordered: the factorization of a body's condensed operator", pb->lu_package[i], sizeof(pb->lu_package[i]), &pb->block_cg[i], &pb->block_pc[i], &pb->block_check[i], &pb->block_products[i]));
     }
   }
@@ -467,17 +472,22 @@ static PetscErrorCode BlockProductsBefore(PC_Bordered *pb, PetscInt i, PetscBool
   PetscCall(KSPGetOperators(ksp, NULL, &A));
   PetscCall(MatGetNonzeroState(A, &nz));
   if (A != pb->Ablock_src[i] || nz != pb->Ablock_nz[i]) { /* a new operator or pattern: a new copy */
-    PetscBool set, flg;
     PetscCall(MatDestroy(&pb->Ablock[i]));
     PetscCall(MatDestroy(&pb->Ablock_src[i]));
     PetscCall(PhlexMatBlockCopy(A, PETSC_FALSE, MAT_INITIAL_MATRIX, &pb->Ablock[i]));
-    PetscCall(MatIsSymmetricKnown(A, &set, &flg));
-    if (pb->Ablock[i] && set) PetscCall(MatSetOption(pb->Ablock[i], MAT_SYMMETRIC, flg));
     PetscCall(PetscObjectReference((PetscObject)A));
     pb->Ablock_src[i] = A;
     pb->Ablock_nz[i]  = nz;
   } else if (changed && pb->Ablock[i]) PetscCall(PhlexMatBlockCopy(A, PETSC_FALSE, MAT_REUSE_MATRIX, &pb->Ablock[i]));
-  if (!pb->Ablock[i]) PetscFunctionReturn(0); /* not in whole node blocks: its products use it as it is */
+  if (!pb->Ablock[i]) { /* not in whole node blocks: its products use it as it is (GAMG starts afresh on a new pattern) */
+    PetscCall(PhlexMGCopiesDestroy(&pb->mgc[i]));
+    PetscFunctionReturn(0);
+  }
+  {
+    PetscBool set, flg; /* A's symmetry after each fill (an assembly forgets it) */
+    PetscCall(MatIsSymmetricKnown(A, &set, &flg));
+    if (set) PetscCall(MatSetOption(pb->Ablock[i], MAT_SYMMETRIC, flg));
+  }
   PetscCall(PhlexMGCopiesRestore(ksp, &pb->mgc[i]));
   PetscCall(KSPSetOperators(ksp, pb->Ablock[i], A));
   PetscFunctionReturn(0);

@@ -364,9 +364,9 @@ static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
     if (c->Ablock) PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, MAT_REUSE_MATRIX, &c->Ablock));
     else {
       PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, MAT_INITIAL_MATRIX, &c->Ablock));
-      if (c->Ablock) PetscCall(MatSetOption(c->Ablock, MAT_SYMMETRIC, PETSC_TRUE)); /* (MPIBAIJ takes no MAT_SPD in 3.18) */
-      else PetscCall(PetscInfo(c->ksp, "the condensed operator is not in whole %" PetscInt_FMT " x %" PetscInt_FMT " blocks: its products use it as it is\n", bs, bs));
+      if (!c->Ablock) PetscCall(PetscInfo(c->ksp, "the condensed operator is not in whole %" PetscInt_FMT " x %" PetscInt_FMT " blocks: its products use it as it is\n", bs, bs));
     }
+    if (c->Ablock) PetscCall(MatSetOption(c->Ablock, MAT_SYMMETRIC, PETSC_TRUE)); /* after each fill: an assembly forgets it (MPIBAIJ takes no MAT_SPD in 3.18) */
     c->svnzstate = nzstate;
   }
   PetscCall(PhlexMGCopiesRestore(c->ksp, &c->mg)); /* GAMG's interpolations back for its set-up */

@@ -16,20 +16,16 @@
    smoother whose Chebyshev bounds are estimated (not GAMG's, -pc_gamg_use_sa_esteig 0 or a preconditioner other
    than Jacobi) estimates them again on the copy: the same values, a few products more per set-up. */
 #include <phlex_impl.h>
-#include <petsc/private/pcimpl.h> /* whether the preconditioner is set up (after a KSPReset its levels have no transfers) */
+#include <petsc/private/pcmgimpl.h> /* whether the preconditioner is set up (after a KSPReset its levels have no transfers); a level's smoothers */
 
-/* whether PCMG's levels have up-smoothers of their own (-pc_mg_distinct_smoothup): PCMGGetSmootherUp would make one */
-static PetscErrorCode DistinctSmoothUp(PC pc, PetscBool *distinct)
+/* whether level l has an up-smoother of its own (-pc_mg_distinct_smoothup, PCMGSetDistinctSmoothUp): asked of the
+   level, since PCMGGetSmootherUp would make one */
+static PetscErrorCode DistinctSmoothUp(PC pc, PetscInt l, PetscBool *distinct)
 {
-  const char  *prefix;
-  PetscOptions options;
-  PetscBool    set;
+  PC_MG *mg = (PC_MG *)pc->data;
 
   PetscFunctionBeginUser;
-  *distinct = PETSC_FALSE;
-  PetscCall(PCGetOptionsPrefix(pc, &prefix));
-  PetscCall(PetscObjectGetOptions((PetscObject)pc, &options));
-  PetscCall(PetscOptionsGetBool(options, prefix, "-pc_mg_distinct_smoothup", distinct, &set));
+  *distinct = (PetscBool)(mg->levels && mg->levels[l]->smoothu && mg->levels[l]->smoothu != mg->levels[l]->smoothd);
   PetscFunctionReturn(0);
 }
 
@@ -64,7 +60,6 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
   if (!mg) PetscFunctionReturn(0);
   PetscCall(KSPSetUp(ksp));
   PetscCall(PCMGGetLevels(pc, &nlevels));
-  PetscCall(DistinctSmoothUp(pc, &distinct));
   if (nlevels != m->nlevels) { /* a new hierarchy: the copies of the old one's go */
     PetscCall(PhlexMGCopiesDestroy(m));
     m->nlevels = nlevels;
@@ -122,6 +117,7 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
       } else if (A != m->Ab[l] && m->Ab[l]) PetscCall(PhlexMatBlockCopy(B, PETSC_FALSE, MAT_REUSE_MATRIX, &m->Ab[l])); /* GAMG formed it again in place */
       if (!m->Ab[l]) continue;
       PetscCall(KSPSetOperators(smoother, m->Ab[l], B));
+      PetscCall(DistinctSmoothUp(pc, l, &distinct));
       if (distinct) {
         KSP up;
         PetscCall(PCMGGetSmootherUp(pc, l, &up));
