@@ -74,7 +74,7 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
     /* the transfer between levels l - 1 and l: a block copy of P in both roles (the same copy while P is the same) */
     PetscCall(PCMGGetInterpolation(pc, l, &P));
     PetscCall(PCMGGetRestriction(pc, l, &R));
-    if (P != m->P[l]) {
+    if (P != m->P[l] && !(m->Pb[l] && P == m->Pb[l])) { /* (P == Pb: applied before, no set-up since) */
       PetscCall(MatDestroy(&m->P[l]));
       PetscCall(MatDestroy(&m->Pb[l]));
       PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)P, &aij, MATSEQAIJ, MATMPIAIJ, ""));
