@@ -194,12 +194,17 @@ PETSC_INTERN PetscErrorCode PhlexMatCreateShell(MPI_Comm, PetscInt, PetscInt, Pe
 PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
 /* mat_block_copy.c: an AIJ matrix copied in node blocks (BAIJ) */
 PETSC_INTERN PetscErrorCode PhlexMatBlockCopy(Mat, PetscBool, MatReuse, Mat *);
+typedef struct {
+  Mat              copy; /* the node-block copy (NULL: none, src not in whole blocks) */
+  Mat              src;  /* the matrix it was taken from (referenced) */
+  PetscObjectState nz, state; /* src's nonzero state and state at the last fill */
+} PhlexBlockCopy;
+PETSC_INTERN PetscErrorCode PhlexBlockCopyUpdate(PhlexBlockCopy *, Mat, PetscBool);
+PETSC_INTERN PetscErrorCode PhlexBlockCopyDestroy(PhlexBlockCopy *);
 /* mg_level_products.c: a multigrid hierarchy's transfers and coarse operators in node blocks after its set-up */
 typedef struct {
   PetscInt nlevels; /* of the hierarchy copied (0: none) */
-  Mat     *P, *Pb;  /* per level: its AIJ interpolation and that one's block copy (NULL: none) */
-  Mat     *A, *Ab;  /* per smoothed coarse level: its AIJ operator and that one's block copy (NULL: none) */
-  PetscObjectState *Anz; /* per level: the AIJ operator's nonzero state when copied */
+  PhlexBlockCopy *P, *A; /* per level: the block copies of its AIJ interpolation and (smoothed coarse levels) operator */
   PetscInt count[5]; /* transfers, by block copies, by stored transposes; smoothed coarse levels, by block copies */
 } PhlexMGCopies;
 PETSC_INTERN PetscErrorCode PhlexMGCopiesApply(KSP, PetscBool, PetscBool, PhlexMGCopies *);

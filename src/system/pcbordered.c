@@ -46,9 +46,7 @@ typedef struct {
   PetscReal         *block_check; /* per block: -<prefix>bordered_[<body>_]block_cg_check (0: off) */
   PetscInt          *bcg_its, *bcg_colits, *seq_its; /* per block, the last basis: block CG iterations, column iterations; sequential CG iterations (check) */
   PetscBool         *block_products; /* per block: -<prefix>bordered_[<body>_]block_products, an iterative solve's products by node-block copies */
-  Mat               *Ablock;  /* per block: the node-block (BAIJ) copy of its operator (NULL: none) */
-  Mat               *Ablock_src; /* per block: the operator it was copied from (referenced) */
-  PetscObjectState  *Ablock_nz; /* per block: and that one's nonzero state then */
+  PhlexBlockCopy    *Ablock;  /* per block: the node-block (BAIJ) copy of its operator */
   PhlexMGCopies     *mgc;     /* per block: its multigrid's transfers and coarse levels as block copies */
   PetscInt           nfactor;
   PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
@@ -302,7 +300,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->lu_package));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->block_pc));
-  PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->block_products, PetscMax(pb->nb, 1), &pb->Ablock, PetscMax(pb->nb, 1), &pb->Ablock_src, PetscMax(pb->nb, 1), &pb->Ablock_nz, PetscMax(pb->nb, 1), &pb->mgc));
+  PetscCall(PetscCalloc3(PetscMax(pb->nb, 1), &pb->block_products, PetscMax(pb->nb, 1), &pb->Ablock, PetscMax(pb->nb, 1), &pb->mgc));
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->block_cg, PetscMax(pb->nb, 1), &pb->block_check, PetscMax(pb->nb, 1), &pb->bcg_its, PetscMax(pb->nb, 1), &pb->bcg_colits, PetscMax(pb->nb, 1), &pb->seq_its));
   PetscCall(PetscCalloc4(PetscMax(pb->nb, 1), &pb->owner, PetscMax(pb->nb, 1), &pb->Aseq, PetscMax(pb->nb, 1), &pb->fseq, PetscMax(pb->nb, 1), &pb->xseq));
   PetscCall(BorderedOwners(pc, pb));
@@ -455,41 +453,27 @@ static PetscErrorCode BlockBasis(PC pc, PC_Bordered *pb, PetscInt i, Mat Wl, Mat
 /* An iterative inner solve's products with block i's operator by its node-block copy (-block_products; BAIJ reads
    one column index per 3 x 3 block: SNES phlexcondensed's block products, BENCHMARKS.md sections 43, 44), the KSP's
    operators then (copy, AIJ): its preconditioner is built from the AIJ one. Called after the KSP was given the AIJ
-   operator, before its set-up: the copy made (a new operator object or pattern) or refilled in place ('changed': the
-   values changed; one object, which GAMG's fine level keeps), and a multigrid preconditioner's interpolations put back
-   for its set-up (PhlexMGCopiesApply copies them again after it). A direct solve (preonly) takes no copy. */
-static PetscErrorCode BlockProductsBefore(PC_Bordered *pb, PetscInt i, PetscBool changed)
+   operator, before its set-up: the copy made or refilled in place (PhlexBlockCopyUpdate: one object, which GAMG's
+   fine level keeps), and a multigrid preconditioner's interpolations put back for its set-up (PhlexMGCopiesApply
+   copies them again after it). A direct solve (preonly) takes no copy. */
+static PetscErrorCode BlockProductsBefore(PC_Bordered *pb, PetscInt i)
 {
-  KSP              ksp = pb->ksp[i];
-  Mat              A;
-  PetscBool        preonly;
-  PetscObjectState nz;
+  KSP       ksp = pb->ksp[i];
+  Mat       A;
+  PetscBool preonly;
 
   PetscFunctionBeginUser;
   if (!pb->block_products[i]) PetscFunctionReturn(0);
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &preonly));
   if (preonly) PetscFunctionReturn(0);
   PetscCall(KSPGetOperators(ksp, NULL, &A));
-  PetscCall(MatGetNonzeroState(A, &nz));
-  if (A != pb->Ablock_src[i] || nz != pb->Ablock_nz[i]) { /* a new operator or pattern: a new copy */
-    PetscCall(MatDestroy(&pb->Ablock[i]));
-    PetscCall(MatDestroy(&pb->Ablock_src[i]));
-    PetscCall(PhlexMatBlockCopy(A, PETSC_FALSE, MAT_INITIAL_MATRIX, &pb->Ablock[i]));
-    PetscCall(PetscObjectReference((PetscObject)A));
-    pb->Ablock_src[i] = A;
-    pb->Ablock_nz[i]  = nz;
-  } else if (changed && pb->Ablock[i]) PetscCall(PhlexMatBlockCopy(A, PETSC_FALSE, MAT_REUSE_MATRIX, &pb->Ablock[i]));
-  if (!pb->Ablock[i]) { /* not in whole node blocks: its products use it as it is (GAMG starts afresh on a new pattern) */
+  PetscCall(PhlexBlockCopyUpdate(&pb->Ablock[i], A, PETSC_FALSE));
+  if (!pb->Ablock[i].copy) { /* not in whole node blocks: its products use it as it is (GAMG starts afresh on a new pattern) */
     PetscCall(PhlexMGCopiesDestroy(&pb->mgc[i]));
     PetscFunctionReturn(0);
   }
-  {
-    PetscBool set, flg; /* A's symmetry after each fill (an assembly forgets it) */
-    PetscCall(MatIsSymmetricKnown(A, &set, &flg));
-    if (set) PetscCall(MatSetOption(pb->Ablock[i], MAT_SYMMETRIC, flg));
-  }
   PetscCall(PhlexMGCopiesRestore(ksp, &pb->mgc[i]));
-  PetscCall(KSPSetOperators(ksp, pb->Ablock[i], A));
+  PetscCall(KSPSetOperators(ksp, pb->Ablock[i].copy, A));
   PetscFunctionReturn(0);
 }
 
@@ -552,9 +536,9 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
       PetscCall(PetscLogEventBegin(PHLEX_BorderedBasis, pb->ksp[i], 0, 0, 0));
       if (mine) PetscCall(BlockSequentialOperator(pb, i, bd->A[i], Achanged[i]));
       else PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
-      PetscCall(BlockProductsBefore(pb, i, Achanged[i]));
+      PetscCall(BlockProductsBefore(pb, i));
       PetscCall(KSPSetUp(pb->ksp[i]));
-      if (pb->Ablock[i]) PetscCall(PhlexMGCopiesApply(pb->ksp[i], PETSC_TRUE, PETSC_FALSE, &pb->mgc[i]));
+      if (pb->Ablock[i].copy) PetscCall(PhlexMGCopiesApply(pb->ksp[i], PETSC_TRUE, PETSC_FALSE, &pb->mgc[i]));
       if (pb->Y[i]) {
         Mat Wl = bd->W[i], Yl = pb->Y[i];
         if (mine) {
@@ -706,8 +690,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < pb->nb; i++) {
     PetscCall(KSPDestroy(&pb->ksp[i]));
-    PetscCall(MatDestroy(&pb->Ablock[i]));
-    PetscCall(MatDestroy(&pb->Ablock_src[i]));
+    PetscCall(PhlexBlockCopyDestroy(&pb->Ablock[i]));
     PetscCall(PhlexMGCopiesDestroy(&pb->mgc[i]));
     PetscCall(MatDestroy(&pb->Y[i]));
     PetscCall(PetscFree(pb->beta[i]));
@@ -722,7 +705,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscCall(PetscFree(pb->is));
   PetscCall(PetscFree(pb->lu_package));
   PetscCall(PetscFree(pb->block_pc));
-  PetscCall(PetscFree5(pb->block_products, pb->Ablock, pb->Ablock_src, pb->Ablock_nz, pb->mgc));
+  PetscCall(PetscFree3(pb->block_products, pb->Ablock, pb->mgc));
   PetscCall(PetscFree5(pb->block_cg, pb->block_check, pb->bcg_its, pb->bcg_colits, pb->seq_its));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
   PetscCall(BorderedCopiesFree(pb));
@@ -746,7 +729,7 @@ static PetscErrorCode BlockProductsView(PC_Bordered *pb, PetscInt i, PetscViewer
 
   PetscFunctionBeginUser;
   if (!pb->block_products[i]) PetscFunctionReturn(0);
-  PetscCall(PetscViewerASCIIPrintf(viewer, "  its products with the operator: %s\n", pb->Ablock[i] ? "its node-block copy" : "itself"));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  its products with the operator: %s\n", pb->Ablock[i].copy ? "its node-block copy" : "itself"));
   if (n[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "  its multigrid: of %" PetscInt_FMT " transfers %" PetscInt_FMT " by node-block copies; of %" PetscInt_FMT " smoothed coarse levels %" PetscInt_FMT " by node-block copies\n", n[0], n[1], n[3], n[4]));
   PetscFunctionReturn(0);
 }

@@ -54,9 +54,8 @@ typedef struct {
   PetscBool   explicit_restrict; /* multigrid's restrictions by stored transposes of its interpolations (those without a block copy) */
   PetscBool   block_symmetric; /* the block copy as its upper triangle (SBAIJ) */
   PhlexMGCopies mg;        /* multigrid's transfers and coarse operators as block copies (mg_level_products.c) */
-  Mat         Ablock;      /* the node-block copy of the operator (NULL: the products use the operator itself) */
+  PhlexBlockCopy Ablock;   /* the node-block copy of the operator (copy NULL: the products use the operator itself) */
   PetscObjectState svstate;   /* the state of the operator the copy was taken from */
-  PetscObjectState svnzstate; /* and of its nonzero pattern */
 } SNES_Condensed;
 
 /* why a scene or an integrator cannot use the condensed stage (empty: it can) */
@@ -353,24 +352,16 @@ static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
 {
   PetscBool        preonly;
   PetscInt         bs;
-  PetscObjectState nzstate;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectTypeCompare((PetscObject)c->ksp, KSPPREONLY, &preonly));
   PetscCall(MatGetBlockSize(Sv, &bs));
-  PetscCall(MatGetNonzeroState(Sv, &nzstate));
-  if (c->Ablock && nzstate != c->svnzstate) PetscCall(MatDestroy(&c->Ablock));
   if (c->block_products && !preonly && bs > 1) {
-    if (c->Ablock) PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, MAT_REUSE_MATRIX, &c->Ablock));
-    else {
-      PetscCall(PhlexMatBlockCopy(Sv, c->block_symmetric, MAT_INITIAL_MATRIX, &c->Ablock));
-      if (!c->Ablock) PetscCall(PetscInfo(c->ksp, "the condensed operator is not in whole %" PetscInt_FMT " x %" PetscInt_FMT " blocks: its products use it as it is\n", bs, bs));
-    }
-    if (c->Ablock) PetscCall(MatSetOption(c->Ablock, MAT_SYMMETRIC, PETSC_TRUE)); /* after each fill: an assembly forgets it (MPIBAIJ takes no MAT_SPD in 3.18) */
-    c->svnzstate = nzstate;
-  }
+    PetscCall(PhlexBlockCopyUpdate(&c->Ablock, Sv, c->block_symmetric));
+    if (!c->Ablock.copy) PetscCall(PetscInfo(c->ksp, "the condensed operator is not in whole %" PetscInt_FMT " x %" PetscInt_FMT " blocks: its products use it as it is\n", bs, bs));
+  } else PetscCall(PhlexBlockCopyDestroy(&c->Ablock));
   PetscCall(PhlexMGCopiesRestore(c->ksp, &c->mg)); /* GAMG's interpolations back for its set-up */
-  PetscCall(KSPSetOperators(c->ksp, c->Ablock ? c->Ablock : Sv, Sv));
+  PetscCall(KSPSetOperators(c->ksp, c->Ablock.copy ? c->Ablock.copy : Sv, Sv));
   if (!preonly) PetscCall(PhlexMGCopiesApply(c->ksp, c->block_levels, c->explicit_restrict, &c->mg));
   PetscCall(PetscObjectStateGet((PetscObject)Sv, &c->svstate)); /* after the set-up (it may mark Sv) */
   PetscFunctionReturn(0);
@@ -409,7 +400,7 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscCall(SetOperators(c, Sv));
     c->shift = s;
     c->nhist = 0; /* the increments scale with the step: the guess starts again */
-  } else if (c->Ablock || c->block_levels || c->explicit_restrict) {
+  } else if (c->Ablock.copy || c->block_levels || c->explicit_restrict) {
     Mat              Sv;
     PetscObjectState state;
     PetscCall(KSPGetOperators(c->ksp, NULL, &Sv));
@@ -483,7 +474,7 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   for (PetscInt j = 0; j < 3; j++) PetscCall(VecDestroy(&c->dv[j]));
   PetscCall(VecDestroy(&c->p));
   PetscCall(VecDestroy(&c->Ap));
-  PetscCall(MatDestroy(&c->Ablock));
+  PetscCall(PhlexBlockCopyDestroy(&c->Ablock));
   PetscCall(PhlexMGCopiesDestroy(&c->mg));
   c->nhist = 0;
   c->shift = 0.0;
@@ -533,7 +524,7 @@ static PetscErrorCode SNESView_Condensed(SNES snes, PetscViewer viewer)
   if (c->ksp) {
     PetscBool preonly;
     PetscCall(PetscObjectTypeCompare((PetscObject)c->ksp, KSPPREONLY, &preonly));
-    if (!preonly) PetscCall(PetscViewerASCIIPrintf(viewer, "  products with the operator: %s\n", c->Ablock ? "its node-block copy" : "itself"));
+    if (!preonly) PetscCall(PetscViewerASCIIPrintf(viewer, "  products with the operator: %s\n", c->Ablock.copy ? "its node-block copy" : "itself"));
     if (c->mg.count[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "  multigrid: of %" PetscInt_FMT " transfers %" PetscInt_FMT " by node-block copies, %" PetscInt_FMT " restricting by stored transposes; of %" PetscInt_FMT " smoothed coarse levels %" PetscInt_FMT " by node-block copies\n", c->mg.count[0], c->mg.count[1], c->mg.count[2], c->mg.count[3], c->mg.count[4]));
   }
   if (c->ksp) {

@@ -63,7 +63,7 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
   if (nlevels != m->nlevels) { /* a new hierarchy: the copies of the old one's go */
     PetscCall(PhlexMGCopiesDestroy(m));
     m->nlevels = nlevels;
-    PetscCall(PetscCalloc5(nlevels, &m->P, nlevels, &m->Pb, nlevels, &m->A, nlevels, &m->Ab, nlevels, &m->Anz));
+    PetscCall(PetscCalloc2(nlevels, &m->P, nlevels, &m->A));
   }
   m->count[0] = nlevels - 1;
   m->count[3] = PetscMax(nlevels - 2, 0);
@@ -74,19 +74,14 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
     /* the transfer between levels l - 1 and l: a block copy of P in both roles (the same copy while P is the same) */
     PetscCall(PCMGGetInterpolation(pc, l, &P));
     PetscCall(PCMGGetRestriction(pc, l, &R));
-    if (P != m->P[l] && !(m->Pb[l] && P == m->Pb[l])) { /* (P == Pb: applied before, no set-up since) */
-      PetscCall(MatDestroy(&m->P[l]));
-      PetscCall(MatDestroy(&m->Pb[l]));
+    if (P != m->P[l].copy) { /* (P the copy: applied before, no set-up since) */
       PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)P, &aij, MATSEQAIJ, MATMPIAIJ, ""));
-      if (aij && blocks) PetscCall(PhlexMatBlockCopy(P, PETSC_FALSE, MAT_INITIAL_MATRIX, &m->Pb[l]));
-      if (m->Pb[l]) {
-        PetscCall(PetscObjectReference((PetscObject)P));
-        m->P[l] = P;
-      }
+      if (aij && blocks) PetscCall(PhlexBlockCopyUpdate(&m->P[l], P, PETSC_FALSE));
+      else PetscCall(PhlexBlockCopyDestroy(&m->P[l]));
     }
-    if (m->Pb[l]) {
-      PetscCall(PCMGSetInterpolation(pc, l, m->Pb[l]));
-      PetscCall(PCMGSetRestriction(pc, l, m->Pb[l]));
+    if (m->P[l].copy) {
+      PetscCall(PCMGSetInterpolation(pc, l, m->P[l].copy));
+      PetscCall(PCMGSetRestriction(pc, l, m->P[l].copy));
       m->count[1]++;
     } else if (transposes && R == P) {
       PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)P, &aij, MATSEQAIJ, MATMPIAIJ, ""));
@@ -99,31 +94,22 @@ PetscErrorCode PhlexMGCopiesApply(KSP ksp, PetscBool blocks, PetscBool transpose
     } else if (R != P) m->count[2]++; /* a stored transpose from an earlier set-up, kept by GAMG with P */
     /* level l's smoothing and residual (the finest level's operator is the KSP's own) */
     if (blocks && l < nlevels - 1) {
-      KSP              smoother;
-      Mat              A, B;
-      PetscObjectState nz;
+      KSP smoother;
+      Mat B;
       PetscCall(PCMGGetSmoother(pc, l, &smoother));
-      PetscCall(KSPGetOperators(smoother, &A, &B));
+      PetscCall(KSPGetOperators(smoother, NULL, &B));
       PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)B, &aij, MATSEQAIJ, MATMPIAIJ, ""));
       if (!aij) continue;
-      PetscCall(MatGetNonzeroState(B, &nz));
-      if (B != m->A[l] || nz != m->Anz[l]) { /* a new operator or pattern: a new copy */
-        PetscCall(MatDestroy(&m->Ab[l]));
-        PetscCall(MatDestroy(&m->A[l]));
-        PetscCall(PhlexMatBlockCopy(B, PETSC_FALSE, MAT_INITIAL_MATRIX, &m->Ab[l]));
-        PetscCall(PetscObjectReference((PetscObject)B));
-        m->A[l]   = B;
-        m->Anz[l] = nz;
-      } else if (A != m->Ab[l] && m->Ab[l]) PetscCall(PhlexMatBlockCopy(B, PETSC_FALSE, MAT_REUSE_MATRIX, &m->Ab[l])); /* GAMG formed it again in place */
-      if (!m->Ab[l]) continue;
-      PetscCall(KSPSetOperators(smoother, m->Ab[l], B));
+      PetscCall(PhlexBlockCopyUpdate(&m->A[l], B, PETSC_FALSE)); /* refilled when GAMG formed B again in place */
+      if (!m->A[l].copy) continue;
+      PetscCall(KSPSetOperators(smoother, m->A[l].copy, B));
       PetscCall(DistinctSmoothUp(pc, l, &distinct));
       if (distinct) {
         KSP up;
         PetscCall(PCMGGetSmootherUp(pc, l, &up));
-        PetscCall(KSPSetOperators(up, m->Ab[l], B));
+        PetscCall(KSPSetOperators(up, m->A[l].copy, B));
       }
-      PetscCall(PCMGSetResidual(pc, l, PCMGResidualDefault, m->Ab[l]));
+      PetscCall(PCMGSetResidual(pc, l, PCMGResidualDefault, m->A[l].copy));
       m->count[4]++;
     }
   }
@@ -151,9 +137,9 @@ PetscErrorCode PhlexMGCopiesRestore(KSP ksp, PhlexMGCopies *m)
   for (PetscInt l = 1; l < nlevels; l++) {
     Mat P;
     PetscCall(PCMGGetInterpolation(pc, l, &P));
-    if (!m->Pb[l] || P != m->Pb[l]) continue;
-    PetscCall(PCMGSetInterpolation(pc, l, m->P[l]));
-    PetscCall(PCMGSetRestriction(pc, l, m->P[l]));
+    if (!m->P[l].copy || P != m->P[l].copy) continue;
+    PetscCall(PCMGSetInterpolation(pc, l, m->P[l].src));
+    PetscCall(PCMGSetRestriction(pc, l, m->P[l].src));
   }
   PetscFunctionReturn(0);
 }
@@ -168,12 +154,10 @@ PetscErrorCode PhlexMGCopiesDestroy(PhlexMGCopies *m)
 {
   PetscFunctionBeginUser;
   for (PetscInt l = 0; l < m->nlevels; l++) {
-    PetscCall(MatDestroy(&m->P[l]));
-    PetscCall(MatDestroy(&m->Pb[l]));
-    PetscCall(MatDestroy(&m->A[l]));
-    PetscCall(MatDestroy(&m->Ab[l]));
+    PetscCall(PhlexBlockCopyDestroy(&m->P[l]));
+    PetscCall(PhlexBlockCopyDestroy(&m->A[l]));
   }
-  PetscCall(PetscFree5(m->P, m->Pb, m->A, m->Ab, m->Anz));
+  PetscCall(PetscFree2(m->P, m->A));
   m->nlevels = 0;
   PetscCall(PetscArrayzero(m->count, 5));
   PetscFunctionReturn(0);
