@@ -38,7 +38,7 @@ typedef struct {
 
 /* log.c */
 PETSC_EXTERN PetscClassId  PHLEX_CLASSID;
-PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult, PHLEX_MatMultBlock, PHLEX_StressMaps, PHLEX_BlockCG, PHLEX_MatBlockCopy;
+PETSC_EXTERN PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult, PHLEX_MatMultBlock, PHLEX_StressMaps, PHLEX_BlockCG, PHLEX_MatBlockCopy, PHLEX_PMGCoarse;
 PETSC_EXTERN PetscLogStage PHLEX_StageSetup, PHLEX_StageTransient, PHLEX_StageModes;
 PETSC_EXTERN PetscErrorCode PhlexLogRegister(void);
 PETSC_EXTERN PetscErrorCode PhlexLogStagePush(const char[], PetscLogStage *);

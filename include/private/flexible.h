@@ -341,6 +341,8 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleRestoreBasis(PhlexElementBasis *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleDestroyFE(PhlexFlexible);
 PETSC_INTERN PetscErrorCode PhlexFlexiblePlacement(PhlexFlexible, uint64_t *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleSetUpLocalDofs(PhlexFlexible);
+/* flexible_p1.c: the P1 coarse space of p-multigrid */
+PETSC_INTERN PetscErrorCode PhlexFlexibleCoarseSpace(PhlexFlexible, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]);
 
 /* flexible_stress_maps.c: B = Ms^{-1} G, G^T and K cell by cell, a linear stage's fused stress passes, the strain energy */
 PETSC_INTERN PetscErrorCode PhlexFlexibleCreateStressMaps(PhlexFlexible);

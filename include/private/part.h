@@ -177,6 +177,7 @@ typedef struct {
   PetscErrorCode (*bordercoefficients)(PhlexPart, PetscReal *, PetscInt);        /* beta: own border columns ~ W beta (k x nq, ld) */
   PetscErrorCode (*portlinearblock)(PhlexPart, PetscInt, Mat, PetscReal, PetscReal *); /* dy for dv = columns of Y, du = Y/shift: 6 x k */
   PetscErrorCode (*portbasiscolumn)(PhlexPart, PetscInt, PetscInt *);                  /* first of the 6 columns of W spanning its field force */
+  PetscErrorCode (*coarsespace)(PhlexPart, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]); /* p-multigrid (pmg.c): its rows of the interpolation from its coarse space (PhlexFlexibleCoarseSpace's arguments); NULL: its unknowns carried to the coarse level */
 } PhlexPartFieldOps;
 
 /* The analysis table: what the modal and linearised analyses ask of a body beyond the core (its own eigenproblem,

@@ -27,6 +27,7 @@ typedef struct {
   PetscErrorCode (*rowsvec)(void *, PetscInt, Vec, PetscReal *);    /* y += C_i x (m values) */
   PetscErrorCode (*blockprefix)(void *, PetscInt, const char **);  /* name used in the options of block i */
   PetscErrorCode (*blockoptions)(void *, PetscInt, const char **); /* options prefix of block i's body (body<k>_) */
+  PetscErrorCode (*coarsespace)(void *, PetscInt, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]); /* block i's coarse space for p-multigrid (PhlexCoarseSpaceFn) */
 } PhlexBorderedData;
 
 typedef struct _p_PhlexSystem *PhlexSystem;
@@ -121,6 +122,23 @@ PETSC_INTERN PetscErrorCode PhlexPCBorderedHelp(PC, PetscInt, const char *const[
 PETSC_INTERN PetscErrorCode PhlexBlockCGApplies(KSP, PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexBlockCG(KSP, Mat, Mat, PetscBool, PetscBool, const char[], PetscInt *, PetscInt *);
 PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
+/* pmg.c: p-multigrid (PCMG) with the bodies' P1 coarse space under an iterative solve with the velocity operator */
+typedef struct {
+  Mat              P;     /* the interpolation from the coarse unknowns (AIJ; built once) */
+  Mat              Ac;    /* the coarse operator P^T A P, with the rigid modes as near-null space */
+  Mat              A;     /* the operator it was formed from (not referenced: the system's) */
+  PetscObjectState state, nz; /* A's state and nonzero state at the last product */
+  PetscInt         nc;    /* local coarse unknowns */
+  PetscInt        *inj;   /* per local coarse unknown: its local fine row */
+} PhlexPMG;
+typedef PetscErrorCode (*PhlexCoarseSpaceFn)(void *, PetscInt, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]);
+PETSC_INTERN PetscErrorCode PhlexPMGWanted(KSP, PetscBool *);
+PETSC_INTERN PetscErrorCode PhlexPMGBuild(KSP, MPI_Comm, PetscInt, PetscInt, PetscInt, PetscInt, const PetscInt[], const PetscInt[], PhlexCoarseSpaceFn, void *, PhlexPMG *);
+PETSC_INTERN PetscErrorCode PhlexPMGSetUp(KSP, Mat, PhlexPMG *);
+/* border.c: block i's coarse space (a part's own, or its unknowns carried): a PhlexCoarseSpaceFn on the system */
+PETSC_INTERN PetscErrorCode PhlexSystemCoarseSpace(void *, PetscInt, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]);
+PETSC_INTERN PetscErrorCode PhlexPMGView(PhlexPMG *, PetscViewer);
+PETSC_INTERN PetscErrorCode PhlexPMGDestroy(PhlexPMG *);
 /* snes_condensed.c: SNES phlexcondensed, the theta-method stage of fixed linear bodies by exact elimination */
 PETSC_INTERN PetscErrorCode PhlexSNESRegister(void);
 PETSC_INTERN PetscErrorCode PhlexSNESCondensedApplicable(PhlexSystem, TS, PetscBool *);

@@ -1200,6 +1200,13 @@ static PetscErrorCode FlexBorderMultTransposeLocal(PhlexPart part, Vec xu, Petsc
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode FlexCoarseSpace(PhlexPart part, PetscInt row0, PetscInt col0, Mat P, PetscInt *n1, PetscInt inj[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PhlexFlexibleCoarseSpace((PhlexFlexible)part->data, row0, col0, P, n1, inj));
+  PetscFunctionReturn(0);
+}
+
 /* W: the state-independent span of the borders: the frame's 12 nodal fields t e_c and w_b e_c (floating; with constant_without_gyroscopic
    inertia every frame border lies in their span, gravity too) and the force distributions of the ports with joints */
 static PetscErrorCode FlexBorderBasis(PhlexPart part, Mat *W)
@@ -1361,6 +1368,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSetDynamicsOps(PhlexPart part)
   part->fieldops->portlinearsummed         = FlexPortLinearSummed;
   part->fieldops->portlinearblock          = FlexPortLinearBlock;
   part->fieldops->portbasiscolumn          = FlexPortBasisColumn;
+  part->fieldops->coarsespace              = FlexCoarseSpace;
   PetscFunctionReturn(0);
 }
 

@@ -242,6 +242,31 @@ static PetscErrorCode BlockOptions(void *ctx, PetscInt i, const char **prefix)
 }
 
 /*@C
+  PhlexSystemCoarseSpace - block i's rows of p-multigrid's interpolation (pmg.c, a PhlexCoarseSpaceFn on the system):
+  its part's own coarse space, or its unknowns carried to the coarse level unchanged (a part without one)
+
+  Collective on the part (every process calls it, with P or without)
+@*/
+PetscErrorCode PhlexSystemCoarseSpace(void *ctx, PetscInt i, PetscInt row0, PetscInt col0, Mat P, PetscInt *n1, PetscInt inj[])
+{
+  PhlexSystem sys = (PhlexSystem)ctx;
+  PhlexPart   p   = sys->fparts[i];
+
+  PetscFunctionBeginUser;
+  if (p->fieldops->coarsespace) {
+    PetscCall((*p->fieldops->coarsespace)(p, row0, col0, P, n1, inj));
+    PetscFunctionReturn(0);
+  }
+  *n1 = sys->border.n[i];
+  if (!P) PetscFunctionReturn(0);
+  for (PetscInt j = 0; j < *n1; j++) {
+    PetscCall(MatSetValue(P, row0 + j, col0 + j, 1.0, INSERT_VALUES));
+    if (inj) inj[j] = j;
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexSystemSetUpBorder - the data of PC phlexbordered: the sparse blocks (condensed velocity operators), their
   border bases, the dense discrete block and the callbacks
 
@@ -262,6 +287,7 @@ PetscErrorCode PhlexSystemSetUpBorder(PhlexSystem sys)
   bd->rowsvec      = BorderRowsVec;
   bd->blockprefix  = BlockPrefix;
   bd->blockoptions = BlockOptions;
+  bd->coarsespace  = PhlexSystemCoarseSpace;
   PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &bd->A));
   PetscCall(PetscCalloc1(PetscMax(sys->nfparts, 1), &bd->W));
   PetscCall(PetscCalloc2(PetscMax(sys->nfparts, 1), &bd->off, PetscMax(sys->nfparts, 1), &bd->n));

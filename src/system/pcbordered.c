@@ -48,6 +48,7 @@ typedef struct {
   PetscBool         *block_products; /* per block: -<prefix>bordered_[<body>_]block_products, an iterative solve's products by node-block copies */
   PhlexBlockCopy    *Ablock;  /* per block: the node-block (BAIJ) copy of its operator */
   PhlexMGCopies     *mgc;     /* per block: its multigrid's transfers and coarse levels as block copies */
+  PhlexPMG          *pmg;     /* per block: p-multigrid's interpolation and coarse operator (pmg.c), where its PC is PCMG */
   PetscInt           nfactor;
   PetscInt           ncopy;  /* common options copied to the bodies' prefixes (BorderedCopyCommonOptions) */
   char             **copy_from, **copy_to;
@@ -300,7 +301,7 @@ static PetscErrorCode BorderedSetUpBlocks(PC pc, PC_Bordered *pb)
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->is));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->lu_package));
   PetscCall(PetscCalloc1(PetscMax(pb->nb, 1), &pb->block_pc));
-  PetscCall(PetscCalloc3(PetscMax(pb->nb, 1), &pb->block_products, PetscMax(pb->nb, 1), &pb->Ablock, PetscMax(pb->nb, 1), &pb->mgc));
+  PetscCall(PetscCalloc4(PetscMax(pb->nb, 1), &pb->block_products, PetscMax(pb->nb, 1), &pb->Ablock, PetscMax(pb->nb, 1), &pb->mgc, PetscMax(pb->nb, 1), &pb->pmg));
   PetscCall(PetscCalloc5(PetscMax(pb->nb, 1), &pb->block_cg, PetscMax(pb->nb, 1), &pb->block_check, PetscMax(pb->nb, 1), &pb->bcg_its, PetscMax(pb->nb, 1), &pb->bcg_colits, PetscMax(pb->nb, 1), &pb->seq_its));
   PetscCall(PetscCalloc4(PetscMax(pb->nb, 1), &pb->owner, PetscMax(pb->nb, 1), &pb->Aseq, PetscMax(pb->nb, 1), &pb->fseq, PetscMax(pb->nb, 1), &pb->xseq));
   PetscCall(BorderedOwners(pc, pb));
@@ -523,6 +524,19 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
     pb->Astate[i] = sa;
     pb->Wstate[i] = sw;
     pb->nfactor++;
+    {
+      /* p-multigrid's interpolation, once: collective on the body (a body whole on one process: every process takes
+         part, the owner's the rows) */
+      PetscBool pmg;
+      PetscCall(PhlexPMGWanted(pb->ksp[i], &pmg));
+      if (pmg && bd->coarsespace && !pb->pmg[i].P) {
+        PetscInt m, rstart = 0, bs, off = 0;
+        PetscCall(MatGetLocalSize(bd->A[i], &m, NULL));
+        if (pb->owner[i] < 0) PetscCall(MatGetOwnershipRange(bd->A[i], &rstart, NULL));
+        PetscCall(MatGetBlockSize(bd->A[i], &bs));
+        PetscCall(PhlexPMGBuild(pb->ksp[i], pb->owner[i] < 0 ? PetscObjectComm((PetscObject)pc) : PETSC_COMM_SELF, m, rstart, bs, 1, &i, &off, bd->coarsespace, bd->ctx, &pb->pmg[i]));
+      }
+    }
   }
   for (PetscInt pass = 0; pass < 2; pass++)
     for (PetscInt i = 0; i < pb->nb; i++) {
@@ -537,8 +551,9 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
       if (mine) PetscCall(BlockSequentialOperator(pb, i, bd->A[i], Achanged[i]));
       else PetscCall(KSPSetOperators(pb->ksp[i], bd->A[i], bd->A[i]));
       PetscCall(BlockProductsBefore(pb, i));
+      if (pb->pmg[i].P) PetscCall(PhlexPMGSetUp(pb->ksp[i], mine ? pb->Aseq[i] : bd->A[i], &pb->pmg[i]));
       PetscCall(KSPSetUp(pb->ksp[i]));
-      if (pb->Ablock[i].copy) PetscCall(PhlexMGCopiesApply(pb->ksp[i], PETSC_TRUE, PETSC_FALSE, &pb->mgc[i]));
+      if (pb->Ablock[i].copy) PetscCall(PhlexMGCopiesApply(pb->ksp[i], PETSC_TRUE, PETSC_TRUE, &pb->mgc[i]));
       if (pb->Y[i]) {
         Mat Wl = bd->W[i], Yl = pb->Y[i];
         if (mine) {
@@ -692,6 +707,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
     PetscCall(KSPDestroy(&pb->ksp[i]));
     PetscCall(PhlexBlockCopyDestroy(&pb->Ablock[i]));
     PetscCall(PhlexMGCopiesDestroy(&pb->mgc[i]));
+    PetscCall(PhlexPMGDestroy(&pb->pmg[i]));
     PetscCall(MatDestroy(&pb->Y[i]));
     PetscCall(PetscFree(pb->beta[i]));
     PetscCall(ISDestroy(&pb->is[i]));
@@ -705,7 +721,7 @@ static PetscErrorCode PCReset_Bordered(PC pc)
   PetscCall(PetscFree(pb->is));
   PetscCall(PetscFree(pb->lu_package));
   PetscCall(PetscFree(pb->block_pc));
-  PetscCall(PetscFree3(pb->block_products, pb->Ablock, pb->mgc));
+  PetscCall(PetscFree4(pb->block_products, pb->Ablock, pb->mgc, pb->pmg));
   PetscCall(PetscFree5(pb->block_cg, pb->block_check, pb->bcg_its, pb->bcg_colits, pb->seq_its));
   PetscCall(PetscFree2(pb->S, pb->S_piv));
   PetscCall(BorderedCopiesFree(pb));
@@ -728,9 +744,10 @@ static PetscErrorCode BlockProductsView(PC_Bordered *pb, PetscInt i, PetscViewer
   const PetscInt *n = pb->mgc[i].count;
 
   PetscFunctionBeginUser;
+  PetscCall(PhlexPMGView(&pb->pmg[i], viewer));
   if (!pb->block_products[i]) PetscFunctionReturn(0);
   PetscCall(PetscViewerASCIIPrintf(viewer, "  its products with the operator: %s\n", pb->Ablock[i].copy ? "its node-block copy" : "itself"));
-  if (n[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "  its multigrid: of %" PetscInt_FMT " transfers %" PetscInt_FMT " by node-block copies; of %" PetscInt_FMT " smoothed coarse levels %" PetscInt_FMT " by node-block copies\n", n[0], n[1], n[3], n[4]));
+  if (n[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "  its multigrid: of %" PetscInt_FMT " transfers %" PetscInt_FMT " by node-block copies, %" PetscInt_FMT " restricting by stored transposes; of %" PetscInt_FMT " smoothed coarse levels %" PetscInt_FMT " by node-block copies\n", n[0], n[1], n[2], n[3], n[4]));
   PetscFunctionReturn(0);
 }
 

@@ -53,6 +53,7 @@ typedef struct {
   PetscBool   block_levels;     /* multigrid's transfers and coarse operators by node-block copies (mg_level_products.c) */
   PetscBool   explicit_restrict; /* multigrid's restrictions by stored transposes of its interpolations (those without a block copy) */
   PetscBool   block_symmetric; /* the block copy as its upper triangle (SBAIJ) */
+  PhlexPMG    pmg;         /* p-multigrid's interpolation and coarse operator (pmg.c), where the PC is PCMG */
   PhlexMGCopies mg;        /* multigrid's transfers and coarse operators as block copies (mg_level_products.c) */
   PhlexBlockCopy Ablock;   /* the node-block copy of the operator (copy NULL: the products use the operator itself) */
   PetscObjectState svstate;   /* the state of the operator the copy was taken from */
@@ -362,6 +363,21 @@ static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
   } else PetscCall(PhlexBlockCopyDestroy(&c->Ablock));
   PetscCall(PhlexMGCopiesRestore(c->ksp, &c->mg)); /* GAMG's interpolations back for its set-up */
   PetscCall(KSPSetOperators(c->ksp, c->Ablock.copy ? c->Ablock.copy : Sv, Sv));
+  if (!preonly) {
+    PetscBool pmg;
+    PetscCall(PhlexPMGWanted(c->ksp, &pmg));
+    if (pmg) {
+      PetscInt rstart, m, bs, *blocks;
+      PetscCall(MatGetOwnershipRange(Sv, &rstart, NULL));
+      PetscCall(MatGetLocalSize(Sv, &m, NULL));
+      PetscCall(MatGetBlockSize(Sv, &bs));
+      PetscCall(PetscMalloc1(PetscMax(c->sys->nfparts, 1), &blocks));
+      for (PetscInt i = 0; i < c->sys->nfparts; i++) blocks[i] = i;
+      PetscCall(PhlexPMGBuild(c->ksp, c->sys->comm, m, rstart, bs, c->sys->nfparts, blocks, c->sys->border.off, PhlexSystemCoarseSpace, c->sys, &c->pmg));
+      PetscCall(PetscFree(blocks));
+      PetscCall(PhlexPMGSetUp(c->ksp, Sv, &c->pmg));
+    }
+  }
   if (!preonly) PetscCall(PhlexMGCopiesApply(c->ksp, c->block_levels, c->explicit_restrict, &c->mg));
   PetscCall(PetscObjectStateGet((PetscObject)Sv, &c->svstate)); /* after the set-up (it may mark Sv) */
   PetscFunctionReturn(0);
@@ -476,6 +492,7 @@ static PetscErrorCode SNESReset_Condensed(SNES snes)
   PetscCall(VecDestroy(&c->Ap));
   PetscCall(PhlexBlockCopyDestroy(&c->Ablock));
   PetscCall(PhlexMGCopiesDestroy(&c->mg));
+  PetscCall(PhlexPMGDestroy(&c->pmg));
   c->nhist = 0;
   c->shift = 0.0;
   PetscFunctionReturn(0);
@@ -525,6 +542,7 @@ static PetscErrorCode SNESView_Condensed(SNES snes, PetscViewer viewer)
     PetscBool preonly;
     PetscCall(PetscObjectTypeCompare((PetscObject)c->ksp, KSPPREONLY, &preonly));
     if (!preonly) PetscCall(PetscViewerASCIIPrintf(viewer, "  products with the operator: %s\n", c->Ablock.copy ? "its node-block copy" : "itself"));
+    PetscCall(PhlexPMGView(&c->pmg, viewer));
     if (c->mg.count[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "  multigrid: of %" PetscInt_FMT " transfers %" PetscInt_FMT " by node-block copies, %" PetscInt_FMT " restricting by stored transposes; of %" PetscInt_FMT " smoothed coarse levels %" PetscInt_FMT " by node-block copies\n", c->mg.count[0], c->mg.count[1], c->mg.count[2], c->mg.count[3], c->mg.count[4]));
   }
   if (c->ksp) {

@@ -2,7 +2,7 @@
 #include <phlex.h>
 
 PetscClassId  PHLEX_CLASSID;
-PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult, PHLEX_MatMultBlock, PHLEX_StressMaps, PHLEX_BlockCG, PHLEX_MatBlockCopy;
+PetscLogEvent PHLEX_BodySetUp, PHLEX_BodyAssemble, PHLEX_SysIFunction, PHLEX_SysIJacobian, PHLEX_MonitorEnergy, PHLEX_ModesSolve, PHLEX_Output, PHLEX_PortDist, PHLEX_FloatResidual, PHLEX_FloatJacobian, PHLEX_BorderedBasis, PHLEX_BorderedSetUp, PHLEX_JointResidual, PHLEX_JointJacobian, PHLEX_Assembly, PHLEX_CondensedStage, PHLEX_CondensedSetUp, PHLEX_ReducedStage, PHLEX_ReducedSetUp, PHLEX_ReducedJacobianMult, PHLEX_MatMultBlock, PHLEX_StressMaps, PHLEX_BlockCG, PHLEX_MatBlockCopy, PHLEX_PMGCoarse;
 PetscLogStage PHLEX_StageSetup = -1, PHLEX_StageTransient = -1, PHLEX_StageModes = -1;
 
 /*@C
@@ -34,6 +34,7 @@ PetscErrorCode PhlexLogRegister(void)
   PetscCall(PetscLogEventRegister("PhlexBordBasis", PHLEX_CLASSID, &PHLEX_BorderedBasis));
   PetscCall(PetscLogEventRegister("PhlexBordSetUp", PHLEX_CLASSID, &PHLEX_BorderedSetUp));
   PetscCall(PetscLogEventRegister("PhlexBlockCG", PHLEX_CLASSID, &PHLEX_BlockCG));
+  PetscCall(PetscLogEventRegister("PhlexPMGCoarse", PHLEX_CLASSID, &PHLEX_PMGCoarse));
   PetscCall(PetscLogEventRegister("PhlexMatBlkCopy", PHLEX_CLASSID, &PHLEX_MatBlockCopy));
   PetscCall(PetscLogEventRegister("PhlexJointResid", PHLEX_CLASSID, &PHLEX_JointResidual));
   PetscCall(PetscLogEventRegister("PhlexJointJac", PHLEX_CLASSID, &PHLEX_JointJacobian));

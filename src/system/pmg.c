@@ -1,0 +1,222 @@
+/* p-multigrid for an iterative solve with the condensed velocity operator A = shift Mv + K/shift (issue 44 item 1):
+   PCMG (-<prefix>pc_type mg) with two levels, the bodies' P2 velocities and their P1 coarse space
+   (PhlexFlexibleCoarseSpace: P exact, P^T A P the P1 discretisation of the same operator), below which the coarse
+   solver (-<prefix>mg_coarse_ksp_type, _pc_type: GAMG, or a factorization of the P1 problem) takes over. Against GAMG
+   on the P2 operator: its Galerkin product, the most of its set-up (BENCHMARKS.md section 44), is here one with an
+   interpolation of one or two entries per row, and the transfers of each cycle read those few entries.
+   The coarse operator carries the bodies' rigid-body modes (the fine operator's near-null space at the vertices,
+   exact in P1) for a GAMG below. It is formed again, in place, when the fine operator's values change. */
+#include <phlex_impl.h>
+#include <petsc/private/petscimpl.h> /* PetscObjectStateGet: whether the operator changed since the coarse product */
+
+/*@C
+  PhlexPMGBuild - for ksp's PCMG: two levels, and the interpolation from the coarse unknowns of the blocks of an operator's rows (each block's own
+  coarse space, from fn), and per local coarse unknown its local fine row; once (kept until PhlexPMGDestroy)
+
+  Collective on the bodies (fn's): every process of the system calls it, also where the operator is another
+  process's (a body whole on one process: comm PETSC_COMM_SELF, no rows here)
+
+  Input Parameters:
++ ksp     - the KSP (its PC: PCMG, PhlexPMGWanted)
+. comm    - the operator's (and the interpolation's) communicator
+. m       - the operator's local rows
+. rstart  - the operator's first local row (global)
+. bs      - the operator's block size (the interpolation takes 3 x 3 blocks where every block's rows and coarse
+            unknowns come in threes)
+. nblocks - the blocks of rows
+. blocks  - their indices for fn
+. off     - their first local rows
+- fn, ctx - a block's coarse space: fn(ctx, block, row0, col0, P, &n1, inj), P NULL to count (PhlexFlexibleCoarseSpace)
+@*/
+PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart, PetscInt bs, PetscInt nblocks, const PetscInt blocks[], const PetscInt off[], PhlexCoarseSpaceFn fn, void *ctx, PhlexPMG *pm)
+{
+  PetscInt    nc = 0, col0 = 0, *n1;
+  PetscBool   threes = (PetscBool)(m % 3 == 0);
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  if (pm->P) PetscFunctionReturn(0);
+  {
+    /* two levels, the coarse operator formed here; the levels' options read now, also where the KSP is another
+       process's (a body whole on one process: PCMG reads them at its first set-up, which only the owner makes) */
+    PC       pc;
+    PetscInt nlevels;
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PCMGGetLevels(pc, &nlevels));
+    if (nlevels != 2) {
+      const char *prefix;
+      PetscCall(PCGetOptionsPrefix(pc, &prefix));
+      PetscCheck(nlevels <= 1, PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "-%spc_mg_levels %" PetscInt_FMT ": phlex's p-multigrid has two levels, the P2 velocities and their P1 space; a coarser hierarchy comes from the coarse solver (-%smg_coarse_pc_type gamg)", prefix ? prefix : "", nlevels, prefix ? prefix : "");
+      PetscCall(PCMGSetLevels(pc, 2, NULL));
+    }
+    PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_NONE));
+    for (PetscInt l = 0; l < 2; l++) {
+      KSP smoother;
+      PetscCall(PCMGGetSmoother(pc, l, &smoother));
+      PetscCall(KSPSetFromOptions(smoother));
+    }
+  }
+  PetscCall(PetscMalloc1(PetscMax(nblocks, 1), &n1));
+  for (PetscInt i = 0; i < nblocks; i++) {
+    PetscCall((*fn)(ctx, blocks[i], 0, 0, NULL, &n1[i], NULL));
+    nc += n1[i];
+    if (n1[i] % 3) threes = PETSC_FALSE;
+  }
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  if (size > 1) {
+    PetscCallMPI(MPI_Scan(&nc, &col0, 1, MPIU_INT, MPI_SUM, comm));
+    col0 -= nc;
+  }
+  PetscCall(MatCreateAIJ(comm, m, nc, PETSC_DETERMINE, PETSC_DETERMINE, 2, NULL, 2, NULL, &pm->P));
+  PetscCall(MatSetOption(pm->P, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_FALSE));
+  if (threes && bs == 3) PetscCall(MatSetBlockSizes(pm->P, 3, 3));
+  PetscCall(PetscMalloc1(PetscMax(nc, 1), &pm->inj));
+  pm->nc = nc;
+  for (PetscInt i = 0, c0 = col0, k = 0; i < nblocks; i++) {
+    PetscInt n;
+    PetscCall((*fn)(ctx, blocks[i], rstart + off[i], c0, pm->P, &n, pm->inj + k));
+    for (PetscInt j = 0; j < n; j++) pm->inj[k + j] += off[i];
+    c0 += n;
+    k += n;
+  }
+  PetscCall(PetscFree(n1));
+  PetscCall(MatAssemblyBegin(pm->P, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(pm->P, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscObjectSetName((PetscObject)pm->P, "P1 to P2 interpolation"));
+  PetscFunctionReturn(0);
+}
+
+/* the fine operator's near-null space at the coarse unknowns (injection), orthonormalised */
+static PetscErrorCode CoarseRigidModes(PhlexPMG *pm, Mat A)
+{
+  MatNullSpace       nsp;
+  PetscBool          has_const;
+  PetscInt           n;
+  const Vec         *v;
+  Vec               *vc;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetNearNullSpace(A, &nsp));
+  if (!nsp) PetscFunctionReturn(0);
+  PetscCall(MatNullSpaceGetVecs(nsp, &has_const, &n, &v));
+  if (!n) PetscFunctionReturn(0);
+  PetscCall(PetscMalloc1(n, &vc));
+  for (PetscInt j = 0; j < n; j++) {
+    const PetscScalar *a;
+    PetscScalar       *c;
+    PetscCall(MatCreateVecs(pm->Ac, &vc[j], NULL));
+    PetscCall(VecGetArrayRead(v[j], &a));
+    PetscCall(VecGetArray(vc[j], &c));
+    for (PetscInt k = 0; k < pm->nc; k++) c[k] = a[pm->inj[k]];
+    PetscCall(VecRestoreArray(vc[j], &c));
+    PetscCall(VecRestoreArrayRead(v[j], &a));
+    /* Gram-Schmidt, twice */
+    for (PetscInt pass = 0; pass < 2; pass++)
+      for (PetscInt i = 0; i < j; i++) {
+        PetscScalar d;
+        PetscCall(VecDot(vc[j], vc[i], &d));
+        PetscCall(VecAXPY(vc[j], -d, vc[i]));
+      }
+    PetscCall(VecNormalize(vc[j], NULL));
+  }
+  PetscCall(MatNullSpaceCreate(PetscObjectComm((PetscObject)A), PETSC_FALSE, n, vc, &nsp));
+  PetscCall(MatSetNearNullSpace(pm->Ac, nsp));
+  PetscCall(MatNullSpaceDestroy(&nsp));
+  for (PetscInt j = 0; j < n; j++) PetscCall(VecDestroy(&vc[j]));
+  PetscCall(PetscFree(vc));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPMGSetUp - where ksp's preconditioner is PCMG (not GAMG): two levels, the interpolation PhlexPMGBuild made
+  and the coarse operator P^T A P, formed again when A's values changed. Call after KSPSetOperators, before the KSP's
+  set-up. Other preconditioners: nothing.
+
+  Collective on the KSP
+
+  Input Parameters:
++ ksp - the KSP
+- A   - the assembled (AIJ) operator (its near-null space: the rigid modes)
+@*/
+PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
+{
+  PC               pc;
+  PetscBool        mg;
+  PetscObjectState state, nz;
+  KSP              coarse;
+  Mat              Pnow;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  if (!mg) PetscFunctionReturn(0);
+  PetscCheck(pm->P, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: PhlexPMGBuild was not called");
+  PetscCall(PCMGGetInterpolation(pc, 1, &Pnow));
+  if (Pnow != pm->P) PetscCall(PCMGSetInterpolation(pc, 1, pm->P));
+  PetscCall(PetscObjectStateGet((PetscObject)A, &state));
+  PetscCall(MatGetNonzeroState(A, &nz));
+  if (!pm->Ac || pm->A != A || nz != pm->nz) {
+    PetscCall(MatDestroy(&pm->Ac));
+    PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
+    PetscCall(MatPtAP(A, pm->P, MAT_INITIAL_MATRIX, 2.0, &pm->Ac));
+    PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
+    PetscCall(PetscObjectSetName((PetscObject)pm->Ac, "P1 coarse operator"));
+    {
+      /* P^T A P is symmetric (positive definite) where A is known to be: a coarse Cholesky takes it (a body with its
+         frame's rate in its operator is not symmetric: its coarse level then wants LU) */
+      PetscBool set, flg;
+      PetscCall(MatIsSPDKnown(A, &set, &flg));
+      if (set) PetscCall(MatSetOption(pm->Ac, MAT_SPD, flg));
+      PetscCall(MatIsSymmetricKnown(A, &set, &flg));
+      if (set) PetscCall(MatSetOption(pm->Ac, MAT_SYMMETRIC, flg));
+    }
+    PetscCall(CoarseRigidModes(pm, A));
+    pm->A = A;
+  } else if (state != pm->state) {
+    PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
+    PetscCall(MatPtAP(A, pm->P, MAT_REUSE_MATRIX, 2.0, &pm->Ac));
+    PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
+  }
+  pm->state = state;
+  pm->nz    = nz;
+  PetscCall(PCMGGetCoarseSolve(pc, &coarse));
+  PetscCall(KSPSetOperators(coarse, pm->Ac, pm->Ac));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPMGWanted - whether ksp's preconditioner is PCMG (exactly: GAMG is one too, with its own hierarchy)
+
+  Not collective
+@*/
+PetscErrorCode PhlexPMGWanted(KSP ksp, PetscBool *wanted)
+{
+  PC pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, wanted));
+  PetscFunctionReturn(0);
+}
+
+/* a line for a view: the coarse space's size (nothing without p-multigrid) */
+PetscErrorCode PhlexPMGView(PhlexPMG *pm, PetscViewer viewer)
+{
+  PetscInt M, N;
+
+  PetscFunctionBeginUser;
+  if (!pm->P) PetscFunctionReturn(0);
+  PetscCall(MatGetSize(pm->P, &M, &N));
+  PetscCall(PetscViewerASCIIPrintf(viewer, "  p-multigrid: the P1 coarse space, %" PetscInt_FMT " unknowns below %" PetscInt_FMT "%s\n", N, M, pm->Ac ? "" : " (coarse operator not formed yet)"));
+  PetscFunctionReturn(0);
+}
+
+PetscErrorCode PhlexPMGDestroy(PhlexPMG *pm)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&pm->P));
+  PetscCall(MatDestroy(&pm->Ac));
+  PetscCall(PetscFree(pm->inj));
+  pm->A = NULL;
+  PetscFunctionReturn(0);
+}
