@@ -126,7 +126,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
 typedef struct {
   Mat              P;     /* the interpolation from the coarse unknowns (AIJ; built once) */
   Mat              Ac;    /* the coarse operator P^T A P, with the rigid modes as near-null space */
-  Mat              A;     /* the operator it was formed from (not referenced: the system's) */
+  Mat              A;     /* the operator it was formed from (referenced) */
   PetscObjectState state, nz; /* A's state and nonzero state at the last product */
   PetscInt         nc;    /* local coarse unknowns */
   PetscInt        *inj;   /* per local coarse unknown: its local fine row */
@@ -137,6 +137,7 @@ PETSC_INTERN PetscErrorCode PhlexPMGBuild(KSP, MPI_Comm, PetscInt, PetscInt, Pet
 PETSC_INTERN PetscErrorCode PhlexPMGSetUp(KSP, Mat, PhlexPMG *);
 /* border.c: block i's coarse space (a part's own, or its unknowns carried): a PhlexCoarseSpaceFn on the system */
 PETSC_INTERN PetscErrorCode PhlexSystemCoarseSpace(void *, PetscInt, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]);
+PETSC_INTERN PetscErrorCode PhlexPMGAfterSetUp(KSP, Mat, PhlexPMG *);
 PETSC_INTERN PetscErrorCode PhlexPMGView(PhlexPMG *, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexPMGDestroy(PhlexPMG *);
 /* snes_condensed.c: SNES phlexcondensed, the theta-method stage of fixed linear bodies by exact elimination */

@@ -15,7 +15,7 @@ static PetscErrorCode VertexColumns(PhlexFlexible b, PetscInt col0, PetscInt **g
 {
   PetscSection    s, gs;
   PetscSF         sf;
-  PetscInt        pStart, pEnd, vStart, vEnd, *root;
+  PetscInt        pStart, pEnd, vStart, vEnd, *root, bad = -1, nroots;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalSection(b->dm, &s));
@@ -33,14 +33,23 @@ static PetscErrorCode VertexColumns(PhlexFlexible b, PetscInt col0, PetscInt **g
     PetscCall(PetscSectionGetConstraintDof(s, p, &cdof));
     PetscCall(PetscSectionGetOffset(gs, p, &goff));
     if (goff < 0 || dof - cdof == 0) continue; /* a ghost, or a vertex of the frame patch */
-    PetscCheck(dof == 3 && cdof == 0, b->comm, PETSC_ERR_SUP, "body %s: p-multigrid's P1 coarse space needs each vertex's three velocity components all free or all constrained (vertex %" PetscInt_FMT ": %" PetscInt_FMT " of %" PetscInt_FMT " constrained)", b->name, p, cdof, dof);
+    if (dof != 3 || cdof != 0) {
+      bad = cdof;
+      continue;
+    }
     root[p - pStart] = col0 + *n1;
     *n1 += 3;
   }
+  /* every process learns of a partly constrained vertex before the collective broadcast below */
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, b->comm));
+  PetscCheck(bad < 0, b->comm, PETSC_ERR_SUP, "body %s: p-multigrid's P1 coarse space needs each vertex's three velocity components all free or all constrained (a vertex has %" PetscInt_FMT " of 3 constrained): use a preset without p-multigrid (options/solver/iterative_gamg.opts, bordered_iterative_gamg.opts)", b->name, bad);
   PetscCall(PetscArraycpy(*gcol, root, pEnd - pStart));
   PetscCall(DMGetPointSF(b->dm, &sf));
-  PetscCall(PetscSFBcastBegin(sf, MPIU_INT, root, *gcol, MPI_REPLACE));
-  PetscCall(PetscSFBcastEnd(sf, MPIU_INT, root, *gcol, MPI_REPLACE));
+  PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
+  if (nroots >= 0) { /* (a DM never distributed has a point SF without a graph) */
+    PetscCall(PetscSFBcastBegin(sf, MPIU_INT, root, *gcol, MPI_REPLACE));
+    PetscCall(PetscSFBcastEnd(sf, MPIU_INT, root, *gcol, MPI_REPLACE));
+  }
   PetscCall(PetscFree(root));
   PetscFunctionReturn(0);
 }

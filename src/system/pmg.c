@@ -31,7 +31,7 @@
 PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart, PetscInt bs, PetscInt nblocks, const PetscInt blocks[], const PetscInt off[], PhlexCoarseSpaceFn fn, void *ctx, PhlexPMG *pm)
 {
   PetscInt    nc = 0, col0 = 0, *n1;
-  PetscBool   threes = (PetscBool)(m % 3 == 0);
+  PetscInt    threes = (m % 3 == 0);
   PetscMPIInt size;
 
   PetscFunctionBeginUser;
@@ -44,10 +44,16 @@ PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PCMGGetLevels(pc, &nlevels));
     if (nlevels != 2) {
+      /* PCMG's one level unless told: two, and PCMG's own options read again for them (-pc_mg_log, ...) */
       const char *prefix;
+      char        name[256];
+      PetscBool   given;
       PetscCall(PCGetOptionsPrefix(pc, &prefix));
-      PetscCheck(nlevels <= 1, PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "-%spc_mg_levels %" PetscInt_FMT ": phlex's p-multigrid has two levels, the P2 velocities and their P1 space; a coarser hierarchy comes from the coarse solver (-%smg_coarse_pc_type gamg)", prefix ? prefix : "", nlevels, prefix ? prefix : "");
+      PetscCall(PetscSNPrintf(name, sizeof(name), "-%spc_mg_levels", prefix ? prefix : ""));
+      PetscCall(PetscOptionsHasName(((PetscObject)pc)->options, NULL, name, &given));
+      PetscCheck(!given, PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "%s %" PetscInt_FMT ": phlex's p-multigrid has two levels, the P2 velocities and their P1 space; a coarser hierarchy comes from the coarse solver (-%smg_coarse_pc_type gamg)", name, nlevels, prefix ? prefix : "");
       PetscCall(PCMGSetLevels(pc, 2, NULL));
+      PetscCall(PCSetFromOptions(pc));
     }
     PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_NONE));
     for (PetscInt l = 0; l < 2; l++) {
@@ -60,8 +66,9 @@ PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart
   for (PetscInt i = 0; i < nblocks; i++) {
     PetscCall((*fn)(ctx, blocks[i], 0, 0, NULL, &n1[i], NULL));
     nc += n1[i];
-    if (n1[i] % 3) threes = PETSC_FALSE;
+    if (n1[i] % 3) threes = 0;
   }
+  PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &threes, 1, MPIU_INT, MPI_MIN, comm));
   PetscCallMPI(MPI_Comm_size(comm, &size));
   if (size > 1) {
     PetscCallMPI(MPI_Scan(&nc, &col0, 1, MPIU_INT, MPI_SUM, comm));
@@ -127,10 +134,53 @@ static PetscErrorCode CoarseRigidModes(PhlexPMG *pm, Mat A)
   PetscFunctionReturn(0);
 }
 
+/* P^T A P is symmetric (positive definite) where A is known to be; the flags again after every product (an
+   assembly clears them) */
+static PetscErrorCode CoarseSymmetry(PhlexPMG *pm, Mat A)
+{
+  PetscBool set, flg;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatIsSPDKnown(A, &set, &flg));
+  if (set) PetscCall(MatSetOption(pm->Ac, MAT_SPD, flg));
+  PetscCall(MatIsSymmetricKnown(A, &set, &flg));
+  if (set) PetscCall(MatSetOption(pm->Ac, MAT_SYMMETRIC, flg));
+  PetscFunctionReturn(0);
+}
+
+/* A body with its frame's rate in its operator (-<body>_preconditioner_rate_tol) makes A, and so P^T A P, not
+   symmetric: a coarse Cholesky would factor one triangle of it. Its LU instead, with the same package where it has
+   one (MUMPS), else MUMPS's or PETSc's (CHOLMOD has no LU), as PC phlexbordered does on the fine operator */
+static PetscErrorCode CoarseFactorType(KSP coarse, Mat A)
+{
+  PC            pc;
+  PetscBool     chol, set, symm, avail = PETSC_FALSE;
+  MatSolverType asked;
+  char          package[64] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(coarse, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCCHOLESKY, &chol));
+  PetscCall(MatIsSymmetricKnown(A, &set, &symm));
+  if (!chol || !set || symm) PetscFunctionReturn(0);
+  PetscCall(PCFactorGetMatSolverType(pc, &asked));
+  if (asked) PetscCall(PetscStrncpy(package, asked, sizeof(package))); /* copied: PCSetType frees it */
+  if (package[0]) PetscCall(MatGetFactorAvailable(A, package, MAT_FACTOR_LU, &avail));
+  if (!avail) {
+    PetscCall(PetscStrncpy(package, MATSOLVERMUMPS, sizeof(package)));
+    PetscCall(MatGetFactorAvailable(A, package, MAT_FACTOR_LU, &avail));
+    if (!avail) package[0] = 0;
+  }
+  PetscCall(PCSetType(pc, PCLU));
+  if (package[0]) PetscCall(PCFactorSetMatSolverType(pc, package));
+  PetscCall(PetscInfo(coarse, "p-multigrid: the operator is not symmetric, the coarse level by LU instead of Cholesky, with %s\n", package[0] ? package : "PETSc's default package"));
+  PetscFunctionReturn(0);
+}
+
 /*@C
-  PhlexPMGSetUp - where ksp's preconditioner is PCMG (not GAMG): two levels, the interpolation PhlexPMGBuild made
-  and the coarse operator P^T A P, formed again when A's values changed. Call after KSPSetOperators, before the KSP's
-  set-up. Other preconditioners: nothing.
+  PhlexPMGSetUp - where ksp's preconditioner is PCMG (not GAMG): the interpolation PhlexPMGBuild made and the coarse
+  operator P^T A P, formed again when A's values changed. Call after KSPSetOperators, before the KSP's set-up. Other
+  preconditioners: nothing.
 
   Collective on the KSP
 
@@ -160,27 +210,45 @@ PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
     PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
     PetscCall(MatPtAP(A, pm->P, MAT_INITIAL_MATRIX, 2.0, &pm->Ac));
     PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
-    PetscCall(PetscObjectSetName((PetscObject)pm->Ac, "P1 coarse operator"));
-    {
-      /* P^T A P is symmetric (positive definite) where A is known to be: a coarse Cholesky takes it (a body with its
-         frame's rate in its operator is not symmetric: its coarse level then wants LU) */
-      PetscBool set, flg;
-      PetscCall(MatIsSPDKnown(A, &set, &flg));
-      if (set) PetscCall(MatSetOption(pm->Ac, MAT_SPD, flg));
-      PetscCall(MatIsSymmetricKnown(A, &set, &flg));
-      if (set) PetscCall(MatSetOption(pm->Ac, MAT_SYMMETRIC, flg));
-    }
+    PetscCall(PetscObjectSetName((PetscObject)pm->Ac, "coarse operator"));
     PetscCall(CoarseRigidModes(pm, A));
+    /* held: a new matrix at the same address must not take the reuse below */
+    PetscCall(PetscObjectReference((PetscObject)A));
+    PetscCall(MatDestroy(&pm->A));
     pm->A = A;
   } else if (state != pm->state) {
     PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
     PetscCall(MatPtAP(A, pm->P, MAT_REUSE_MATRIX, 2.0, &pm->Ac));
     PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
   }
+  PetscCall(CoarseSymmetry(pm, A));
   pm->state = state;
   pm->nz    = nz;
   PetscCall(PCMGGetCoarseSolve(pc, &coarse));
+  PetscCall(CoarseFactorType(coarse, A));
   PetscCall(KSPSetOperators(coarse, pm->Ac, pm->Ac));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPMGAfterSetUp - after the KSP's set-up: the coarse level's factorization LU where A is not symmetric (PCMG's
+  first set-up reads the coarse solver's options again, which undoes the choice PhlexPMGSetUp made before it: the
+  coarse level is then factored again, by LU, at its next use; once per run)
+
+  Collective on the KSP
+@*/
+PetscErrorCode PhlexPMGAfterSetUp(KSP ksp, Mat A, PhlexPMG *pm)
+{
+  PC        pc;
+  PetscBool mg;
+  KSP       coarse;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  if (!mg || !pm->P) PetscFunctionReturn(0);
+  PetscCall(PCMGGetCoarseSolve(pc, &coarse));
+  PetscCall(CoarseFactorType(coarse, A));
   PetscFunctionReturn(0);
 }
 
@@ -216,7 +284,7 @@ PetscErrorCode PhlexPMGDestroy(PhlexPMG *pm)
   PetscFunctionBeginUser;
   PetscCall(MatDestroy(&pm->P));
   PetscCall(MatDestroy(&pm->Ac));
+  PetscCall(MatDestroy(&pm->A));
   PetscCall(PetscFree(pm->inj));
-  pm->A = NULL;
   PetscFunctionReturn(0);
 }

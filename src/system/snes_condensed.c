@@ -363,14 +363,14 @@ static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
   } else PetscCall(PhlexBlockCopyDestroy(&c->Ablock));
   PetscCall(PhlexMGCopiesRestore(c->ksp, &c->mg)); /* GAMG's interpolations back for its set-up */
   PetscCall(KSPSetOperators(c->ksp, c->Ablock.copy ? c->Ablock.copy : Sv, Sv));
-  if (!preonly) {
+  {
+    /* p-multigrid (pmg.c) where the PC is PCMG: its levels once, its coarse operator at every new operator */
     PetscBool pmg;
     PetscCall(PhlexPMGWanted(c->ksp, &pmg));
     if (pmg) {
-      PetscInt rstart, m, bs, *blocks;
+      PetscInt rstart, m, *blocks;
       PetscCall(MatGetOwnershipRange(Sv, &rstart, NULL));
       PetscCall(MatGetLocalSize(Sv, &m, NULL));
-      PetscCall(MatGetBlockSize(Sv, &bs));
       PetscCall(PetscMalloc1(PetscMax(c->sys->nfparts, 1), &blocks));
       for (PetscInt i = 0; i < c->sys->nfparts; i++) blocks[i] = i;
       PetscCall(PhlexPMGBuild(c->ksp, c->sys->comm, m, rstart, bs, c->sys->nfparts, blocks, c->sys->border.off, PhlexSystemCoarseSpace, c->sys, &c->pmg));
