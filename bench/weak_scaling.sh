@@ -1,7 +1,8 @@
 #!/bin/sh
 # Weak scaling of the iterative path: the same bar refined so that each process holds about the same number of
 # velocity DOFs (h = H1 * P^(-1/3)), P = 1, 2, 4, ... processes, the clamped bar in its first bending shape with
-# options/solver/iterative.opts (SNES phlexcondensed, CG + GAMG), a few steps each.
+# options/solver/iterative.opts (SNES phlexcondensed, CG + p-multigrid; PRESET=options/solver/iterative_gamg.opts for
+# GAMG), a few steps each.
 #
 #   bench/weak_scaling.sh [P ...]                 default: 1 2 4
 #   H1=0.013 STEPS=4 bench/weak_scaling.sh 1 2 4 8
@@ -9,16 +10,16 @@
 # Environment (all optional):
 #   PHLEX=bin/phlex        binary
 #   H1=0.013               mesh size on one process (0.013: 1.1e5 P2 velocity DOFs; 0.006: 9.5e5)
-#   STEPS=4                steps per run (the first holds GAMG's set-up: per step is taken from the log, see below)
+#   STEPS=4                steps per run (the first holds the preconditioner's set-up: per step is taken from the log, see below)
 #   MPIEXEC="mpiexec"      launcher (e.g. "srun" inside a SLURM allocation, or "mpiexec --hostfile hosts")
 #   RESULTS=bench/results  where the logs go (weak_P<p>_h<h>.log)
 #   PRESET=options/solver/iterative.opts
 #   EXTRA=                 options appended (e.g. -condensed_ksp_rtol 1e-8)
 #
 # Prints two lines per P: DOFs, DOFs per process, CG iterations per step, KSPSolve per step (the solves only: the
-# GAMG set-up is PCSetUp's, printed apart), peak RSS of the largest process (/usr/bin/time -v of the launcher is not
+# preconditioner's set-up is PCSetUp's, printed apart), peak RSS of the largest process (/usr/bin/time -v of the launcher is not
 # that: phlex's own -memory_view line is used when present), and the efficiency T(1)/T(P) of the solve per step;
-# then the communication of a step (the steps less GAMG's set-up, from -log_view): global reductions, messages and
+# then the communication of a step (the steps less the preconditioner's set-up, from -log_view): global reductions, messages and
 # bytes sent per process (counts do not depend on the machine: oversubscribed runs give them too).
 # Meshes: meshes/bench/bar_h<h>.msh, made by `make -C meshes bench/bar_h<h>.msh` (gmsh) when missing; each process
 # count's mesh is read by rank 0 and distributed (it must fit there once).
@@ -65,7 +66,7 @@ print("P %d | velocity DOFs %d (%d per process) | CG its per step %s | KSPSolve 
 # communication per step, from the "Phlex Transient" stage's event lines (-log_view: Mess is the count of messages
 # sent by all processes, AvgLen their mean length in bytes, Reduct the global reductions): the events that repeat
 # every step (the CG solve, the stress passes, the energy monitor) over the steps; the one-time set-up inside the
-# first step (GAMG's PCSetUp, the operator's assembly) is left out. One process counts no reductions.
+# first step (the preconditioner's PCSetUp, the operator's assembly) is left out. One process counts no reductions.
 stage = txt.split("--- Event Stage 3: Phlex Transient")[1].split("--- Event Stage")[0] if "--- Event Stage 3: Phlex Transient" in txt else ""
 def ev(name):
     m = re.search(r"^%s\s+(\d+)\s+\S+\s+\S+\s+\S+\s+\S+\s+\S+\s+(\S+)\s+(\S+)\s+(\S+)" % name, stage, re.M)
