@@ -137,7 +137,6 @@ PETSC_INTERN PetscErrorCode PhlexPMGBuild(KSP, MPI_Comm, PetscInt, PetscInt, Pet
 PETSC_INTERN PetscErrorCode PhlexPMGSetUp(KSP, Mat, PhlexPMG *);
 /* border.c: block i's coarse space (a part's own, or its unknowns carried): a PhlexCoarseSpaceFn on the system */
 PETSC_INTERN PetscErrorCode PhlexSystemCoarseSpace(void *, PetscInt, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]);
-PETSC_INTERN PetscErrorCode PhlexPMGAfterSetUp(KSP, Mat, PhlexPMG *);
 PETSC_INTERN PetscErrorCode PhlexPMGView(PhlexPMG *, PetscViewer);
 PETSC_INTERN PetscErrorCode PhlexPMGDestroy(PhlexPMG *);
 /* snes_condensed.c: SNES phlexcondensed, the theta-method stage of fixed linear bodies by exact elimination */

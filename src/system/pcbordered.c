@@ -553,7 +553,6 @@ static PetscErrorCode PCSetUp_Bordered(PC pc)
       PetscCall(BlockProductsBefore(pb, i));
       if (pb->pmg[i].P) PetscCall(PhlexPMGSetUp(pb->ksp[i], mine ? pb->Aseq[i] : bd->A[i], &pb->pmg[i]));
       PetscCall(KSPSetUp(pb->ksp[i]));
-      if (pb->pmg[i].P) PetscCall(PhlexPMGAfterSetUp(pb->ksp[i], mine ? pb->Aseq[i] : bd->A[i], &pb->pmg[i]));
       if (pb->Ablock[i].copy) PetscCall(PhlexMGCopiesApply(pb->ksp[i], PETSC_TRUE, PETSC_TRUE, &pb->mgc[i]));
       if (pb->Y[i]) {
         Mat Wl = bd->W[i], Yl = pb->Y[i];

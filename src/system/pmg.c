@@ -42,16 +42,18 @@ PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart
     PC       pc;
     PetscInt nlevels;
     PetscCall(KSPGetPC(ksp, &pc));
+    const char *prefix;
+    char        name[256];
+    PetscBool   given;
+    PetscCall(PCGetOptionsPrefix(pc, &prefix));
+    PetscCall(PetscSNPrintf(name, sizeof(name), "-%spc_mg_levels", prefix ? prefix : ""));
+    PetscCall(PetscOptionsHasName(((PetscObject)pc)->options, NULL, name, &given));
     PetscCall(PCMGGetLevels(pc, &nlevels));
+    /* phlex sets the levels: a level count from the options would have made PCMG's levels before a body's own
+       prefix was set (their options then not read) */
+    PetscCheck(!given, PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "%s %" PetscInt_FMT ": phlex's p-multigrid sets its two levels itself, the P2 velocities and their P1 space (a coarser hierarchy comes from the coarse solver, -%smg_coarse_pc_type gamg): remove the option", name, nlevels, prefix ? prefix : "");
     if (nlevels != 2) {
-      /* PCMG's one level unless told: two, and PCMG's own options read again for them (-pc_mg_log, ...) */
-      const char *prefix;
-      char        name[256];
-      PetscBool   given;
-      PetscCall(PCGetOptionsPrefix(pc, &prefix));
-      PetscCall(PetscSNPrintf(name, sizeof(name), "-%spc_mg_levels", prefix ? prefix : ""));
-      PetscCall(PetscOptionsHasName(((PetscObject)pc)->options, NULL, name, &given));
-      PetscCheck(!given, PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "%s %" PetscInt_FMT ": phlex's p-multigrid has two levels, the P2 velocities and their P1 space; a coarser hierarchy comes from the coarse solver (-%smg_coarse_pc_type gamg)", name, nlevels, prefix ? prefix : "");
+      /* PCMG's one level: two, and PCMG's own options read again for them (-pc_mg_log, ...) */
       PetscCall(PCMGSetLevels(pc, 2, NULL));
       PetscCall(PCSetFromOptions(pc));
     }
@@ -60,6 +62,9 @@ PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart
       KSP smoother;
       PetscCall(PCMGGetSmoother(pc, l, &smoother));
       PetscCall(KSPSetFromOptions(smoother));
+      /* the coarse solver's options are read now: PCMG's first set-up would read them again and undo the LU that
+         PhlexPMGSetUp chooses for a non-symmetric operator (factoring its Cholesky first) */
+      if (!l) PetscCall(KSPSetSkipPCSetFromOptions(smoother, PETSC_TRUE));
     }
   }
   PetscCall(PetscMalloc1(PetscMax(nblocks, 1), &n1));
@@ -150,7 +155,8 @@ static PetscErrorCode CoarseSymmetry(PhlexPMG *pm, Mat A)
 
 /* A body with its frame's rate in its operator (-<body>_preconditioner_rate_tol) makes A, and so P^T A P, not
    symmetric: a coarse Cholesky would factor one triangle of it. Its LU instead, with the same package where it has
-   one (MUMPS), else MUMPS's or PETSc's (CHOLMOD has no LU), as PC phlexbordered does on the fine operator */
+   one (MUMPS), else MUMPS's or PETSc's (CHOLMOD has no LU), as PC phlexbordered does on the fine operator. Once LU,
+   it stays LU (an operator symmetric again is factored by LU too) */
 static PetscErrorCode CoarseFactorType(KSP coarse, Mat A)
 {
   PC            pc;
@@ -227,28 +233,6 @@ PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
   PetscCall(PCMGGetCoarseSolve(pc, &coarse));
   PetscCall(CoarseFactorType(coarse, A));
   PetscCall(KSPSetOperators(coarse, pm->Ac, pm->Ac));
-  PetscFunctionReturn(0);
-}
-
-/*@C
-  PhlexPMGAfterSetUp - after the KSP's set-up: the coarse level's factorization LU where A is not symmetric (PCMG's
-  first set-up reads the coarse solver's options again, which undoes the choice PhlexPMGSetUp made before it: the
-  coarse level is then factored again, by LU, at its next use; once per run)
-
-  Collective on the KSP
-@*/
-PetscErrorCode PhlexPMGAfterSetUp(KSP ksp, Mat A, PhlexPMG *pm)
-{
-  PC        pc;
-  PetscBool mg;
-  KSP       coarse;
-
-  PetscFunctionBeginUser;
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
-  if (!mg || !pm->P) PetscFunctionReturn(0);
-  PetscCall(PCMGGetCoarseSolve(pc, &coarse));
-  PetscCall(CoarseFactorType(coarse, A));
   PetscFunctionReturn(0);
 }
 

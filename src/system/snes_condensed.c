@@ -416,12 +416,12 @@ static PetscErrorCode SNESSolve_Condensed(SNES snes)
     PetscCall(SetOperators(c, Sv));
     c->shift = s;
     c->nhist = 0; /* the increments scale with the step: the guess starts again */
-  } else if (c->Ablock.copy || c->block_levels || c->explicit_restrict) {
+  } else if (c->Ablock.copy || c->block_levels || c->explicit_restrict || c->pmg.P) {
     Mat              Sv;
     PetscObjectState state;
     PetscCall(KSPGetOperators(c->ksp, NULL, &Sv));
     PetscCall(PetscObjectStateGet((PetscObject)Sv, &state));
-    if (state != c->svstate) PetscCall(SetOperators(c, Sv)); /* Sv's values changed in place: the copies made again */
+    if (state != c->svstate) PetscCall(SetOperators(c, Sv)); /* Sv's values changed in place: the copies and the coarse operator made again */
   }
   /* the loads b at the stage time (those of a fixed body depend on t only) */
   PetscCall(PhlexSystemEvaluate(sys, tstage, X0, NULL));
