@@ -7,6 +7,16 @@
 #include <petscblaslapack.h>
 #include <private/part.h>
 
+/* what became of a matrix since a product was last taken from it: the same, new values, or another matrix or
+   pattern (PhlexMatWatchCheck, mat_block_copy.c; the block copy below and p-multigrid's coarse operator) */
+typedef enum { PHLEX_MAT_SAME, PHLEX_MAT_VALUES, PHLEX_MAT_NEW } PhlexMatChange;
+typedef struct {
+  Mat              src;       /* the matrix watched (referenced) */
+  PetscObjectState nz, state; /* its nonzero state and state when last checked */
+} PhlexMatWatch;
+PETSC_INTERN PetscErrorCode PhlexMatWatchCheck(PhlexMatWatch *, Mat, PhlexMatChange *);
+PETSC_INTERN PetscErrorCode PhlexMatWatchReset(PhlexMatWatch *);
+
 /* Time profile f(t) multiplying an input amplitude (profile.c). */
 typedef enum {
   PHLEX_PROFILE_CONSTANT,
@@ -195,9 +205,8 @@ PETSC_INTERN PetscErrorCode PhlexMatMultBlock(Mat, Mat, Mat);
 /* mat_block_copy.c: an AIJ matrix copied in node blocks (BAIJ) */
 PETSC_INTERN PetscErrorCode PhlexMatBlockCopy(Mat, PetscBool, MatReuse, Mat *);
 typedef struct {
-  Mat              copy; /* the node-block copy (NULL: none, src not in whole blocks) */
-  Mat              src;  /* the matrix it was taken from (referenced) */
-  PetscObjectState nz, state; /* src's nonzero state and state at the last fill */
+  Mat           copy;  /* the node-block copy (NULL: none, the matrix not in whole blocks) */
+  PhlexMatWatch watch; /* the matrix it was taken from */
 } PhlexBlockCopy;
 PETSC_INTERN PetscErrorCode PhlexBlockCopyUpdate(PhlexBlockCopy *, Mat, PetscBool);
 PETSC_INTERN PetscErrorCode PhlexBlockCopyDestroy(PhlexBlockCopy *);

@@ -126,8 +126,7 @@ PETSC_INTERN PetscErrorCode PhlexSystemVelocityOperator(PhlexSystem, Mat *);
 typedef struct {
   Mat              P;     /* the interpolation from the coarse unknowns (AIJ; built once) */
   Mat              Ac;    /* the coarse operator P^T A P, with the rigid modes as near-null space */
-  Mat              A;     /* the operator it was formed from (referenced) */
-  PetscObjectState state, nz; /* A's state and nonzero state at the last product */
+  PhlexMatWatch    A;     /* the operator it was formed from */
   PetscInt         nc;    /* local coarse unknowns */
   PetscInt        *inj;   /* per local coarse unknown: its local fine row */
 } PhlexPMG;

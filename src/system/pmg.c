@@ -7,7 +7,7 @@
    The coarse operator carries the bodies' rigid-body modes (the fine operator's near-null space at the vertices,
    exact in P1) for a GAMG below. It is formed again, in place, when the fine operator's values change. */
 #include <phlex_impl.h>
-#include <petsc/private/petscimpl.h> /* PetscObjectStateGet: whether the operator changed since the coarse product */
+#include <petsc/private/petscimpl.h> /* the PC's options database (whether -pc_mg_levels was given) */
 
 /*@C
   PhlexPMGBuild - for ksp's PCMG: two levels, and the interpolation from the coarse unknowns of the blocks of an operator's rows (each block's own
@@ -198,7 +198,7 @@ PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
 {
   PC               pc;
   PetscBool        mg;
-  PetscObjectState state, nz;
+  PhlexMatChange   change;
   KSP              coarse;
   Mat              Pnow;
 
@@ -209,27 +209,20 @@ PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
   PetscCheck(pm->P, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: PhlexPMGBuild was not called");
   PetscCall(PCMGGetInterpolation(pc, 1, &Pnow));
   if (Pnow != pm->P) PetscCall(PCMGSetInterpolation(pc, 1, pm->P));
-  PetscCall(PetscObjectStateGet((PetscObject)A, &state));
-  PetscCall(MatGetNonzeroState(A, &nz));
-  if (!pm->Ac || pm->A != A || nz != pm->nz) {
+  PetscCall(PhlexMatWatchCheck(&pm->A, A, &change));
+  if (!pm->Ac || change == PHLEX_MAT_NEW) {
     PetscCall(MatDestroy(&pm->Ac));
     PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
     PetscCall(MatPtAP(A, pm->P, MAT_INITIAL_MATRIX, 2.0, &pm->Ac));
     PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
     PetscCall(PetscObjectSetName((PetscObject)pm->Ac, "coarse operator"));
     PetscCall(CoarseRigidModes(pm, A));
-    /* held: a new matrix at the same address must not take the reuse below */
-    PetscCall(PetscObjectReference((PetscObject)A));
-    PetscCall(MatDestroy(&pm->A));
-    pm->A = A;
-  } else if (state != pm->state) {
+  } else if (change == PHLEX_MAT_VALUES) {
     PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
     PetscCall(MatPtAP(A, pm->P, MAT_REUSE_MATRIX, 2.0, &pm->Ac));
     PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
   }
   PetscCall(CoarseSymmetry(pm, A));
-  pm->state = state;
-  pm->nz    = nz;
   PetscCall(PCMGGetCoarseSolve(pc, &coarse));
   PetscCall(CoarseFactorType(coarse, A));
   PetscCall(KSPSetOperators(coarse, pm->Ac, pm->Ac));
@@ -268,7 +261,7 @@ PetscErrorCode PhlexPMGDestroy(PhlexPMG *pm)
   PetscFunctionBeginUser;
   PetscCall(MatDestroy(&pm->P));
   PetscCall(MatDestroy(&pm->Ac));
-  PetscCall(MatDestroy(&pm->A));
+  PetscCall(PhlexMatWatchReset(&pm->A));
   PetscCall(PetscFree(pm->inj));
   PetscFunctionReturn(0);
 }

@@ -367,7 +367,7 @@ static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
     /* p-multigrid (pmg.c) where the PC is PCMG: its levels once, its coarse operator at every new operator */
     PetscBool pmg;
     PetscCall(PhlexPMGWanted(c->ksp, &pmg));
-    if (pmg) {
+    if (pmg && !c->pmg.P) {
       PetscInt rstart, m, *blocks;
       PetscCall(MatGetOwnershipRange(Sv, &rstart, NULL));
       PetscCall(MatGetLocalSize(Sv, &m, NULL));
@@ -375,8 +375,8 @@ static PetscErrorCode SetOperators(SNES_Condensed *c, Mat Sv)
       for (PetscInt i = 0; i < c->sys->nfparts; i++) blocks[i] = i;
       PetscCall(PhlexPMGBuild(c->ksp, c->sys->comm, m, rstart, bs, c->sys->nfparts, blocks, c->sys->border.off, PhlexSystemCoarseSpace, c->sys, &c->pmg));
       PetscCall(PetscFree(blocks));
-      PetscCall(PhlexPMGSetUp(c->ksp, Sv, &c->pmg));
     }
+    if (pmg) PetscCall(PhlexPMGSetUp(c->ksp, Sv, &c->pmg));
   }
   if (!preonly) PetscCall(PhlexMGCopiesApply(c->ksp, c->block_levels, c->explicit_restrict, &c->mg));
   PetscCall(PetscObjectStateGet((PetscObject)Sv, &c->svstate)); /* after the set-up (it may mark Sv) */

@@ -137,6 +137,43 @@ PetscErrorCode PhlexMatBlockCopy(Mat A, PetscBool symmetric, MatReuse reuse, Mat
 }
 
 /*@C
+  PhlexMatWatchCheck - what became of A since the last check: another matrix or nonzero pattern than the one watched
+  (PHLEX_MAT_NEW: A is watched from now, referenced), new values (PHLEX_MAT_VALUES: its state moved), or nothing
+
+  Not collective
+@*/
+PetscErrorCode PhlexMatWatchCheck(PhlexMatWatch *w, Mat A, PhlexMatChange *change)
+{
+  PetscObjectState nz, state;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatGetNonzeroState(A, &nz));
+  PetscCall(PetscObjectStateGet((PetscObject)A, &state));
+  if (A != w->src || nz != w->nz) {
+    PetscCall(PetscObjectReference((PetscObject)A));
+    PetscCall(MatDestroy(&w->src));
+    w->src  = A;
+    *change = PHLEX_MAT_NEW;
+  } else *change = state != w->state ? PHLEX_MAT_VALUES : PHLEX_MAT_SAME;
+  w->nz    = nz;
+  w->state = state;
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexMatWatchReset - the watched matrix released (the next check answers PHLEX_MAT_NEW)
+
+  Not collective
+@*/
+PetscErrorCode PhlexMatWatchReset(PhlexMatWatch *w)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatDestroy(&w->src));
+  w->nz = w->state = 0;
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexBlockCopyUpdate - keep bc->copy the node-block copy of A (PhlexMatBlockCopy): a new copy for another matrix or
   a new nonzero pattern (NULL when A is not in whole blocks: remembered, not tried again until then), A's values
   refilled into the same object when A's state moved since the last fill (whoever holds the copy sees them); the
@@ -146,20 +183,15 @@ PetscErrorCode PhlexMatBlockCopy(Mat A, PetscBool symmetric, MatReuse reuse, Mat
 @*/
 PetscErrorCode PhlexBlockCopyUpdate(PhlexBlockCopy *bc, Mat A, PetscBool upper)
 {
-  PetscObjectState nz, state;
-  PetscBool        set, flg;
+  PhlexMatChange change;
+  PetscBool      set, flg;
 
   PetscFunctionBeginUser;
-  PetscCall(MatGetNonzeroState(A, &nz));
-  PetscCall(PetscObjectStateGet((PetscObject)A, &state));
-  if (A != bc->src || nz != bc->nz) {
-    PetscCall(PhlexBlockCopyDestroy(bc));
+  PetscCall(PhlexMatWatchCheck(&bc->watch, A, &change));
+  if (change == PHLEX_MAT_NEW) {
+    PetscCall(MatDestroy(&bc->copy));
     PetscCall(PhlexMatBlockCopy(A, upper, MAT_INITIAL_MATRIX, &bc->copy));
-    PetscCall(PetscObjectReference((PetscObject)A));
-    bc->src = A;
-    bc->nz  = nz;
-  } else if (state != bc->state && bc->copy) PetscCall(PhlexMatBlockCopy(A, upper, MAT_REUSE_MATRIX, &bc->copy));
-  bc->state = state;
+  } else if (change == PHLEX_MAT_VALUES && bc->copy) PetscCall(PhlexMatBlockCopy(A, upper, MAT_REUSE_MATRIX, &bc->copy));
   if (!bc->copy) PetscFunctionReturn(0);
   PetscCall(MatIsSymmetricKnown(A, &set, &flg));
   if (set) PetscCall(MatSetOption(bc->copy, MAT_SYMMETRIC, flg));
@@ -175,7 +207,6 @@ PetscErrorCode PhlexBlockCopyDestroy(PhlexBlockCopy *bc)
 {
   PetscFunctionBeginUser;
   PetscCall(MatDestroy(&bc->copy));
-  PetscCall(MatDestroy(&bc->src));
-  bc->nz = bc->state = 0;
+  PetscCall(PhlexMatWatchReset(&bc->watch));
   PetscFunctionReturn(0);
 }

@@ -138,8 +138,8 @@ PetscErrorCode PhlexMGCopiesRestore(KSP ksp, PhlexMGCopies *m)
     Mat P;
     PetscCall(PCMGGetInterpolation(pc, l, &P));
     if (!m->P[l].copy || P != m->P[l].copy) continue;
-    PetscCall(PCMGSetInterpolation(pc, l, m->P[l].src));
-    PetscCall(PCMGSetRestriction(pc, l, m->P[l].src));
+    PetscCall(PCMGSetInterpolation(pc, l, m->P[l].watch.src));
+    PetscCall(PCMGSetRestriction(pc, l, m->P[l].watch.src));
   }
   PetscFunctionReturn(0);
 }
