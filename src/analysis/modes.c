@@ -45,6 +45,22 @@ static PetscErrorCode ModesSetFromOptions(MPI_Comm comm, ModesOptions *o)
   PetscFunctionReturn(0);
 }
 
+/* with p-multigrid in the shift-and-invert solves (-modes_st_pc_type mg), its levels' options (-modes_st_mg_*),
+   which PCMG reads only once its levels exist */
+static PetscErrorCode ModesPMGLevelsOptions(EPS eps)
+{
+  ST        st;
+  KSP       ksp;
+  PetscBool mg;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(PhlexPMGWanted(ksp, &mg));
+  if (mg) PetscCall(PhlexPMGSetLevels(ksp));
+  PetscFunctionReturn(0);
+}
+
 /* every option of a modal run read once more (PhlexOptionsCheckUnused collects the valid names): the scene's, the
    analysis', the eigensolver's */
 PetscErrorCode PhlexModesRereadOptions(void *ctx)
@@ -60,6 +76,7 @@ PetscErrorCode PhlexModesRereadOptions(void *ctx)
   PetscCall(ModesSetFromOptions(comm, &o));
   PetscCall(PhlexModesEPSCreate(comm, &eps, &ftarget, &flg));
   PetscCall(EPSSetFromOptions(eps));
+  PetscCall(ModesPMGLevelsOptions(eps));
   PetscCall(EPSDestroy(&eps));
   PetscFunctionReturn(0);
 }
@@ -148,7 +165,10 @@ PetscErrorCode PhlexSceneSolveModes(PhlexScene scene)
     PetscReal ftarget = -1;
     PetscBool flg;
     PetscCall(PhlexModesEPSCreate(scene->comm, &eps, &ftarget, &flg));
-    if (PhlexHelpGetMode() != PHLEX_HELP_OPTIONS) PetscCall(EPSSetFromOptions(eps));
+    if (PhlexHelpGetMode() != PHLEX_HELP_OPTIONS) {
+      PetscCall(EPSSetFromOptions(eps));
+      PetscCall(ModesPMGLevelsOptions(eps));
+    }
     PetscCall(EPSDestroy(&eps));
   }
   if (PhlexHelpGetMode() != PHLEX_HELP_NONE) PetscFunctionReturn(0);

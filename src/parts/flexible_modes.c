@@ -274,6 +274,130 @@ static PetscErrorCode EigenpairResiduals(EPS eps, PetscInt n, PetscReal rigid_be
   PetscFunctionReturn(0);
 }
 
+/* p-multigrid's coarse space of a modal pencil (a PhlexCoarseSpaceFn): block 0 the body's velocities (their P1
+   space), block 1 a floating pencil's six rigid unknowns (on rank 0), carried to the coarse level */
+typedef struct {
+  PhlexFlexible b;
+  PetscInt      q; /* the rigid unknowns here */
+} ModesCoarse;
+
+static PetscErrorCode ModesCoarseSpace(void *ctx, PetscInt i, PetscInt row0, PetscInt col0, Mat P, PetscInt *n1, PetscInt inj[])
+{
+  ModesCoarse *c = (ModesCoarse *)ctx;
+
+  PetscFunctionBeginUser;
+  if (i == 0) {
+    PetscCall(PhlexFlexibleCoarseSpace(c->b, row0, col0, P, n1, inj));
+    PetscFunctionReturn(0);
+  }
+  *n1 = c->q;
+  for (PetscInt j = 0; P && j < c->q; j++) {
+    PetscCall(MatSetValue(P, row0 + j, col0 + j, 1.0, INSERT_VALUES));
+    if (inj) inj[j] = j;
+  }
+  PetscFunctionReturn(0);
+}
+
+/* the iterative inner solves of a body's modal analysis: each checked, counted, and a progress line when due (a
+   restart cycle of the eigensolver, where its monitor reports, is about 70 inner solves: half an hour at 3e6 DOFs) */
+typedef struct {
+  PhlexFlexible b;
+  PhlexProgress progress;
+  PetscInt      solves, its;
+} ModesInner;
+
+/* after each inner solve: one that stopped short of its tolerance is an error (the eigenpairs would be silently
+   wrong), naming the option to change; the interrupt flag checked, progress reported */
+static PetscErrorCode ModesInnerSolveCheck(KSP ksp, Vec rhs, Vec x, void *ctx)
+{
+  ModesInner        *c = (ModesInner *)ctx;
+  PhlexFlexible      b = c->b;
+  KSPConvergedReason reason;
+  PetscInt           its;
+  char               what[PHLEX_NAME_LEN + 128];
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetConvergedReason(ksp, &reason));
+  PetscCall(KSPGetIterationNumber(ksp, &its));
+  PetscCheck(reason > 0 || (reason != KSP_DIVERGED_INDEFINITE_PC && reason != KSP_DIVERGED_INDEFINITE_MAT), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) stopped at iteration %" PetscInt_FMT ": %s. The shifted operator K - sigma Mv is indefinite where the shift lies above the lowest modes (-modes_target_frequency), and CG solves definite systems only: use -modes_st_ksp_type gmres, or the default factorization", b->name, its, KSPConvergedReasons[reason]);
+  PetscCheck(reason > 0, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) did not reach its tolerance: %s after %" PetscInt_FMT " iterations (-modes_st_ksp_max_it, -modes_st_ksp_rtol); the eigenpairs would be wrong", b->name, KSPConvergedReasons[reason], its);
+  c->solves++;
+  c->its += its;
+  PetscCall(PetscSNPrintf(what, sizeof(what), "modes of body %s: %" PetscInt_FMT " inner solves, %" PetscInt_FMT " iterations", b->name, c->solves, c->its));
+  PetscCall(PhlexProgressPhase(&c->progress, b->comm, what, -1.0));
+  PetscFunctionReturn(0);
+}
+
+/* -modes_st_pc_type mg: the shift-and-invert solves by an iterative KSP with p-multigrid (a body too large for a
+   factorization, BENCHMARKS.md section 46): the two levels and the coarse operator P^T (A - sigma B) P formed before
+   the eigensolver's set-up (the ST forms A - sigma B and sets its KSP up at once), from the shift the ST will use.
+*/
+static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, PetscReal sigma, PhlexPMG *pm)
+{
+  ST          st;
+  KSP         ksp;
+  PetscBool   wanted, sinvert, given;
+  PetscScalar shift;
+  PetscInt    m, rstart, bs, blocks[2] = {0, 1}, off[2];
+  ModesCoarse c;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(PhlexPMGWanted(ksp, &wanted));
+  if (!wanted) PetscFunctionReturn(0);
+  PetscCall(PetscObjectTypeCompare((PetscObject)st, STSINVERT, &sinvert));
+  if (!sinvert) {
+    STType type;
+    PetscCall(STGetType(st, &type));
+    SETERRQ(b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid) solves with the shift-and-invert operator A - sigma B; -modes_st_type %s has another: use -modes_st_type sinvert", type);
+  }
+  PetscCheck(b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid): body %s is of degree %" PetscInt_FMT " (-%spetscspace_degree); its coarse space is the P1 space of a P2 body: use a factorization (the default) or -modes_st_pc_type gamg", b->name, b->degree, b->prefix);
+  /* the shift the ST will take: the user's, else the target (set here, so that STGetShift reads it before set-up) */
+  PetscCall(PetscOptionsHasName(NULL, "modes_", "-st_shift", &given));
+  if (!given) PetscCall(STSetShift(st, sigma));
+  PetscCall(STGetShift(st, &shift));
+  PetscCall(MatGetOwnershipRange(A, &rstart, NULL));
+  PetscCall(MatGetLocalSize(A, &m, NULL));
+  PetscCall(MatGetBlockSize(A, &bs));
+  c.b    = b;
+  c.q    = m - b->nv_local;
+  off[0] = 0;
+  off[1] = b->nv_local;
+  PetscCall(PhlexPMGBuild(ksp, b->comm, m, rstart, bs, A == b->K ? 1 : 2, blocks, off, ModesCoarseSpace, &c, pm));
+  PetscCall(PhlexPMGSetUpPencil(ksp, A, B, shift, pm));
+  PetscFunctionReturn(0);
+}
+
+/* SLEPc's ST makes a KSP that stops short an error of PETSc's, with its traceback, at its set-up: undone before each
+   solve, so that ModesInnerSolveCheck tells what to change */
+static PetscErrorCode ModesInnerSolveNoPETScError(KSP ksp, Vec rhs, Vec x, void *ctx)
+{
+  PetscFunctionBeginUser;
+  PetscCall(KSPSetErrorIfNotConverged(ksp, PETSC_FALSE));
+  PetscFunctionReturn(0);
+}
+
+/* an iterative inner solve (any KSP but preonly) checked after each solve by phlex, which names the option to change */
+static PetscErrorCode ModesInnerSolvesChecked(PhlexFlexible b, EPS eps, ModesInner *c)
+{
+  ST        st;
+  KSP       ksp;
+  PetscBool preonly;
+
+  PetscFunctionBeginUser;
+  PetscCall(EPSGetST(eps, &st));
+  PetscCall(STGetKSP(st, &ksp));
+  PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &preonly));
+  if (preonly) PetscFunctionReturn(0);
+  PetscCall(KSPSetPreSolve(ksp, ModesInnerSolveNoPETScError, NULL));
+  c->b      = b;
+  c->solves = c->its = 0;
+  PetscCall(PhlexProgressStart(&c->progress));
+  PetscCall(KSPSetPostSolve(ksp, ModesInnerSolveCheck, c));
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexFlexibleModesRequestCheck - refuses, before any work, a request of more eigenpairs than the body's eigensolver
   can give in reason: nev elastic modes (plus a free body's six rigid ones) and the subspace of about twice as many
@@ -359,6 +483,8 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   Mat       A = b->K, B = b->Mv;
   IS        is[2] = {NULL, NULL};
   Vec       x = NULL;
+  PhlexPMG  pm = {0};
+  ModesInner inner; /* the KSP's post-solve context: lives until the solve's end */
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
@@ -406,6 +532,8 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     }
   }
   PetscCall(ShiftedOperatorStorage(b, eps, A, B, resid != NULL));
+  PetscCall(ModesPMGSetUp(b, eps, A, B, sigma, &pm));
+  PetscCall(ModesInnerSolvesChecked(b, eps, &inner));
   {
     char what[PHLEX_NAME_LEN + 8];
     PetscCall(PetscSNPrintf(what, sizeof(what), "body %s", part->name));
@@ -477,6 +605,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     PetscCall(ISDestroy(&is[1]));
   }
   PetscCall(EPSDestroy(&eps));
+  PetscCall(PhlexPMGDestroy(&pm));
   PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }

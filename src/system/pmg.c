@@ -10,6 +10,49 @@
 #include <petsc/private/petscimpl.h> /* the PC's options database (whether -pc_mg_levels was given) */
 
 /*@C
+  PhlexPMGSetLevels - ksp's PCMG given phlex's two levels, the P2 velocities and their P1 space, and the levels'
+  options read now (the coarse solver's once: PCMG's first set-up would read them again and undo the LU that
+  PhlexPMGSetUp chooses for a non-symmetric operator); also where the KSP is another process's (a body whole on one
+  process: PCMG reads them at its first set-up, which only the owner makes), and where a run's options are checked
+  before its solve (the levels' options are read only once the levels exist). An explicit -pc_mg_levels is refused.
+
+  Collective on the KSP
+@*/
+PetscErrorCode PhlexPMGSetLevels(KSP ksp)
+{
+  PC          pc;
+  PetscInt    nlevels;
+  const char *prefix;
+  char        name[256];
+  PetscBool   given;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  PetscCall(PetscSNPrintf(name, sizeof(name), "-%spc_mg_levels", prefix ? prefix : ""));
+  PetscCall(PetscOptionsHasName(((PetscObject)pc)->options, NULL, name, &given));
+  PetscCall(PCMGGetLevels(pc, &nlevels));
+  /* phlex sets the levels: a level count from the options would have made PCMG's levels before a body's own
+     prefix was set (their options then not read) */
+  PetscCheck(!given, PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "%s %" PetscInt_FMT ": phlex's p-multigrid sets its two levels itself, the P2 velocities and their P1 space (a coarser hierarchy comes from the coarse solver, -%smg_coarse_pc_type gamg): remove the option", name, nlevels, prefix ? prefix : "");
+  if (nlevels != 2) {
+    /* PCMG's one level: two, and PCMG's own options read again for them (-pc_mg_log, ...) */
+    PetscCall(PCMGSetLevels(pc, 2, NULL));
+    PetscCall(PCSetFromOptions(pc));
+  }
+  PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_NONE));
+  for (PetscInt l = 0; l < 2; l++) {
+    KSP smoother;
+    PetscCall(PCMGGetSmoother(pc, l, &smoother));
+    PetscCall(KSPSetFromOptions(smoother));
+    /* the coarse solver's options are read now: PCMG's first set-up would read them again and undo the LU that
+       PhlexPMGSetUp chooses for a non-symmetric operator (factoring its Cholesky first) */
+    if (!l) PetscCall(KSPSetSkipPCSetFromOptions(smoother, PETSC_TRUE));
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexPMGBuild - for ksp's PCMG: two levels, and the interpolation from the coarse unknowns of the blocks of an operator's rows (each block's own
   coarse space, from fn), and per local coarse unknown its local fine row; once (kept until PhlexPMGDestroy)
 
@@ -36,37 +79,7 @@ PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart
 
   PetscFunctionBeginUser;
   if (pm->P) PetscFunctionReturn(0);
-  {
-    /* two levels, the coarse operator formed here; the levels' options read now, also where the KSP is another
-       process's (a body whole on one process: PCMG reads them at its first set-up, which only the owner makes) */
-    PC       pc;
-    PetscInt nlevels;
-    PetscCall(KSPGetPC(ksp, &pc));
-    const char *prefix;
-    char        name[256];
-    PetscBool   given;
-    PetscCall(PCGetOptionsPrefix(pc, &prefix));
-    PetscCall(PetscSNPrintf(name, sizeof(name), "-%spc_mg_levels", prefix ? prefix : ""));
-    PetscCall(PetscOptionsHasName(((PetscObject)pc)->options, NULL, name, &given));
-    PetscCall(PCMGGetLevels(pc, &nlevels));
-    /* phlex sets the levels: a level count from the options would have made PCMG's levels before a body's own
-       prefix was set (their options then not read) */
-    PetscCheck(!given, PetscObjectComm((PetscObject)pc), PETSC_ERR_USER_INPUT, "%s %" PetscInt_FMT ": phlex's p-multigrid sets its two levels itself, the P2 velocities and their P1 space (a coarser hierarchy comes from the coarse solver, -%smg_coarse_pc_type gamg): remove the option", name, nlevels, prefix ? prefix : "");
-    if (nlevels != 2) {
-      /* PCMG's one level: two, and PCMG's own options read again for them (-pc_mg_log, ...) */
-      PetscCall(PCMGSetLevels(pc, 2, NULL));
-      PetscCall(PCSetFromOptions(pc));
-    }
-    PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_NONE));
-    for (PetscInt l = 0; l < 2; l++) {
-      KSP smoother;
-      PetscCall(PCMGGetSmoother(pc, l, &smoother));
-      PetscCall(KSPSetFromOptions(smoother));
-      /* the coarse solver's options are read now: PCMG's first set-up would read them again and undo the LU that
-         PhlexPMGSetUp chooses for a non-symmetric operator (factoring its Cholesky first) */
-      if (!l) PetscCall(KSPSetSkipPCSetFromOptions(smoother, PETSC_TRUE));
-    }
-  }
+  PetscCall(PhlexPMGSetLevels(ksp));
   PetscCall(PetscMalloc1(PetscMax(nblocks, 1), &n1));
   for (PetscInt i = 0; i < nblocks; i++) {
     PetscCall((*fn)(ctx, blocks[i], 0, 0, NULL, &n1[i], NULL));
@@ -225,6 +238,63 @@ PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
   PetscCall(CoarseSymmetry(pm, A));
   PetscCall(PCMGGetCoarseSolve(pc, &coarse));
   PetscCall(CoarseFactorType(coarse, A));
+  PetscCall(KSPSetOperators(coarse, pm->Ac, pm->Ac));
+  PetscFunctionReturn(0);
+}
+
+/* P^T X P of an operator of any storage (a modal analysis's K and Mv are SBAIJ, which MatPtAP does not take: an AIJ
+   copy for the product only) */
+static PetscErrorCode CoarseProduct(Mat X, Mat P, Mat *C)
+{
+  PetscBool aij;
+  Mat       Xa = X;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectBaseTypeCompareAny((PetscObject)X, &aij, MATSEQAIJ, MATMPIAIJ, ""));
+  if (!aij) PetscCall(MatConvert(X, MATAIJ, MAT_INITIAL_MATRIX, &Xa));
+  PetscCall(MatPtAP(Xa, P, MAT_INITIAL_MATRIX, 2.0, C));
+  if (!aij) PetscCall(MatDestroy(&Xa));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexPMGSetUpPencil - where ksp's preconditioner is PCMG: the interpolation PhlexPMGBuild made and the coarse
+  operator P^T A P - sigma P^T B P of a shift-and-invert solve with A - sigma B (a modal analysis's ST, whose set-up
+  forms the shifted operator and sets its KSP up at once, so the coarse level is formed from the pencil before it).
+  Call once, before the eigensolver's set-up. Other preconditioners: nothing.
+
+  Collective on the KSP
+
+  Input Parameters:
++ ksp   - the ST's KSP
+. A, B  - the pencil (any storage; both symmetric: the coarse operator is flagged so)
+- sigma - the ST's shift
+@*/
+PetscErrorCode PhlexPMGSetUpPencil(KSP ksp, Mat A, Mat B, PetscScalar sigma, PhlexPMG *pm)
+{
+  PC   pc;
+  KSP  coarse;
+  Mat  Bc;
+  PetscBool mg;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  if (!mg) PetscFunctionReturn(0);
+  PetscCheck(pm->P, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: PhlexPMGBuild was not called");
+  PetscCheck(!pm->Ac, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: the pencil's coarse operator is formed once");
+  PetscCall(PCMGSetInterpolation(pc, 1, pm->P));
+  PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
+  PetscCall(CoarseProduct(A, pm->P, &pm->Ac));
+  if (sigma != 0.0) {
+    PetscCall(CoarseProduct(B, pm->P, &Bc));
+    PetscCall(MatAXPY(pm->Ac, -sigma, Bc, UNKNOWN_NONZERO_PATTERN));
+    PetscCall(MatDestroy(&Bc));
+  }
+  PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
+  PetscCall(PetscObjectSetName((PetscObject)pm->Ac, "coarse operator"));
+  PetscCall(MatSetOption(pm->Ac, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(PCMGGetCoarseSolve(pc, &coarse));
   PetscCall(KSPSetOperators(coarse, pm->Ac, pm->Ac));
   PetscFunctionReturn(0);
 }
