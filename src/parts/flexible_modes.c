@@ -319,6 +319,7 @@ static PetscErrorCode ModesInnerSolveCheck(KSP ksp, Vec rhs, Vec x, void *ctx)
   PetscFunctionBeginUser;
   PetscCall(KSPGetConvergedReason(ksp, &reason));
   PetscCall(KSPGetIterationNumber(ksp, &its));
+  PetscCheck(reason > 0 || (reason != KSP_DIVERGED_PC_FAILED && reason != KSP_DIVERGED_NANORINF), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) failed at iteration %" PetscInt_FMT ": %s: the preconditioner (-modes_st_pc_type; p-multigrid's coarse factorization, -modes_st_mg_coarse_pc_type) failed on the shifted operator K - sigma Mv, singular at a shift on an eigenvalue (-modes_st_shift, -modes_target_frequency)", b->name, its, KSPConvergedReasons[reason]);
   PetscCheck(reason > 0 || (reason != KSP_DIVERGED_INDEFINITE_PC && reason != KSP_DIVERGED_INDEFINITE_MAT), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) stopped at iteration %" PetscInt_FMT ": %s. The shifted operator K - sigma Mv is indefinite where the shift lies above the lowest modes (-modes_target_frequency), and CG solves definite systems only: use -modes_st_ksp_type gmres, or the default factorization", b->name, its, KSPConvergedReasons[reason]);
   PetscCheck(reason > 0, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) did not reach its tolerance: %s after %" PetscInt_FMT " iterations (-modes_st_ksp_max_it, -modes_st_ksp_rtol); the eigenpairs would be wrong", b->name, KSPConvergedReasons[reason], its);
   c->solves++;
@@ -332,7 +333,7 @@ static PetscErrorCode ModesInnerSolveCheck(KSP ksp, Vec rhs, Vec x, void *ctx)
    factorization, BENCHMARKS.md section 46): the two levels and the coarse operator P^T (A - sigma B) P formed before
    the eigensolver's set-up (the ST forms A - sigma B and sets its KSP up at once), from the shift the ST will use.
 */
-static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, PetscReal sigma, PhlexPMG *pm)
+static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, PhlexPMG *pm)
 {
   ST          st;
   KSP         ksp;
@@ -353,9 +354,23 @@ static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, Pets
     SETERRQ(b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid) solves with the shift-and-invert operator A - sigma B; -modes_st_type %s has another: use -modes_st_type sinvert", type);
   }
   PetscCheck(b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid): body %s is of degree %" PetscInt_FMT " (-%spetscspace_degree); its coarse space is the P1 space of a P2 body: use a factorization (the default) or -modes_st_pc_type gamg", b->name, b->degree, b->prefix);
-  /* the shift the ST will take: the user's, else the target (set here, so that STGetShift reads it before set-up) */
+  {
+    /* one V-cycle per "solve" (KSP preonly, richardson) would be an operator other than (K - sigma Mv)^{-1}: the
+       eigenpairs silently wrong */
+    PetscBool cycle;
+    KSPType   type;
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)ksp, &cycle, KSPPREONLY, KSPRICHARDSON, ""));
+    PetscCall(KSPGetType(ksp, &type));
+    PetscCheck(!cycle, b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid) with -modes_st_ksp_type %s: the shift-and-invert needs the solves converged, not single cycles: add -modes_st_ksp_type cg (options/solver/modes_iterative.opts)", type);
+  }
+  /* the shift the ST will take: the user's, else the eigensolver's target (-modes_target_frequency, or
+     -modes_eps_target), set here so that STGetShift reads it before the set-up */
   PetscCall(PetscOptionsHasName(NULL, "modes_", "-st_shift", &given));
-  if (!given) PetscCall(STSetShift(st, sigma));
+  if (!given) {
+    PetscScalar target;
+    PetscCall(EPSGetTarget(eps, &target));
+    PetscCall(STSetShift(st, target));
+  }
   PetscCall(STGetShift(st, &shift));
   PetscCall(MatGetOwnershipRange(A, &rstart, NULL));
   PetscCall(MatGetLocalSize(A, &m, NULL));
@@ -373,8 +388,12 @@ static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, Pets
    solve, so that ModesInnerSolveCheck tells what to change */
 static PetscErrorCode ModesInnerSolveNoPETScError(KSP ksp, Vec rhs, Vec x, void *ctx)
 {
+  PC pc;
+
   PetscFunctionBeginUser;
   PetscCall(KSPSetErrorIfNotConverged(ksp, PETSC_FALSE));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetErrorIfFailure(pc, PETSC_FALSE)); /* set by the KSP's set-up inside the ST's */
   PetscFunctionReturn(0);
 }
 
@@ -463,7 +482,8 @@ PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart part, PetscInt nev, PetscInt
   field's: the six rigid modes are the frame's own (v = 0), and the elastic ones solve K v = lambda Mv v on the
   Mv-orthogonal complement of Phi (SLEPc's deflation space), i.e. they are the unconstrained free body's. The frame
   modes come first, with zero elastic vectors and unit rigid parts; -modes_eps_nev then counts the elastic modes
-  only (with a frame patch it counts all, rigid ones included).
+  only (with a frame patch it counts all, rigid ones included). With a target frequency above zero a free body's
+  six rigid modes are deflated the same way (the rigid fields; a floating pencil's rigid unknowns) and listed first.
 
   Options Database Keys:
 + -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)
@@ -485,6 +505,9 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   Vec       x = NULL;
   PhlexPMG  pm = {0};
   ModesInner inner; /* the KSP's post-solve context: lives until the solve's end */
+  PetscBool  deflate;
+  MatNullSpace rigid_fields = NULL; /* the deflated rigid fields of a free body or mean axes */
+  Vec        qmodes[6] = {NULL, NULL, NULL, NULL, NULL, NULL}; /* a floating pencil's deflated rigid unknowns */
 
   PetscFunctionBeginUser;
   PetscCall(PetscLogEventBegin(PHLEX_ModesSolve, 0, 0, 0, 0));
@@ -500,17 +523,35 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(EPSSetOperators(eps, A, B));
   PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(EPSSetTarget(eps, sigma));
-  if (mean_axes) {
-    /* the constraint space: Mv-orthogonal to the rigid fields */
-    MatNullSpace       nsp;
-    const Vec         *rig;
-    PetscInt           nrig;
-    PetscBool          has_const;
-    PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
-    PetscCall(MatNullSpaceGetVecs(nsp, &has_const, &nrig, &rig));
-    PetscCall(EPSSetDeflationSpace(eps, nrig, (Vec *)rig));
-    PetscCall(MatNullSpaceDestroy(&nsp));
-    want -= 6; /* the frame's rigid modes are added below */
+  /* the six rigid modes deflated, known exactly: with mean axes (the constraint space, Mv-orthogonal to the rigid
+     fields: the frame's own modes), and for a free body's modes nearest a target frequency above zero, where they
+     would be computed to the eigensolver's tolerance times the shift (a few mHz at 1 kHz, above the rigid threshold:
+     reported as elastic) and only those nearest the target found (a floating pencil's rigid unknowns: v = 0, q = e_i) */
+  deflate = (PetscBool)(mean_axes || (free_body && flg && sigma > rigid_below));
+  if (deflate) {
+    const Vec *rig;
+    PetscInt   nrig;
+    PetscBool  has_const;
+    if (b->floating && !mean_axes) {
+      const PetscInt *qrows;
+      PetscInt        nq;
+      PetscCall(ISGetLocalSize(is[1], &nq));
+      PetscCall(ISGetIndices(is[1], &qrows));
+      for (PetscInt i = 0; i < 6; i++) {
+        PetscCall(MatCreateVecs(A, &qmodes[i], NULL));
+        PetscCall(VecSet(qmodes[i], 0.0));
+        if (nq == 6) PetscCall(VecSetValue(qmodes[i], qrows[i], 1.0, INSERT_VALUES));
+        PetscCall(VecAssemblyBegin(qmodes[i]));
+        PetscCall(VecAssemblyEnd(qmodes[i]));
+      }
+      PetscCall(ISRestoreIndices(is[1], &qrows));
+      PetscCall(EPSSetDeflationSpace(eps, 6, qmodes));
+    } else {
+      PetscCall(DMPlexCreateRigidBody(b->dm, 0, &rigid_fields));
+      PetscCall(MatNullSpaceGetVecs(rigid_fields, &has_const, &nrig, &rig));
+      PetscCall(EPSSetDeflationSpace(eps, nrig, (Vec *)rig));
+    }
+    want -= 6; /* the rigid modes are added below */
     PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
   }
   PetscCall(EPSSetFromOptions(eps));
@@ -522,7 +563,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     /* the types whose convergence loop passes back-transformed eigenvalues with true residuals (others refuse a
        user test, or pass the shift-and-invert Ritz values) */
     PetscCall(PetscObjectTypeCompareAny((PetscObject)eps, &krylov, EPSKRYLOVSCHUR, EPSARNOLDI, ""));
-    if (free_body && !mean_axes && trueres && krylov && conv == EPS_CONV_REL) {
+    if (free_body && !deflate && trueres && krylov && conv == EPS_CONV_REL) {
       ConvergedRigidCtx *c;
       PetscCall(PetscNew(&c));
       c->rigid_below = rigid_below;
@@ -532,7 +573,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     }
   }
   PetscCall(ShiftedOperatorStorage(b, eps, A, B, resid != NULL));
-  PetscCall(ModesPMGSetUp(b, eps, A, B, sigma, &pm));
+  PetscCall(ModesPMGSetUp(b, eps, A, B, &pm));
   PetscCall(ModesInnerSolvesChecked(b, eps, &inner));
   {
     char what[PHLEX_NAME_LEN + 8];
@@ -543,11 +584,12 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(EPSGetConverged(eps, &n));
   /* a modal analysis that has fewer pairs than asked for says so (a transient's initial mode and the convergence
      study check the modes they need) */
-  PetscCheck(!resid || n >= want, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs asked of the eigensolver converged (-modes_nev%s, or -modes_eps_nev): raise -modes_eps_max_it or loosen -modes_eps_tol (with -modes_eps_true_residual a relative residual cannot go below the round-off of ||K x|| / lambda, about 1e-11 for a P2 bar)", part->name, n, want, free_body && !mean_axes ? " plus the 6 rigid-body modes" : "");
+  PetscCheck(!resid || n >= want, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: %" PetscInt_FMT " of the %" PetscInt_FMT " eigenpairs asked of the eigensolver converged (-modes_nev%s, or -modes_eps_nev): raise -modes_eps_max_it or loosen -modes_eps_tol (with -modes_eps_true_residual a relative residual cannot go below the round-off of ||K x|| / lambda, about 1e-11 for a P2 bar)", part->name, n, want, free_body && !deflate ? " plus the 6 rigid-body modes" : "");
   n = PetscMin(n, want);
   {
-    /* mean axes: the frame's six rigid modes (v = 0) come first */
-    const PetscInt r0 = mean_axes ? 6 : 0, ntot = n + r0;
+    /* the deflated rigid modes come first: a floating body's frame modes (v = 0, its rigid part e_i), a free body's
+       rigid fields */
+    const PetscInt r0 = deflate ? 6 : 0, ntot = n + r0;
     /* the eigenvectors are copied out only for the caller's copies or a floating pencil's rigid parts */
     const PetscBool need_x = (PetscBool)(vecs || (rigid && b->floating && !mean_axes));
     PetscCall(PetscMalloc1(ntot, lambda));
@@ -559,9 +601,21 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
       if (resid) (*resid)[i] = 0.0;
       if (vecs) {
         PetscCall(MatCreateVecs(b->K, &(*vecs)[i], NULL));
-        PetscCall(VecSet((*vecs)[i], 0.0));
+        if (b->floating) PetscCall(VecSet((*vecs)[i], 0.0));
+        else {
+          /* the rigid field, Mv-normalised as the eigenvectors */
+          const Vec  *rig;
+          PetscInt    nrig;
+          PetscBool   has_const;
+          PetscScalar mm;
+          PetscCall(MatNullSpaceGetVecs(rigid_fields, &has_const, &nrig, &rig));
+          PetscCall(MatMult(b->Mv, rig[i], (*vecs)[i]));
+          PetscCall(VecDot((*vecs)[i], rig[i], &mm));
+          PetscCall(VecCopy(rig[i], (*vecs)[i]));
+          PetscCall(VecScale((*vecs)[i], 1.0 / PetscSqrtReal(PetscRealPart(mm))));
+        }
       }
-      if (rigid) (*rigid)[6 * i + i] = 1.0;
+      if (rigid && b->floating) (*rigid)[6 * i + i] = 1.0;
     }
     *nrigid = r0;
     if (resid) PetscCall(EigenpairResiduals(eps, n, rigid_below, *resid + r0));
@@ -606,6 +660,8 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   }
   PetscCall(EPSDestroy(&eps));
   PetscCall(PhlexPMGDestroy(&pm));
+  PetscCall(MatNullSpaceDestroy(&rigid_fields));
+  for (PetscInt i = 0; i < 6; i++) PetscCall(VecDestroy(&qmodes[i]));
   PetscCall(PetscLogEventEnd(PHLEX_ModesSolve, 0, 0, 0, 0));
   PetscFunctionReturn(0);
 }

@@ -42,8 +42,8 @@ static PetscErrorCode VertexColumns(PhlexFlexible b, PetscInt col0, PetscInt **g
   }
   /* every process learns of a partly constrained vertex before the collective broadcast below */
   PetscCallMPI(MPI_Allreduce(MPI_IN_PLACE, &bad, 1, MPIU_INT, MPI_MAX, b->comm));
-  PetscCheck(bad < 100, b->comm, PETSC_ERR_SUP, "body %s: p-multigrid's P1 coarse space needs three velocity components at each vertex (a vertex has %" PetscInt_FMT "): use a preset without p-multigrid (options/solver/iterative_gamg.opts, bordered_iterative_gamg.opts)", b->name, bad - 100);
-  PetscCheck(bad < 0, b->comm, PETSC_ERR_SUP, "body %s: p-multigrid's P1 coarse space needs each vertex's three velocity components all free or all constrained (a vertex has %" PetscInt_FMT " of 3 constrained): use a preset without p-multigrid (options/solver/iterative_gamg.opts, bordered_iterative_gamg.opts)", b->name, bad);
+  PetscCheck(bad < 100, b->comm, PETSC_ERR_SUP, "body %s: p-multigrid's P1 coarse space needs three velocity components at each vertex (a vertex has %" PetscInt_FMT "): use a preset without p-multigrid (options/solver/iterative_gamg.opts, bordered_iterative_gamg.opts; a modal analysis: the default factorization)", b->name, bad - 100);
+  PetscCheck(bad < 0, b->comm, PETSC_ERR_SUP, "body %s: p-multigrid's P1 coarse space needs each vertex's three velocity components all free or all constrained (a vertex has %" PetscInt_FMT " of 3 constrained): use a preset without p-multigrid (options/solver/iterative_gamg.opts, bordered_iterative_gamg.opts; a modal analysis: the default factorization)", b->name, bad);
   PetscCall(PetscArraycpy(*gcol, root, pEnd - pStart));
   PetscCall(DMGetPointSF(b->dm, &sf));
   PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
