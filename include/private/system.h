@@ -135,7 +135,7 @@ PETSC_INTERN PetscErrorCode PhlexPMGWanted(KSP, PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexPMGSetLevels(KSP);
 PETSC_INTERN PetscErrorCode PhlexPMGBuild(KSP, MPI_Comm, PetscInt, PetscInt, PetscInt, PetscInt, const PetscInt[], const PetscInt[], PhlexCoarseSpaceFn, void *, PhlexPMG *);
 PETSC_INTERN PetscErrorCode PhlexPMGSetUp(KSP, Mat, PhlexPMG *);
-PETSC_INTERN PetscErrorCode PhlexPMGSetUpPencil(KSP, Mat, Mat, PetscScalar, PhlexPMG *);
+PETSC_INTERN PetscErrorCode PhlexPMGSetUpPencil(KSP, Mat, Mat, PetscScalar, MatNullSpace, PhlexPMG *);
 /* border.c: block i's coarse space (a part's own, or its unknowns carried): a PhlexCoarseSpaceFn on the system */
 PETSC_INTERN PetscErrorCode PhlexSystemCoarseSpace(void *, PetscInt, PetscInt, PetscInt, Mat, PetscInt *, PetscInt[]);
 PETSC_INTERN PetscErrorCode PhlexPMGView(PhlexPMG *, PetscViewer);

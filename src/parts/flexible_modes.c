@@ -380,7 +380,14 @@ static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, Phle
   off[0] = 0;
   off[1] = b->nv_local;
   PetscCall(PhlexPMGBuild(ksp, b->comm, m, rstart, bs, A == b->K ? 1 : 2, blocks, off, ModesCoarseSpace, &c, pm));
-  PetscCall(PhlexPMGSetUpPencil(ksp, A, B, shift, pm));
+  {
+    /* the rigid-body modes, for a GAMG on the coarse level (-modes_st_mg_coarse_pc_type gamg): the body's rigid
+       fields (a floating pencil's rigid unknowns: carried, left out) */
+    MatNullSpace nsp = NULL;
+    if (A == b->K) PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
+    PetscCall(PhlexPMGSetUpPencil(ksp, A, B, shift, nsp, pm));
+    PetscCall(MatNullSpaceDestroy(&nsp));
+  }
   PetscFunctionReturn(0);
 }
 

@@ -111,17 +111,16 @@ PetscErrorCode PhlexPMGBuild(KSP ksp, MPI_Comm comm, PetscInt m, PetscInt rstart
   PetscFunctionReturn(0);
 }
 
-/* the fine operator's near-null space at the coarse unknowns (injection), orthonormalised */
-static PetscErrorCode CoarseRigidModes(PhlexPMG *pm, Mat A)
+/* a fine near-null space (the rigid-body modes) at the coarse unknowns (injection), orthonormalised, as the coarse
+   operator's (for a GAMG below) */
+static PetscErrorCode CoarseRigidModes(PhlexPMG *pm, MatNullSpace nsp)
 {
-  MatNullSpace       nsp;
   PetscBool          has_const;
   PetscInt           n;
   const Vec         *v;
   Vec               *vc;
 
   PetscFunctionBeginUser;
-  PetscCall(MatGetNearNullSpace(A, &nsp));
   if (!nsp) PetscFunctionReturn(0);
   PetscCall(MatNullSpaceGetVecs(nsp, &has_const, &n, &v));
   if (!n) PetscFunctionReturn(0);
@@ -144,7 +143,7 @@ static PetscErrorCode CoarseRigidModes(PhlexPMG *pm, Mat A)
       }
     PetscCall(VecNormalize(vc[j], NULL));
   }
-  PetscCall(MatNullSpaceCreate(PetscObjectComm((PetscObject)A), PETSC_FALSE, n, vc, &nsp));
+  PetscCall(MatNullSpaceCreate(PetscObjectComm((PetscObject)pm->Ac), PETSC_FALSE, n, vc, &nsp));
   PetscCall(MatSetNearNullSpace(pm->Ac, nsp));
   PetscCall(MatNullSpaceDestroy(&nsp));
   for (PetscInt j = 0; j < n; j++) PetscCall(VecDestroy(&vc[j]));
@@ -229,7 +228,11 @@ PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
     PetscCall(MatPtAP(A, pm->P, MAT_INITIAL_MATRIX, 2.0, &pm->Ac));
     PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
     PetscCall(PetscObjectSetName((PetscObject)pm->Ac, "coarse operator"));
-    PetscCall(CoarseRigidModes(pm, A));
+    {
+      MatNullSpace nsp;
+      PetscCall(MatGetNearNullSpace(A, &nsp));
+      PetscCall(CoarseRigidModes(pm, nsp));
+    }
   } else if (change == PHLEX_MAT_VALUES) {
     PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
     PetscCall(MatPtAP(A, pm->P, MAT_REUSE_MATRIX, 2.0, &pm->Ac));
@@ -268,9 +271,10 @@ static PetscErrorCode CoarseProduct(Mat X, Mat P, Mat *C)
   Input Parameters:
 + ksp   - the ST's KSP
 . A, B  - the pencil (any storage; both symmetric: the coarse operator is flagged so)
-- sigma - the ST's shift
+. sigma - the ST's shift
+- nsp   - the rigid-body modes in A's layout (the coarse operator's near-null space, for a GAMG below), or NULL
 @*/
-PetscErrorCode PhlexPMGSetUpPencil(KSP ksp, Mat A, Mat B, PetscScalar sigma, PhlexPMG *pm)
+PetscErrorCode PhlexPMGSetUpPencil(KSP ksp, Mat A, Mat B, PetscScalar sigma, MatNullSpace nsp, PhlexPMG *pm)
 {
   PC   pc;
   KSP  coarse;
@@ -294,6 +298,7 @@ PetscErrorCode PhlexPMGSetUpPencil(KSP ksp, Mat A, Mat B, PetscScalar sigma, Phl
   PetscCall(PetscLogEventEnd(PHLEX_PMGCoarse, 0, 0, 0, 0));
   PetscCall(PetscObjectSetName((PetscObject)pm->Ac, "coarse operator"));
   PetscCall(MatSetOption(pm->Ac, MAT_SYMMETRIC, PETSC_TRUE));
+  PetscCall(CoarseRigidModes(pm, nsp));
   PetscCall(PCMGGetCoarseSolve(pc, &coarse));
   PetscCall(KSPSetOperators(coarse, pm->Ac, pm->Ac));
   PetscFunctionReturn(0);
