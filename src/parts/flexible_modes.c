@@ -321,7 +321,7 @@ static PetscErrorCode ModesInnerSolveCheck(KSP ksp, Vec rhs, Vec x, void *ctx)
   PetscCall(KSPGetIterationNumber(ksp, &its));
   PetscCheck(reason > 0 || (reason != KSP_DIVERGED_PC_FAILED && reason != KSP_DIVERGED_NANORINF), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) failed at iteration %" PetscInt_FMT ": %s: the preconditioner (-modes_st_pc_type; p-multigrid's coarse factorization, -modes_st_mg_coarse_pc_type) failed on the shifted operator K - sigma Mv, singular at a shift on an eigenvalue (-modes_st_shift, -modes_target_frequency)", b->name, its, KSPConvergedReasons[reason]);
   PetscCheck(reason > 0 || (reason != KSP_DIVERGED_INDEFINITE_PC && reason != KSP_DIVERGED_INDEFINITE_MAT), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) stopped at iteration %" PetscInt_FMT ": %s. The shifted operator K - sigma Mv is indefinite where the shift lies above the lowest modes (-modes_target_frequency), and CG solves definite systems only: use -modes_st_ksp_type gmres, or the default factorization", b->name, its, KSPConvergedReasons[reason]);
-  PetscCheck(reason > 0, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) did not reach its tolerance: %s after %" PetscInt_FMT " iterations (-modes_st_ksp_max_it, -modes_st_ksp_rtol); the eigenpairs would be wrong", b->name, KSPConvergedReasons[reason], its);
+  PetscCheck(reason > 0 && reason != KSP_CONVERGED_ITS, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: an inner solve of the modal analysis (-modes_st_ksp_type) did not reach its tolerance: %s after %" PetscInt_FMT " iterations (-modes_st_ksp_max_it, -modes_st_ksp_rtol%s); the eigenpairs would be wrong", b->name, KSPConvergedReasons[reason], its, reason == KSP_CONVERGED_ITS ? "; -modes_st_ksp_norm_type none tests no residual" : "");
   c->solves++;
   c->its += its;
   PetscCall(PetscSNPrintf(what, sizeof(what), "modes of body %s: %" PetscInt_FMT " inner solves, %" PetscInt_FMT " iterations", b->name, c->solves, c->its));
@@ -415,7 +415,18 @@ static PetscErrorCode ModesInnerSolvesChecked(PhlexFlexible b, EPS eps, ModesInn
   PetscCall(EPSGetST(eps, &st));
   PetscCall(STGetKSP(st, &ksp));
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &preonly));
-  if (preonly) PetscFunctionReturn(0);
+  if (preonly) {
+    /* one application of a preconditioner that is not a direct solve would stand for the inverse: the eigenpairs of
+       another operator, silently */
+    PC        pc;
+    PCType    type;
+    PetscBool direct;
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &direct, PCCHOLESKY, PCLU, PCREDUNDANT, PCQR, PCSVD, PCKSP, ""));
+    PetscCall(PCGetType(pc, &type));
+    PetscCheck(direct, b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type %s with -modes_st_ksp_type preonly: one application of the preconditioner would stand for the shift-and-invert's solve (the eigenpairs of another operator); give a Krylov method (-modes_st_ksp_type cg, options/solver/modes_iterative.opts) or a factorization (-modes_st_pc_type cholesky, the default)", type ? type : "(none)");
+    PetscFunctionReturn(0);
+  }
   PetscCall(KSPSetPreSolve(ksp, ModesInnerSolveNoPETScError, NULL));
   c->b      = b;
   c->solves = c->its = 0;
@@ -475,9 +486,11 @@ PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart part, PetscInt nev, PetscInt
   Output Parameters:
 + nconv  - number of eigenpairs returned
 . nrigid - how many of them are rigid-body modes (|lambda| below 1e-6 of the elastic frequency scale squared)
-. lambda - eigenvalues (ascending)
-. vecs   - eigenvectors (Mv-normalised; the elastic part of a floating body's), may be NULL
-. rigid  - floating body: the rigid part (v_P, w_P) of each eigenvector, 6 per mode, on every rank; may be NULL
+. lambda - eigenvalues (ascending; with a target frequency, by their distance to it after the rigid modes)
+. vecs   - eigenvectors (Mv-normalised; the elastic part of a floating body's; deflated rigid modes: a free body's
+           rigid fields, each Mv-normalised but not Mv-orthogonal to the others, a floating body's zero), may be NULL
+. rigid  - floating body: the rigid part (v_P, w_P) of each eigenvector, 6 per mode, on every rank (a deflated rigid
+           mode's: e_i); may be NULL
 - resid  - relative residual norms ||K x - lambda Mv x|| / (|lambda| ||x||) (rigid modes: the backward error
            ||K x - lambda Mv x|| / ((||K|| + |lambda| ||Mv||) ||x||)), may be NULL: then the caller (a transient's
            initial condition) keeps K bit for bit (the shifted operator is not formed in K's storage)
@@ -489,11 +502,13 @@ PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart part, PetscInt nev, PetscInt
   field's: the six rigid modes are the frame's own (v = 0), and the elastic ones solve K v = lambda Mv v on the
   Mv-orthogonal complement of Phi (SLEPc's deflation space), i.e. they are the unconstrained free body's. The frame
   modes come first, with zero elastic vectors and unit rigid parts; -modes_eps_nev then counts the elastic modes
-  only (with a frame patch it counts all, rigid ones included). With a target frequency above zero a free body's
-  six rigid modes are deflated the same way (the rigid fields; a floating pencil's rigid unknowns) and listed first.
+  only (with a frame patch it counts all, rigid ones included). With -modes_target_frequency at least a tenth of the
+  body's frequency scale (its estimated first bending frequency) a free body's six rigid modes are deflated the same
+  way (the rigid fields; a floating pencil's rigid unknowns: v = 0, q = e_i) and listed first; -modes_eps_nev then
+  counts the elastic modes only. (SLEPc's own -modes_eps_target does not deflate them.)
 
   Options Database Keys:
-+ -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body)
++ -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body whose rigid modes are not deflated)
 . -modes_target_frequency <Hz>    - look for modes nearest this frequency (default: lowest)
 - -modes_eps_*, -modes_st_*       - any SLEPc EPS/ST option; defaults: phlexblock (block Krylov-Schur), shift-and-invert, Cholesky (MUMPS)
 @*/
@@ -534,7 +549,10 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
      fields: the frame's own modes), and for a free body's modes nearest a target frequency above zero, where they
      would be computed to the eigensolver's tolerance times the shift (a few mHz at 1 kHz, above the rigid threshold:
      reported as elastic) and only those nearest the target found (a floating pencil's rigid unknowns: v = 0, q = e_i) */
-  deflate = (PetscBool)(mean_axes || (free_body && flg && sigma > rigid_below));
+  /* (from a tenth of the frequency scale: below it the rigid modes are the pairs nearest the target and come out to
+     the tolerance times the shift, far below rigid_below; and a deflation vector nearly in the null space of
+     A - sigma B would be attached to the ST's operator as its null space, which an iterative inner solve projects out) */
+  deflate = (PetscBool)(mean_axes || (free_body && flg && sigma >= 1e-2 * omega * omega));
   if (deflate) {
     const Vec *rig;
     PetscInt   nrig;
@@ -556,6 +574,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     } else {
       PetscCall(DMPlexCreateRigidBody(b->dm, 0, &rigid_fields));
       PetscCall(MatNullSpaceGetVecs(rigid_fields, &has_const, &nrig, &rig));
+      PetscCheck(nrig == 6, b->comm, PETSC_ERR_PLIB, "body %s: %" PetscInt_FMT " rigid-body fields, not 6", b->name, nrig);
       PetscCall(EPSSetDeflationSpace(eps, nrig, (Vec *)rig));
     }
     want -= 6; /* the rigid modes are added below */
