@@ -195,6 +195,25 @@ static PetscErrorCode CoarseFactorType(KSP coarse, Mat A)
   PetscFunctionReturn(0);
 }
 
+/* ksp's PCMG with the interpolation PhlexPMGBuild made (NULL: another preconditioner) */
+static PetscErrorCode BuiltPMG(KSP ksp, PhlexPMG *pm, PC *mgpc)
+{
+  PC        pc;
+  PetscBool mg;
+  Mat       Pnow;
+
+  PetscFunctionBeginUser;
+  *mgpc = NULL;
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
+  if (!mg) PetscFunctionReturn(0);
+  PetscCheck(pm->P, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: PhlexPMGBuild was not called");
+  PetscCall(PCMGGetInterpolation(pc, 1, &Pnow));
+  if (Pnow != pm->P) PetscCall(PCMGSetInterpolation(pc, 1, pm->P));
+  *mgpc = pc;
+  PetscFunctionReturn(0);
+}
+
 /*@C
   PhlexPMGSetUp - where ksp's preconditioner is PCMG (not GAMG): the interpolation PhlexPMGBuild made and the coarse
   operator P^T A P, formed again when A's values changed. Call after KSPSetOperators, before the KSP's set-up. Other
@@ -208,19 +227,13 @@ static PetscErrorCode CoarseFactorType(KSP coarse, Mat A)
 @*/
 PetscErrorCode PhlexPMGSetUp(KSP ksp, Mat A, PhlexPMG *pm)
 {
-  PC               pc;
-  PetscBool        mg;
-  PhlexMatChange   change;
-  KSP              coarse;
-  Mat              Pnow;
+  PC             pc;
+  PhlexMatChange change;
+  KSP            coarse;
 
   PetscFunctionBeginUser;
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
-  if (!mg) PetscFunctionReturn(0);
-  PetscCheck(pm->P, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: PhlexPMGBuild was not called");
-  PetscCall(PCMGGetInterpolation(pc, 1, &Pnow));
-  if (Pnow != pm->P) PetscCall(PCMGSetInterpolation(pc, 1, pm->P));
+  PetscCall(BuiltPMG(ksp, pm, &pc));
+  if (!pc) PetscFunctionReturn(0);
   PetscCall(PhlexMatWatchCheck(&pm->A, A, &change));
   if (!pm->Ac || change == PHLEX_MAT_NEW) {
     PetscCall(MatDestroy(&pm->Ac));
@@ -276,18 +289,14 @@ static PetscErrorCode CoarseProduct(Mat X, Mat P, Mat *C)
 @*/
 PetscErrorCode PhlexPMGSetUpPencil(KSP ksp, Mat A, Mat B, PetscScalar sigma, MatNullSpace nsp, PhlexPMG *pm)
 {
-  PC   pc;
-  KSP  coarse;
-  Mat  Bc;
-  PetscBool mg;
+  PC  pc;
+  KSP coarse;
+  Mat Bc;
 
   PetscFunctionBeginUser;
-  PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &mg));
-  if (!mg) PetscFunctionReturn(0);
-  PetscCheck(pm->P, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: PhlexPMGBuild was not called");
+  PetscCall(BuiltPMG(ksp, pm, &pc));
+  if (!pc) PetscFunctionReturn(0);
   PetscCheck(!pm->Ac, PetscObjectComm((PetscObject)ksp), PETSC_ERR_ORDER, "p-multigrid: the pencil's coarse operator is formed once");
-  PetscCall(PCMGSetInterpolation(pc, 1, pm->P));
   PetscCall(PetscLogEventBegin(PHLEX_PMGCoarse, 0, 0, 0, 0));
   PetscCall(CoarseProduct(A, pm->P, &pm->Ac));
   if (sigma != 0.0) {
