@@ -353,7 +353,7 @@ static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, Phle
     PetscCall(STGetType(st, &type));
     SETERRQ(b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid) solves with the shift-and-invert operator A - sigma B; -modes_st_type %s has another: use -modes_st_type sinvert", type);
   }
-  PetscCheck(b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid): body %s is of degree %" PetscInt_FMT " (-%spetscspace_degree); its coarse space is the P1 space of a P2 body: use a factorization (the default) or -modes_st_pc_type gamg", b->name, b->degree, b->prefix);
+  PetscCheck(b->degree == 2, b->comm, PETSC_ERR_USER_INPUT, "-modes_st_pc_type mg (p-multigrid): body %s is of degree %" PetscInt_FMT " (-%spetscspace_degree); its coarse space is the P1 space of a P2 body: use a factorization (the default) or -modes_st_ksp_type cg -modes_st_pc_type gamg", b->name, b->degree, b->prefix);
   {
     /* one V-cycle per "solve" (KSP preonly, richardson) would be an operator other than (K - sigma Mv)^{-1}: the
        eigenpairs silently wrong */
@@ -546,12 +546,12 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(EPSSetTarget(eps, sigma));
   /* the six rigid modes deflated, known exactly: with mean axes (the constraint space, Mv-orthogonal to the rigid
-     fields: the frame's own modes), and for a free body's modes nearest a target frequency above zero, where they
-     would be computed to the eigensolver's tolerance times the shift (a few mHz at 1 kHz, above the rigid threshold:
-     reported as elastic) and only those nearest the target found (a floating pencil's rigid unknowns: v = 0, q = e_i) */
-  /* (from a tenth of the frequency scale: below it the rigid modes are the pairs nearest the target and come out to
-     the tolerance times the shift, far below rigid_below; and a deflation vector nearly in the null space of
-     A - sigma B would be attached to the ST's operator as its null space, which an iterative inner solve projects out) */
+     fields: the frame's own modes), and for a free body's modes nearest a target frequency from a tenth of the
+     frequency scale up, where they would be computed to the eigensolver's tolerance times the shift (a few mHz at
+     1 kHz, above the rigid threshold: reported as elastic) and only those nearest the target found (a floating
+     pencil's rigid unknowns: v = 0, q = e_i). Below a tenth the rigid modes are the pairs nearest the target and come
+     out far below rigid_below, and a deflation vector nearly in the null space of A - sigma B would be attached to the
+     ST's operator as its null space, which an iterative inner solve projects out. */
   deflate = (PetscBool)(mean_axes || (free_body && flg && sigma >= 1e-2 * omega * omega));
   if (deflate) {
     const Vec *rig;
