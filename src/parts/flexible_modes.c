@@ -333,7 +333,7 @@ static PetscErrorCode ModesInnerSolveCheck(KSP ksp, Vec rhs, Vec x, void *ctx)
    factorization, BENCHMARKS.md section 46): the two levels and the coarse operator P^T (A - sigma B) P formed before
    the eigensolver's set-up (the ST forms A - sigma B and sets its KSP up at once), from the shift the ST will use.
 */
-static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, PhlexPMG *pm)
+static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, MatNullSpace rigid_fields, PhlexPMG *pm)
 {
   ST          st;
   KSP         ksp;
@@ -382,9 +382,12 @@ static PetscErrorCode ModesPMGSetUp(PhlexFlexible b, EPS eps, Mat A, Mat B, Phle
   PetscCall(PhlexPMGBuild(ksp, b->comm, m, rstart, bs, A == b->K ? 1 : 2, blocks, off, ModesCoarseSpace, &c, pm));
   {
     /* the rigid-body modes, for a GAMG on the coarse level (-modes_st_mg_coarse_pc_type gamg): the body's rigid
-       fields (a floating pencil's rigid unknowns: carried, left out) */
+       fields, the deflation's where it made them (a floating pencil's rigid unknowns: carried, left out) */
     MatNullSpace nsp = NULL;
-    if (A == b->K) PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
+    if (A == b->K && rigid_fields) {
+      nsp = rigid_fields;
+      PetscCall(PetscObjectReference((PetscObject)nsp));
+    } else if (A == b->K) PetscCall(DMPlexCreateRigidBody(b->dm, 0, &nsp));
     PetscCall(PhlexPMGSetUpPencil(ksp, A, B, shift, nsp, pm));
     PetscCall(MatNullSpaceDestroy(&nsp));
   }
@@ -599,7 +602,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     }
   }
   PetscCall(ShiftedOperatorStorage(b, eps, A, B, resid != NULL));
-  PetscCall(ModesPMGSetUp(b, eps, A, B, &pm));
+  PetscCall(ModesPMGSetUp(b, eps, A, B, rigid_fields, &pm));
   PetscCall(ModesInnerSolvesChecked(b, eps, &inner));
   {
     char what[PHLEX_NAME_LEN + 8];
