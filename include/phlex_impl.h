@@ -229,6 +229,10 @@ PETSC_INTERN PetscErrorCode PhlexLocalMDot(Vec, PetscInt, const Vec[], PetscReal
 PETSC_INTERN PetscErrorCode PhlexSplitSumBegin(MPI_Comm, const PetscReal *, PetscReal *, PetscInt, MPI_Request *);
 PETSC_INTERN PetscErrorCode PhlexSplitSumEnd(MPI_Request *);
 
+/* blas.c: OpenBLAS's kernels where it does not know the processor */
+PETSC_INTERN PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm);
+PETSC_INTERN PetscErrorCode PhlexBLASView(PetscViewer);
+
 /* memory.c: freed heap memory returned to the operating system */
 PETSC_INTERN PetscErrorCode PhlexReturnFreedMemory(void);
 

@@ -58,6 +58,7 @@ static PetscErrorCode Run(PhlexScene *scene)
   PetscFunctionBeginUser;
   PetscCall(PhlexLogStagePush("Phlex Setup", &PHLEX_StageSetup));
   if (help_mode == PHLEX_HELP_OPTIONS) PetscCall(SetHelpCatalogue(&catalogue));
+  PetscCall(PhlexBLASSetFromOptions(PETSC_COMM_WORLD)); /* before the first BLAS call */
   PetscCall(PhlexSceneCreate(PETSC_COMM_WORLD, scene));
   PetscCall(PhlexSceneSetFromOptions(*scene));
   if (help_mode != PHLEX_HELP_OPTIONS) {

@@ -235,6 +235,7 @@ PetscErrorCode PhlexSceneView(PhlexScene s, PetscViewer viewer)
   if (s->njoints) PetscCall(PetscViewerASCIIPrintf(viewer, ", %" PetscInt_FMT " joint%s", s->njoints, s->njoints == 1 ? "" : "s"));
   PetscCall(PetscViewerASCIIPrintf(viewer, "\n"));
   PetscCall(PetscViewerASCIIPushTab(viewer));
+  PetscCall(PhlexBLASView(viewer));
   if (s->gravity[0] != 0 || s->gravity[1] != 0 || s->gravity[2] != 0) PetscCall(PetscViewerASCIIPrintf(viewer, "gravity (%.15g, %.15g, %.15g) m/s^2 (inertial frame)\n", (double)s->gravity[0], (double)s->gravity[1], (double)s->gravity[2]));
   for (PetscInt k = 0; k < s->nparts; k++) PetscCall(PhlexPartView(s->parts[k], viewer));
   for (PetscInt k = 0; k < s->njoints; k++) PetscCall(PhlexJointView(s->joints[k], viewer));

@@ -1,0 +1,94 @@
+/* The BLAS kernels OpenBLAS runs on this processor.
+
+   OpenBLAS built for many processors (DYNAMIC_ARCH, as Debian's libopenblas0 is) picks its kernels from the CPU's
+   family and model at load time. Debian bookworm's OpenBLAS 0.3.21 does not list Intel's Emerald Rapids (family 6
+   model 207) and, where a family-6 model is missing from its table, falls through to the kernels of the Prescott
+   Pentium 4 (SSE3) instead of choosing by the CPU's features as it does for other unknown processors; its dgemm then
+   runs at 14 instead of 64 GFlop/s, and CHOLMOD's and MUMPS's
+   factorizations take 1.6-2.1 x as long (BENCHMARKS.md section 47). OpenBLAS's remedy is OPENBLAS_CORETYPE, read when
+   the library loads, before phlex runs: phlex sets it and has OpenBLAS choose again (its own gotoblas_dynamic_quit
+   and gotoblas_dynamic_init), before the first BLAS call. Automatic only where OpenBLAS fell back to Prescott on a
+   processor with AVX-512 or AVX2 (a real Prescott has neither) and OPENBLAS_CORETYPE is not set; -openblas_coretype
+   names kernels or keeps OpenBLAS's choice. Nothing happens with another BLAS. */
+#define _GNU_SOURCE /* RTLD_DEFAULT */
+#include <phlex_impl.h>
+#include <dlfcn.h>
+
+static char blas_note[256]; /* what was changed, for the scene's summary ("" if nothing) */
+
+typedef char *(*CoreNameFn)(void);
+typedef void (*DynamicFn)(void);
+
+/* the kernels to use where OpenBLAS fell back to Prescott's (NULL: keep them) */
+static const char *AutoCore(void)
+{
+  __builtin_cpu_init();
+  /* OpenBLAS's own choice by features (its gotoblas_dynamic_init for an unknown processor) */
+  if (__builtin_cpu_supports("avx512bf16")) return "Cooperlake";
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")) return "SkylakeX";
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return "Haswell";
+  if (__builtin_cpu_supports("avx")) return "Sandybridge";
+  return NULL;
+}
+
+/*@C
+  PhlexBLASSetFromOptions - chooses OpenBLAS's kernels where it does not know the processor; before any BLAS call
+
+  Collective
+
+  Options Database Keys:
+. -openblas_coretype <auto|keep|name> - auto: where OpenBLAS fell back to its Prescott kernels on a processor with
+                                        AVX-512 or AVX2, the kernels it chooses by the CPU's features (Cooperlake, SkylakeX, Haswell); keep: OpenBLAS's choice; or the name
+                                        of OpenBLAS kernels (as OPENBLAS_CORETYPE)
+@*/
+PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
+{
+  char        value[64] = "auto", was[32];
+  const char *env       = getenv("OPENBLAS_CORETYPE"), *want = NULL;
+  PetscBool   set, isauto, iskeep, same;
+  CoreNameFn  corename = (CoreNameFn)dlsym(RTLD_DEFAULT, "openblas_get_corename");
+  DynamicFn   quit     = (DynamicFn)dlsym(RTLD_DEFAULT, "gotoblas_dynamic_quit");
+  DynamicFn   init     = (DynamicFn)dlsym(RTLD_DEFAULT, "gotoblas_dynamic_init");
+
+  PetscFunctionBeginUser;
+  blas_note[0] = 0;
+  PetscOptionsBegin(comm, NULL, "BLAS options", NULL);
+  PetscCall(PetscOptionsString("-openblas_coretype", "OpenBLAS kernels: auto (where OpenBLAS fell back to its Prescott kernels on a processor with AVX-512 or AVX2, as 0.3.21 does on processors newer than it: those it chooses by the CPU's features, Cooperlake, SkylakeX or Haswell), keep (OpenBLAS's choice), or a name as in OPENBLAS_CORETYPE (SkylakeX, Haswell, Zen, ...)", "PhlexBLASSetFromOptions", value, value, sizeof(value), &set));
+  PetscOptionsEnd();
+  PetscCall(PetscStrcasecmp(value, "auto", &isauto));
+  PetscCall(PetscStrcasecmp(value, "keep", &iskeep));
+  if (iskeep || (isauto && env)) PetscFunctionReturn(0); /* OpenBLAS read OPENBLAS_CORETYPE itself */
+  if (!corename || !quit || !init) {
+    PetscCheck(isauto, comm, PETSC_ERR_USER_INPUT, "-openblas_coretype %s: the BLAS phlex runs with is not OpenBLAS with kernels for several processors (DYNAMIC_ARCH); use auto or keep", value);
+    PetscFunctionReturn(0);
+  }
+  PetscCall(PetscStrncpy(was, corename(), sizeof(was)));
+  if (isauto) {
+    PetscCall(PetscStrcasecmp(was, "Prescott", &same));
+    if (!same || !(want = AutoCore())) PetscFunctionReturn(0);
+  } else want = value;
+  PetscCall(PetscStrcasecmp(was, want, &same));
+  if (same) {
+    if (!isauto) PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (-openblas_coretype; OpenBLAS's own choice)\n", was));
+    PetscFunctionReturn(0);
+  }
+  PetscCheck(!setenv("OPENBLAS_CORETYPE", want, 1), PETSC_COMM_SELF, PETSC_ERR_SYS, "setenv OPENBLAS_CORETYPE failed");
+  quit();
+  init();
+  PetscCall(PetscStrcasecmp(corename(), want, &same));
+  /* an unknown name leaves OpenBLAS on its own choice (it prints "Core not found") */
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "-openblas_coretype %s: OpenBLAS has no kernels of that name (it chose %s); names as in its TargetList.txt, e.g. SkylakeX, Haswell, Zen, Sandybridge", value, corename());
+  if (isauto) PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (OpenBLAS did not know this processor and chose %s's; -openblas_coretype keep to leave them)\n", want, was));
+  else PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (-openblas_coretype; OpenBLAS chose %s's)\n", corename(), was));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexBLASView - one line of the scene's summary if phlex changed OpenBLAS's kernels (nothing otherwise)
+@*/
+PetscErrorCode PhlexBLASView(PetscViewer viewer)
+{
+  PetscFunctionBeginUser;
+  if (blas_note[0]) PetscCall(PetscViewerASCIIPrintf(viewer, "%s", blas_note));
+  PetscFunctionReturn(0);
+}
