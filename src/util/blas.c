@@ -4,12 +4,12 @@
    family and model at load time. Debian bookworm's OpenBLAS 0.3.21 does not list Intel's Emerald Rapids (family 6
    model 207) and, where a family-6 model is missing from its table, falls through to the kernels of the Prescott
    Pentium 4 (SSE3) instead of choosing by the CPU's features as it does for other unknown processors; its dgemm then
-   runs at 14 instead of 64 GFlop/s, and CHOLMOD's and MUMPS's
-   factorizations take 1.6-2.1 x as long (BENCHMARKS.md section 47). OpenBLAS's remedy is OPENBLAS_CORETYPE, read when
-   the library loads, before phlex runs: phlex sets it and has OpenBLAS choose again (its own gotoblas_dynamic_quit
-   and gotoblas_dynamic_init), before the first BLAS call. Automatic only where OpenBLAS fell back to Prescott on a
-   processor with AVX-512 or AVX2 (a real Prescott has neither) and OPENBLAS_CORETYPE is not set; -openblas_coretype
-   names kernels or keeps OpenBLAS's choice. Nothing happens with another BLAS. */
+   runs at 14 instead of 62-64 GFlop/s, and CHOLMOD's and MUMPS's factorizations take 1.6-2.1 x as long (BENCHMARKS.md
+   section 47). OpenBLAS's remedy is OPENBLAS_CORETYPE, read when the library loads, before phlex runs: phlex sets it
+   and has OpenBLAS choose again (its own gotoblas_dynamic_quit and gotoblas_dynamic_init) before the first BLAS call.
+   Automatic only where OpenBLAS fell back to Prescott on a processor with AVX-512 or AVX2 (a real Prescott has
+   neither) and OPENBLAS_CORETYPE is not set; -openblas_coretype names kernels or keeps OpenBLAS's choice. Nothing
+   happens with another BLAS. */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
 #include <phlex_impl.h>
 #include <dlfcn.h>
@@ -38,8 +38,9 @@ static const char *AutoCore(void)
 
   Options Database Keys:
 . -openblas_coretype <auto|keep|name> - auto: where OpenBLAS fell back to its Prescott kernels on a processor with
-                                        AVX-512 or AVX2, the kernels it chooses by the CPU's features (Cooperlake, SkylakeX, Haswell); keep: OpenBLAS's choice; or the name
-                                        of OpenBLAS kernels (as OPENBLAS_CORETYPE)
+                                        AVX-512 or AVX2, the kernels it chooses by the CPU's features for processors
+                                        it does not know (Cooperlake, SkylakeX, Haswell); keep: OpenBLAS's choice; or
+                                        the name of OpenBLAS kernels (as OPENBLAS_CORETYPE)
 @*/
 PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
 {
