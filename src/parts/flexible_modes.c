@@ -508,7 +508,8 @@ PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart part, PetscInt nev, PetscInt
   only (with a frame patch it counts all, rigid ones included). With -modes_target_frequency at least a tenth of the
   body's frequency scale (its estimated first bending frequency) a free body's six rigid modes are deflated the same
   way (the rigid fields; a floating pencil's rigid unknowns: v = 0, q = e_i) and listed first; -modes_eps_nev then
-  counts the elastic modes only. (SLEPc's own -modes_eps_target does not deflate them.)
+  counts the elastic modes only. SLEPc's own -modes_eps_target, the eigenvalue (omega T)^2 in the scene's time unit T,
+  is taken the same way.
 
   Options Database Keys:
 + -modes_eps_nev <n>              - number of eigenpairs (default nev, +6 for a free body whose rigid modes are not deflated)
@@ -543,6 +544,17 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     PetscCheck(ftarget >= 0, b->comm, PETSC_ERR_USER_INPUT, "-modes_target_frequency must be >= 0 Hz, got %g", (double)ftarget);
     sigma = PetscSqr(2.0 * PETSC_PI * ftarget * units->time);
     if (sigma == 0 && free_body) sigma = -PetscSqr(1e-2 * omega);
+  }
+  {
+    /* SLEPc's own target, a non-dimensional eigenvalue (omega T)^2, read as -modes_target_frequency's (it wins, as
+       EPSSetFromOptions will set it): a free body's rigid modes are then deflated the same way */
+    PetscReal target;
+    PetscBool given;
+    PetscCall(PetscOptionsGetReal(NULL, "modes_", "-eps_target", &target, &given));
+    if (given) {
+      sigma = target;
+      flg   = PETSC_TRUE;
+    }
   }
   if (b->floating && !mean_axes) PetscCall(FloatingPencil(b, &A, &B, is));
   PetscCall(EPSSetOperators(eps, A, B));
