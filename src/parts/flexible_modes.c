@@ -477,6 +477,8 @@ PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart part, PetscInt nev, PetscInt
   PetscFunctionReturn(0);
 }
 
+static PetscErrorCode ComputeModes(PhlexPart, PetscBool, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
+
 /*@C
   PhlexFlexibleComputeModes - lowest eigenpairs of K x = lambda Mv x of a flexible body (non-dimensional lambda = omega^2)
 
@@ -518,6 +520,35 @@ PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart part, PetscInt nev, PetscInt
 @*/
 PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
 {
+  PetscFunctionBeginUser;
+  PetscCall(ComputeModes(part, PETSC_TRUE, nev, nconv, nrigid, lambda, vecs, rigid, resid));
+  PetscFunctionReturn(0);
+}
+
+/*@C
+  PhlexFlexibleFirstElasticEigenvalue - the lowest elastic eigenvalue of K x = lambda Mv x (non-dimensional), whatever
+  target the modal options give (-modes_target_frequency, -modes_eps_target: they choose the modes of a modal analysis
+  or a reduction, not this one); the inertia-relief shift of a reduced body on mean axes (reduced_build.c), whose
+  refinements divide the error in mode i by 1 + lambda_i / lambda1, at least 2 only with the lowest
+
+  Collective
+@*/
+PetscErrorCode PhlexFlexibleFirstElasticEigenvalue(PhlexPart part, PetscReal *lambda1)
+{
+  PetscInt   nconv, nrigid;
+  PetscReal *lam;
+
+  PetscFunctionBeginUser;
+  PetscCall(ComputeModes(part, PETSC_FALSE, 1, &nconv, &nrigid, &lam, NULL, NULL, NULL));
+  PetscCheck(nconv > nrigid, part->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the first elastic mode did not converge", part->name);
+  *lambda1 = lam[nrigid];
+  PetscCall(PetscFree(lam));
+  PetscFunctionReturn(0);
+}
+
+/* the eigenpairs of PhlexFlexibleComputeModes(); use_target false: the lowest, whatever target the options give */
+static PetscErrorCode ComputeModes(PhlexPart part, PetscBool use_target, PetscInt nev, PetscInt *nconv, PetscInt *nrigid, PetscReal **lambda, Vec **vecs, PetscReal **rigid, PetscReal **resid)
+{
   PhlexFlexible     b     = (PhlexFlexible)part->data;
   const PhlexUnits *units = part->units;
   PetscBool         mean_axes = (b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES) ? PETSC_TRUE : PETSC_FALSE;
@@ -540,6 +571,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
   want  = nev + (free_body ? 6 : 0);
   sigma = free_body ? -PetscSqr(1e-2 * omega) : 0.0;
   PetscCall(PhlexModesEPSCreate(b->comm, &eps, &ftarget, &flg));
+  if (!use_target) flg = PETSC_FALSE;
   if (flg) {
     PetscCheck(ftarget >= 0, b->comm, PETSC_ERR_USER_INPUT, "-modes_target_frequency must be >= 0 Hz, got %g", (double)ftarget);
     sigma = PetscSqr(2.0 * PETSC_PI * ftarget * units->time);
@@ -551,7 +583,7 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     PetscReal target;
     PetscBool given;
     PetscCall(PetscOptionsGetReal(NULL, "modes_", "-eps_target", &target, &given));
-    if (given) {
+    if (given && use_target) {
       sigma = target;
       flg   = PETSC_TRUE;
     }
@@ -596,6 +628,10 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
     PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
   }
   PetscCall(EPSSetFromOptions(eps));
+  if (!use_target) { /* the lowest: the options' target (-modes_eps_target, which=...) undone */
+    PetscCall(EPSSetTarget(eps, sigma));
+    PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+  }
   {
     PetscBool trueres, krylov;
     EPSConv   conv;

@@ -376,16 +376,11 @@ static PetscErrorCode FixedInterfaceModes(PhlexPart part, PetscInt nmodes, Petsc
 static PetscErrorCode ReliefShift(PhlexPart part, PetscReal *lambda1)
 {
   PhlexFlexible b = (PhlexFlexible)part->data;
-  PetscInt      nconv, nrigid;
-  PetscReal    *lam;
 
   PetscFunctionBeginUser;
   *lambda1 = 0.0;
   if (!(b->floating && b->frame_condition == PHLEX_FRAME_MEAN_AXES)) PetscFunctionReturn(0);
-  PetscCall(PhlexFlexibleComputeModes(part, 1, &nconv, &nrigid, &lam, NULL, NULL, NULL));
-  PetscCheck(nconv > 6, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the first free elastic mode did not converge", b->name);
-  *lambda1 = lam[6];
-  PetscCall(PetscFree(lam));
+  PetscCall(PhlexFlexibleFirstElasticEigenvalue(part, lambda1));
   PetscFunctionReturn(0);
 }
 
@@ -494,15 +489,8 @@ static PetscErrorCode CraigBamptonVectors(PhlexPart part, PetscInt nmodes, Vec *
   Vec            *psi, *Z, *dist, *vecs;
 
   PetscFunctionBeginUser;
-  if (mean_axes) {
-    /* the shift: the first free elastic eigenvalue (that of the attachment modes' solves) */
-    PetscInt   nconv, nrigid;
-    PetscReal *lam;
-    PetscCall(PhlexFlexibleComputeModes(part, 1, &nconv, &nrigid, &lam, NULL, NULL, NULL));
-    PetscCheck(nconv > 6, b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: the first free elastic mode did not converge", b->name);
-    lambda1 = lam[6];
-    PetscCall(PetscFree(lam));
-  }
+  /* the shift: the first free elastic eigenvalue (that of the attachment modes' solves) */
+  if (mean_axes) PetscCall(PhlexFlexibleFirstElasticEigenvalue(part, &lambda1));
   PetscCall(AttachmentModes(part, lambda1, &psi, &npsi));
   PetscCall(PetscMalloc4(nz, &dist, nz, &Z, nz * nz, &S, PetscMax(nmodes, 1), &vecs));
   for (PetscInt q = 0; q < b->nports; q++)
