@@ -336,6 +336,7 @@ FEATURES = {
     "ptscotch": "PETSC_HAVE_PTSCOTCH",
     "hypre": "PETSC_HAVE_HYPRE",
     "mpi2": None,
+    "openblas": "OPENBLAS",  # not a PETSc macro: the system's libblas.so.3 is OpenBLAS on x86-64 (openblas_available)
 }
 
 # requirement -> a program that must be on PATH (a tool a test's filter runs besides phlex)
@@ -622,6 +623,20 @@ def petsc_macros() -> Optional[set]:
     return None
 
 
+def openblas_available() -> bool:
+    """The BLAS phlex links (-lblas: the system's libblas.so.3) is OpenBLAS with kernels for several x86-64 processors
+    (Debian's, which make deps installs): the tests of -openblas_coretype need it."""
+    import ctypes
+    import platform
+    if platform.machine() not in ("x86_64", "AMD64"):
+        return False
+    try:
+        lib = ctypes.CDLL("libblas.so.3")
+    except OSError:
+        return False
+    return all(hasattr(lib, f) for f in ("openblas_get_corename", "gotoblas_dynamic_init"))
+
+
 def missing_features(requires: Sequence[str], macros: Optional[set]) -> List[str]:
     """The required features that this PETSc installation lacks, and the tools not on PATH
     (named 'feature (program not on PATH)')."""
@@ -632,6 +647,10 @@ def missing_features(requires: Sequence[str], macros: Optional[set]) -> List[str
                 missing.append(f"{feature} ({TOOLS[feature]} not on PATH)")
             continue
         macro = FEATURES[feature]
+        if macro == "OPENBLAS":
+            if not openblas_available():
+                missing.append("openblas (libblas.so.3 is not OpenBLAS for x86-64)")
+            continue
         if macro is not None and (macros is None or macro not in macros):
             missing.append(feature)
     return missing
@@ -1302,7 +1321,7 @@ def main(argv: Sequence[str]) -> int:
         return 1
     macros = petsc_macros()
     cases = [load_case(name, exists, cfg.cases, macros) for name, exists in names]
-    if macros is None and any(c.spec and any(FEATURES.get(f) for f in c.spec.requires) for c in cases):
+    if macros is None and any(c.spec and any(FEATURES.get(f) not in (None, "OPENBLAS") for f in c.spec.requires) for c in cases):
         print("# warning: petscconf.h not found (pkg-config petsc); optional features count as missing")
     if cfg.update:
         print("# --update: storing outputs as the new expected results")

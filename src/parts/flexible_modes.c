@@ -586,6 +586,7 @@ static PetscErrorCode ComputeModes(PhlexPart part, PetscBool use_target, PetscIn
     if (given && use_target) {
       sigma = target;
       flg   = PETSC_TRUE;
+      if (sigma == 0 && free_body) sigma = -PetscSqr(1e-2 * omega); /* K is singular: as -modes_target_frequency 0 */
     }
   }
   if (b->floating && !mean_axes) PetscCall(FloatingPencil(b, &A, &B, is));
@@ -628,9 +629,16 @@ static PetscErrorCode ComputeModes(PhlexPart part, PetscBool use_target, PetscIn
     PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
   }
   PetscCall(EPSSetFromOptions(eps));
-  if (!use_target) { /* the lowest: the options' target (-modes_eps_target, which=...) undone */
+  if (flg) PetscCall(EPSSetTarget(eps, sigma)); /* -modes_eps_target 0 on a free body: the substitute above */
+  if (!use_target) {
+    /* the lowest: the options' target, shift and count undone (-modes_eps_target, -modes_st_shift, -modes_eps_nev,
+       which-eigenpairs) */
+    ST st;
     PetscCall(EPSSetTarget(eps, sigma));
     PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+    PetscCall(EPSSetDimensions(eps, want, PETSC_DEFAULT, PETSC_DEFAULT));
+    PetscCall(EPSGetST(eps, &st));
+    PetscCall(STSetShift(st, sigma));
   }
   {
     PetscBool trueres, krylov;

@@ -192,7 +192,7 @@ static PetscErrorCode ShiftedSolverSolve(ShiftedSolver *s, Vec rhs, Vec *x)
     PetscCall(KSPSolve(s->ksp, s->r, s->dx));
     PetscCall(VecAXPY(*x, 1.0, s->dx));
   }
-  PetscCheck(!s->relief || rn <= 1e-12 * fn || rn <= 1e-13 * (kn * xn + fn), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: a static solve of the Krylov reduction did not converge on mean axes (backward error %g after %" PetscInt_FMT " refinements)", b->name, (double)(rn / (kn * xn + fn)), it);
+  PetscCheck(!s->relief || rn <= 1e-12 * fn || rn <= 1e-13 * (kn * xn + fn), b->comm, PETSC_ERR_NOT_CONVERGED, "body %s: a static solve of the reduction (inertia relief) did not converge on mean axes (backward error %g after %" PetscInt_FMT " refinements)", b->name, (double)(rn / (kn * xn + fn)), it);
   if (s->mean_axes) PetscCall(RemoveRigid(b, s->R, *x, s->work));
   PetscFunctionReturn(0);
 }
@@ -615,6 +615,13 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, const PhlexReduction *red, Phle
       PetscCall(PetscMalloc1(nmodes, &model->lambda_full));
       for (PetscInt k = 0; k < nmodes; k++) model->lambda_full[k] = lambda[r0 + k];
       lambda1 = nmodes ? lambda[r0] : 1.0;
+      if (mean_axes) {
+        /* the relief shift must be the lowest elastic eigenvalue: with a target the modes above are those nearest it */
+        PetscBool t1, t2;
+        PetscCall(PetscOptionsHasName(NULL, "modes_", "-target_frequency", &t1));
+        PetscCall(PetscOptionsHasName(NULL, "modes_", "-eps_target", &t2));
+        if (t1 || t2) PetscCall(PhlexFlexibleFirstElasticEigenvalue(part, &lambda1));
+      }
       for (PetscInt k = 0; k < r0; k++) PetscCall(VecDestroy(&vecs[k]));
       PetscCall(PetscMalloc1(nmodes + 6 * b->nports, &Phi));
       for (PetscInt k = 0; k < nmodes; k++) Phi[nb++] = vecs[r0 + k];

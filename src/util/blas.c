@@ -7,28 +7,58 @@
    runs at 14 instead of 62-64 GFlop/s, and CHOLMOD's and MUMPS's factorizations take 1.6-2.1 x as long (BENCHMARKS.md
    section 47). OpenBLAS's remedy is OPENBLAS_CORETYPE, read when the library loads, before phlex runs: phlex sets it
    and has OpenBLAS choose again (its own gotoblas_dynamic_quit and gotoblas_dynamic_init) before the first BLAS call.
-   Automatic only where OpenBLAS fell back to Prescott on a processor with AVX-512 or AVX2 (a real Prescott has
-   neither) and OPENBLAS_CORETYPE is not set; -openblas_coretype names kernels or keeps OpenBLAS's choice. Nothing
+   Automatic only where OpenBLAS fell back to Prescott on a processor with AVX-512, AVX2 or AVX (a real Prescott has
+   none) and OPENBLAS_CORETYPE is not set; -openblas_coretype names kernels or keeps OpenBLAS's choice. Nothing
    happens with another BLAS. */
 #define _GNU_SOURCE /* RTLD_DEFAULT */
 #include <phlex_impl.h>
 #include <dlfcn.h>
+#include <ctype.h>
 
 static char blas_note[256]; /* what was changed, for the scene's summary ("" if nothing) */
 
 typedef char *(*CoreNameFn)(void);
 typedef void (*DynamicFn)(void);
 
-/* the kernels to use where OpenBLAS fell back to Prescott's (NULL: keep them) */
+/* the kernels to use where OpenBLAS fell back to Prescott's (NULL: keep them): as its own choice by features for a
+   processor it does not know, except SkylakeX's for Cooperlake's (the same double-precision kernels: dgemm 64 against
+   62 GFlop/s here; Cooperlake's add bfloat16), which 0.3.21 cannot be given by name (its force_coretype stops one
+   short of Cooperlake in its table) */
 static const char *AutoCore(void)
 {
   __builtin_cpu_init();
-  /* OpenBLAS's own choice by features (its gotoblas_dynamic_init for an unknown processor) */
-  if (__builtin_cpu_supports("avx512bf16")) return "Cooperlake";
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")) return "SkylakeX";
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return "Haswell";
   if (__builtin_cpu_supports("avx")) return "Sandybridge";
   return NULL;
+}
+
+/* whether this processor runs the named kernels (a name OpenBLAS has, forced on a processor without its instructions,
+   would stop phlex with SIGILL at the first product); names it does not list here are left to OpenBLAS */
+static PetscBool CoreRuns(const char *name, const char **needs)
+{
+  static const struct {
+    const char *names, *needs;
+    int         level; /* 3: AVX-512 (F, DQ, BW, VL), 2: AVX2 and FMA, 1: AVX, 0: SSE4.2 */
+  } cores[] = {
+    {" skylakex cooperlake sapphirerapids ", "AVX-512", 3},
+    {" haswell zen ", "AVX2 and FMA", 2},
+    {" sandybridge ", "AVX", 1},
+    {" nehalem ", "SSE4.2", 0},
+  };
+  char key[40];
+  int  level;
+
+  __builtin_cpu_init();
+  level = (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")) ? 3 : (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) ? 2 : __builtin_cpu_supports("avx") ? 1 : __builtin_cpu_supports("sse4.2") ? 0 : -1;
+  snprintf(key, sizeof(key), " %.36s ", name);
+  for (char *c = key; *c; c++) *c = (char)tolower((unsigned char)*c);
+  for (size_t i = 0; i < sizeof(cores) / sizeof(cores[0]); i++)
+    if (strstr(cores[i].names, key)) {
+      *needs = cores[i].needs;
+      return level >= cores[i].level ? PETSC_TRUE : PETSC_FALSE;
+    }
+  return PETSC_TRUE;
 }
 
 /*@C
@@ -38,8 +68,8 @@ static const char *AutoCore(void)
 
   Options Database Keys:
 . -openblas_coretype <auto|keep|name> - auto: where OpenBLAS fell back to its Prescott kernels on a processor with
-                                        AVX-512 or AVX2, the kernels it chooses by the CPU's features for processors
-                                        it does not know (Cooperlake, SkylakeX, Haswell); keep: OpenBLAS's choice; or
+                                        AVX-512, AVX2 or AVX, the kernels it chooses by the CPU's features for processors
+                                        it does not know (SkylakeX, Haswell, Sandybridge); keep: OpenBLAS's choice; or
                                         the name of OpenBLAS kernels (as OPENBLAS_CORETYPE)
 @*/
 PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
@@ -54,8 +84,9 @@ PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
   PetscFunctionBeginUser;
   blas_note[0] = 0;
   PetscOptionsBegin(comm, NULL, "BLAS options", NULL);
-  PetscCall(PetscOptionsString("-openblas_coretype", "OpenBLAS kernels: auto (where OpenBLAS fell back to its Prescott kernels on a processor with AVX-512 or AVX2, as 0.3.21 does on processors newer than it: those it chooses by the CPU's features, Cooperlake, SkylakeX or Haswell), keep (OpenBLAS's choice), or a name as in OPENBLAS_CORETYPE (SkylakeX, Haswell, Zen, ...)", "PhlexBLASSetFromOptions", value, value, sizeof(value), &set));
+  PetscCall(PetscOptionsString("-openblas_coretype", "OpenBLAS kernels: auto (where OpenBLAS fell back to its Prescott kernels on a processor with AVX-512, AVX2 or AVX, as 0.3.21 does on processors newer than it: those it chooses by the CPU's features, SkylakeX, Haswell or Sandybridge), keep (OpenBLAS's choice), or a name as in OPENBLAS_CORETYPE (SkylakeX, Haswell, Zen, ...)", "PhlexBLASSetFromOptions", value, value, sizeof(value), &set));
   PetscOptionsEnd();
+  PetscCheck(value[0], comm, PETSC_ERR_USER_INPUT, "-openblas_coretype needs a value: auto, keep or the name of OpenBLAS kernels");
   PetscCall(PetscStrcasecmp(value, "auto", &isauto));
   PetscCall(PetscStrcasecmp(value, "keep", &iskeep));
   if (iskeep || (isauto && env)) PetscFunctionReturn(0); /* OpenBLAS read OPENBLAS_CORETYPE itself */
@@ -67,7 +98,11 @@ PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
   if (isauto) {
     PetscCall(PetscStrcasecmp(was, "Prescott", &same));
     if (!same || !(want = AutoCore())) PetscFunctionReturn(0);
-  } else want = value;
+  } else {
+    const char *needs = NULL;
+    want = value;
+    PetscCheck(CoreRuns(want, &needs), comm, PETSC_ERR_USER_INPUT, "-openblas_coretype %s: those kernels need %s, which this processor lacks", value, needs);
+  }
   PetscCall(PetscStrcasecmp(was, want, &same));
   if (same) {
     if (!isauto) PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (-openblas_coretype; OpenBLAS's own choice)\n", was));
@@ -77,8 +112,8 @@ PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
   quit();
   init();
   PetscCall(PetscStrcasecmp(corename(), want, &same));
-  /* an unknown name leaves OpenBLAS on its own choice (it prints "Core not found") */
-  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "-openblas_coretype %s: OpenBLAS has no kernels of that name (it chose %s); names as in its TargetList.txt, e.g. SkylakeX, Haswell, Zen, Sandybridge", value, corename());
+  /* a name OpenBLAS does not take (unknown, or Cooperlake in 0.3.21) leaves it to choose by the CPU's features */
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "-openblas_coretype %s: this OpenBLAS does not take that name (it chose %s by the processor's features); names as in its TargetList.txt, e.g. SkylakeX, Haswell, Zen, Sandybridge", value, corename());
   if (isauto) PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (OpenBLAS did not know this processor and chose %s's; -openblas_coretype keep to leave them)\n", want, was));
   else PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (-openblas_coretype; OpenBLAS chose %s's)\n", corename(), was));
   PetscFunctionReturn(0);

@@ -366,6 +366,7 @@ static const struct {
   const char *name;
   unsigned    analyses;
 } cat_setup[] = {
+  {"openblas_coretype",               7}, /* before the scene (blas.c) */
   {"phlex_jacobian_aij",              5}, /* the system's Jacobian (transient, linearized) */
   {"snes_phlexcondensed_balance",     1}, /* SNES phlexcondensed */
   {"snes_phlexcondensed_guess_order", 1},
