@@ -16,6 +16,7 @@ import argparse
 import concurrent.futures
 import csv
 import fnmatch
+import functools
 import io
 import math
 import os
@@ -623,6 +624,7 @@ def petsc_macros() -> Optional[set]:
     return None
 
 
+@functools.lru_cache(maxsize=None)
 def openblas_available() -> bool:
     """The BLAS phlex links (-lblas: the system's libblas.so.3) is OpenBLAS with kernels for several x86-64 processors
     (Debian's, which make deps installs): the tests of -openblas_coretype need it."""

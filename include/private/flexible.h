@@ -390,6 +390,7 @@ PETSC_INTERN PetscErrorCode PhlexFlexibleSteadyDrive(PhlexPart, PetscInt, const 
 /* flexible_modes.c */
 PETSC_INTERN PetscErrorCode PhlexFlexibleComputeModes(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
 PETSC_INTERN PetscErrorCode PhlexFlexibleFirstElasticEigenvalue(PhlexPart, PetscReal *);
+PETSC_INTERN PetscErrorCode PhlexModesLowestFirst(PetscBool *);
 PETSC_INTERN PetscErrorCode PhlexFlexibleModesAnalysis(PhlexPart, PetscInt, PetscInt *, PetscInt *, PetscReal **, Vec **, PetscReal **, PetscReal **);
 PETSC_INTERN PetscErrorCode PhlexFlexibleModesRequestCheck(PhlexPart, PetscInt, const char[], PetscInt);
 PETSC_INTERN PetscErrorCode PhlexFlexiblePortInput(PhlexPart, PhlexFlexible, PetscBool, const PhlexFrameState *, PetscInt, PetscReal, PetscReal[6]);

@@ -526,6 +526,26 @@ PetscErrorCode PhlexFlexibleComputeModes(PhlexPart part, PetscInt nev, PetscInt 
 }
 
 /*@C
+  PhlexModesLowestFirst - whether the modal options leave the eigensolver's default order, the lowest eigenvalues
+  first (no -modes_target_frequency, -modes_eps_target, -modes_eps_interval or other choice of which eigenpairs)
+
+  Not collective
+@*/
+PetscErrorCode PhlexModesLowestFirst(PetscBool *lowest)
+{
+  const char *const which[] = {"-target_frequency", "-eps_target", "-eps_interval", "-eps_all", "-eps_largest_magnitude", "-eps_smallest_magnitude", "-eps_largest_real", "-eps_smallest_real", "-eps_largest_imaginary", "-eps_smallest_imaginary", "-eps_target_real", "-eps_target_imaginary"};
+
+  PetscFunctionBeginUser;
+  *lowest = PETSC_TRUE;
+  for (size_t i = 0; i < sizeof(which) / sizeof(which[0]) && *lowest; i++) {
+    PetscBool given;
+    PetscCall(PetscOptionsHasName(NULL, "modes_", which[i], &given));
+    if (given) *lowest = PETSC_FALSE;
+  }
+  PetscFunctionReturn(0);
+}
+
+/*@C
   PhlexFlexibleFirstElasticEigenvalue - the lowest elastic eigenvalue of K x = lambda Mv x (non-dimensional), whatever
   target the modal options give (-modes_target_frequency, -modes_eps_target: they choose the modes of a modal analysis
   or a reduction, not this one); the inertia-relief shift of a reduced body on mean axes (reduced_build.c), whose

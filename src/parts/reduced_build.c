@@ -616,11 +616,11 @@ PetscErrorCode PhlexReducedBuild(PhlexPart part, const PhlexReduction *red, Phle
       for (PetscInt k = 0; k < nmodes; k++) model->lambda_full[k] = lambda[r0 + k];
       lambda1 = nmodes ? lambda[r0] : 1.0;
       if (mean_axes) {
-        /* the relief shift must be the lowest elastic eigenvalue: with a target the modes above are those nearest it */
-        PetscBool t1, t2;
-        PetscCall(PetscOptionsHasName(NULL, "modes_", "-target_frequency", &t1));
-        PetscCall(PetscOptionsHasName(NULL, "modes_", "-eps_target", &t2));
-        if (t1 || t2) PetscCall(PhlexFlexibleFirstElasticEigenvalue(part, &lambda1));
+        /* the relief shift must be the lowest elastic eigenvalue: with a target (or another order) the modes above are
+           not the lowest */
+        PetscBool lowest;
+        PetscCall(PhlexModesLowestFirst(&lowest));
+        if (!lowest) PetscCall(PhlexFlexibleFirstElasticEigenvalue(part, &lambda1));
       }
       for (PetscInt k = 0; k < r0; k++) PetscCall(VecDestroy(&vecs[k]));
       PetscCall(PetscMalloc1(nmodes + 6 * b->nports, &Phi));

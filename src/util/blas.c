@@ -20,6 +20,27 @@ static char blas_note[256]; /* what was changed, for the scene's summary ("" if 
 typedef char *(*CoreNameFn)(void);
 typedef void (*DynamicFn)(void);
 
+static int HasAVX512(void)
+{
+  return __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl");
+}
+static int HasAVX2(void)
+{
+  return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+}
+static int HasAVX(void)
+{
+  return __builtin_cpu_supports("avx");
+}
+static int HasFMA4(void)
+{
+  return __builtin_cpu_supports("fma4");
+}
+static int HasSSE42(void)
+{
+  return __builtin_cpu_supports("sse4.2");
+}
+
 /* the kernels to use where OpenBLAS fell back to Prescott's (NULL: keep them): as its own choice by features for a
    processor it does not know, except SkylakeX's for Cooperlake's (the same double-precision kernels: dgemm 64 against
    62 GFlop/s here; Cooperlake's add bfloat16), which 0.3.21 cannot be given by name (its force_coretype stops one
@@ -27,36 +48,36 @@ typedef void (*DynamicFn)(void);
 static const char *AutoCore(void)
 {
   __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")) return "SkylakeX";
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return "Haswell";
-  if (__builtin_cpu_supports("avx")) return "Sandybridge";
+  if (HasAVX512()) return "SkylakeX";
+  if (HasAVX2()) return "Haswell";
+  if (HasAVX()) return "Sandybridge";
   return NULL;
 }
 
-/* whether this processor runs the named kernels (a name OpenBLAS has, forced on a processor without its instructions,
-   would stop phlex with SIGILL at the first product); names it does not list here are left to OpenBLAS */
+/* whether this processor runs the named kernels: OpenBLAS does not check, and kernels forced on a processor without
+   their instructions stop phlex with SIGILL at the first product. Names not listed (older x86 kernels, up to SSE4.1;
+   names a newer OpenBLAS adds) are left to OpenBLAS */
 static PetscBool CoreRuns(const char *name, const char **needs)
 {
   static const struct {
     const char *names, *needs;
-    int         level; /* 3: AVX-512 (F, DQ, BW, VL), 2: AVX2 and FMA, 1: AVX, 0: SSE4.2 */
+    int (*has)(void);
   } cores[] = {
-    {" skylakex cooperlake sapphirerapids ", "AVX-512", 3},
-    {" haswell zen ", "AVX2 and FMA", 2},
-    {" sandybridge ", "AVX", 1},
-    {" nehalem ", "SSE4.2", 0},
+    {" skylakex cooperlake sapphirerapids ", "AVX-512 (F, DQ, BW, VL)", HasAVX512},
+    {" haswell zen ", "AVX2 and FMA", HasAVX2},
+    {" sandybridge ", "AVX", HasAVX},
+    {" bulldozer piledriver steamroller excavator ", "AMD's FMA4", HasFMA4},
+    {" nehalem ", "SSE4.2", HasSSE42},
   };
   char key[40];
-  int  level;
 
   __builtin_cpu_init();
-  level = (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512vl")) ? 3 : (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) ? 2 : __builtin_cpu_supports("avx") ? 1 : __builtin_cpu_supports("sse4.2") ? 0 : -1;
   snprintf(key, sizeof(key), " %.36s ", name);
   for (char *c = key; *c; c++) *c = (char)tolower((unsigned char)*c);
   for (size_t i = 0; i < sizeof(cores) / sizeof(cores[0]); i++)
     if (strstr(cores[i].names, key)) {
       *needs = cores[i].needs;
-      return level >= cores[i].level ? PETSC_TRUE : PETSC_FALSE;
+      return cores[i].has() ? PETSC_TRUE : PETSC_FALSE;
     }
   return PETSC_TRUE;
 }
@@ -112,8 +133,9 @@ PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
   quit();
   init();
   PetscCall(PetscStrcasecmp(corename(), want, &same));
-  /* a name OpenBLAS does not take (unknown, or Cooperlake in 0.3.21) leaves it to choose by the CPU's features */
-  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "-openblas_coretype %s: this OpenBLAS does not take that name (it chose %s by the processor's features); names as in its TargetList.txt, e.g. SkylakeX, Haswell, Zen, Sandybridge", value, corename());
+  /* a name OpenBLAS does not know leaves it to choose by the CPU's features; some it maps to other kernels (0.3.21:
+     Penryn's are Core2's; Cooperlake it cannot be given, and reaches only by features) */
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "-openblas_coretype %s: OpenBLAS runs %s's kernels, not %s's (a name this OpenBLAS does not know, or one it maps to other kernels); names as in its TargetList.txt, e.g. SkylakeX, Haswell, Zen, Sandybridge", value, corename(), value);
   if (isauto) PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (OpenBLAS did not know this processor and chose %s's; -openblas_coretype keep to leave them)\n", want, was));
   else PetscCall(PetscSNPrintf(blas_note, sizeof(blas_note), "BLAS: OpenBLAS's %s kernels (-openblas_coretype; OpenBLAS chose %s's)\n", corename(), was));
   PetscFunctionReturn(0);
