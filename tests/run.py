@@ -337,7 +337,6 @@ FEATURES = {
     "ptscotch": "PETSC_HAVE_PTSCOTCH",
     "hypre": "PETSC_HAVE_HYPRE",
     "mpi2": None,
-    "openblas": "OPENBLAS",  # not a PETSc macro: the system's libblas.so.3 is OpenBLAS on x86-64 (openblas_available)
 }
 
 # requirement -> a program that must be on PATH (a tool a test's filter runs besides phlex)
@@ -555,9 +554,9 @@ def parse_spec(name: str, text: str) -> Spec:
     nsize = parse_nsize(values, "nsize", 1)
     requires = [r.lower() for r in split_list(values.get("requires", ""))]
     for feature in requires:
-        if feature not in FEATURES and feature not in TOOLS:
+        if feature not in FEATURES and feature not in TOOLS and feature not in PROBES:
             raise SpecError(f"requires: unknown feature {feature!r} "
-                            f"(known: {', '.join(sorted({**FEATURES, **TOOLS}))})")
+                            f"(known: {', '.join(sorted({**FEATURES, **TOOLS, **PROBES}))})")
     output = values.get("output", f"{name}.out")
     runs = parse_runs(values, nsize)
     tol, csv_tol = parse_tolerances(values)
@@ -639,6 +638,12 @@ def openblas_available() -> bool:
     return all(hasattr(lib, f) for f in ("openblas_get_corename", "gotoblas_dynamic_init"))
 
 
+# requirement -> a probe of this machine (neither a PETSc macro nor a program)
+PROBES = {
+    "openblas": openblas_available,
+}
+
+
 def missing_features(requires: Sequence[str], macros: Optional[set]) -> List[str]:
     """The required features that this PETSc installation lacks, and the tools not on PATH
     (named 'feature (program not on PATH)')."""
@@ -648,11 +653,11 @@ def missing_features(requires: Sequence[str], macros: Optional[set]) -> List[str
             if shutil.which(TOOLS[feature]) is None:
                 missing.append(f"{feature} ({TOOLS[feature]} not on PATH)")
             continue
-        macro = FEATURES[feature]
-        if macro == "OPENBLAS":
-            if not openblas_available():
-                missing.append("openblas (libblas.so.3 is not OpenBLAS for x86-64)")
+        if feature in PROBES:
+            if not PROBES[feature]():
+                missing.append(f"{feature} (not on this machine)")
             continue
+        macro = FEATURES[feature]
         if macro is not None and (macros is None or macro not in macros):
             missing.append(feature)
     return missing
@@ -1323,7 +1328,7 @@ def main(argv: Sequence[str]) -> int:
         return 1
     macros = petsc_macros()
     cases = [load_case(name, exists, cfg.cases, macros) for name, exists in names]
-    if macros is None and any(c.spec and any(FEATURES.get(f) not in (None, "OPENBLAS") for f in c.spec.requires) for c in cases):
+    if macros is None and any(c.spec and any(FEATURES.get(f) for f in c.spec.requires) for c in cases):
         print("# warning: petscconf.h not found (pkg-config petsc); optional features count as missing")
     if cfg.update:
         print("# --update: storing outputs as the new expected results")

@@ -97,7 +97,7 @@ PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
 {
   char        value[64] = "auto", was[32];
   const char *env       = getenv("OPENBLAS_CORETYPE"), *want = NULL;
-  PetscBool   set, isauto, iskeep, same;
+  PetscBool   isauto, iskeep, same;
   CoreNameFn  corename = (CoreNameFn)dlsym(RTLD_DEFAULT, "openblas_get_corename");
   DynamicFn   quit     = (DynamicFn)dlsym(RTLD_DEFAULT, "gotoblas_dynamic_quit");
   DynamicFn   init     = (DynamicFn)dlsym(RTLD_DEFAULT, "gotoblas_dynamic_init");
@@ -105,7 +105,7 @@ PetscErrorCode PhlexBLASSetFromOptions(MPI_Comm comm)
   PetscFunctionBeginUser;
   blas_note[0] = 0;
   PetscOptionsBegin(comm, NULL, "BLAS options", NULL);
-  PetscCall(PetscOptionsString("-openblas_coretype", "OpenBLAS kernels: auto (where OpenBLAS fell back to its Prescott kernels on a processor with AVX-512, AVX2 or AVX, as 0.3.21 does on processors newer than it: those it chooses by the CPU's features, SkylakeX, Haswell or Sandybridge), keep (OpenBLAS's choice), or a name as in OPENBLAS_CORETYPE (SkylakeX, Haswell, Zen, ...)", "PhlexBLASSetFromOptions", value, value, sizeof(value), &set));
+  PetscCall(PetscOptionsString("-openblas_coretype", "OpenBLAS kernels: auto (where OpenBLAS fell back to its Prescott kernels on a processor with AVX-512, AVX2 or AVX, as 0.3.21 does on processors newer than it: those it chooses by the CPU's features, SkylakeX, Haswell or Sandybridge), keep (OpenBLAS's choice), or a name as in OPENBLAS_CORETYPE (SkylakeX, Haswell, Zen, ...)", "PhlexBLASSetFromOptions", value, value, sizeof(value), NULL));
   PetscOptionsEnd();
   PetscCheck(value[0], comm, PETSC_ERR_USER_INPUT, "-openblas_coretype needs a value: auto, keep or the name of OpenBLAS kernels");
   PetscCall(PetscStrcasecmp(value, "auto", &isauto));
